@@ -1,0 +1,61 @@
+//! Options of one design run (they enter the campaign's job-id hash, so they are serde).
+
+use serde::{Deserialize, Serialize};
+
+/// Which problem to solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjectiveKind {
+    /// Strong stabilisation: minimise max(‖Tzw‖∞, ε‖K‖∞) subject to a stable closed loop and a
+    /// stable controller (Gumussoy–Millstone–Overton 2008).
+    #[default]
+    Strong,
+    /// Plain fixed-order H∞: minimise ‖Tzw‖∞ with a stable closed loop, K unrestricted.
+    Plain,
+}
+
+/// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (algorithm.md §7).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DesignOptions {
+    /// Controller order nk ≥ 0.
+    pub order: usize,
+    /// Weight ε of the controller's own term (strong stabilisation only), ε > 0.
+    pub eps: f64,
+    /// Seed of the run's random number generator.
+    pub seed: u64,
+    /// CPU-second budget of the whole run (both phases and gradient sampling).
+    pub cpumax: f64,
+    /// Number of random starting points (HIFOO `nrand`, default 3).
+    pub nrand: usize,
+    /// Strong stabilisation or plain H∞.
+    pub objective: ObjectiveKind,
+    /// Relative tolerance of the H∞ norm computation.
+    pub hinf_tol: f64,
+    /// BFGS iteration limit per start and phase (HIFOO `maxit`, 1000).
+    pub maxit: usize,
+    /// Stop BFGS when the certificate dnorm ≤ normtol (HIFOO passes 1e-3).
+    pub normtol: f64,
+    /// Gradient-bundle radius (HIFOO passes 1e-3).
+    pub evaldist: f64,
+    /// Run gradient sampling after BFGS (HIFOO `fast = 0`).
+    pub gradient_sampling: bool,
+}
+
+impl Default for DesignOptions {
+    fn default() -> Self {
+        DesignOptions {
+            order: 1,
+            eps: 1e-3,
+            seed: 0,
+            cpumax: 60.0,
+            nrand: 3,
+            objective: ObjectiveKind::Strong,
+            hinf_tol: 1e-10,
+            maxit: 1000,
+            normtol: 1e-3,
+            evaldist: 1e-3,
+            gradient_sampling: true,
+        }
+    }
+}

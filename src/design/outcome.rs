@@ -1,0 +1,148 @@
+//! What a design run returns and what its observers see.
+
+use std::ops::ControlFlow;
+
+use serde::{Deserialize, Serialize};
+
+use super::float_serde::serde_f64_or_string;
+
+/// Phase of a design run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// Minimising max(α(A_cl), ε·α(Ak)) until it is negative.
+    Stabilisation,
+    /// BFGS on max(‖Tzw‖∞, ε‖K‖∞).
+    Optimisation,
+    /// Gradient sampling from the best optimisation point.
+    GradientSampling,
+}
+
+/// How a design run ended. Failing to stabilise is an outcome, not an error.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum DesignStatus {
+    /// Both phases ran; the controller is stable and stabilising.
+    Optimised,
+    /// Stabilised, but the optimisation phase made no progress (or could not run).
+    StabilisedOnly,
+    /// No stabilising (strongly stabilising) controller found; the best abscissa reached.
+    NotStabilised {
+        /// Best max(α(A_cl), ε·α(Ak)) reached.
+        #[serde(with = "serde_f64_or_string")]
+        best_alpha: f64,
+    },
+    /// The CPU budget ran out during optimisation; the best controller so far is returned.
+    BudgetExhausted,
+    /// Stopped by a cancel request or an observer.
+    Interrupted,
+}
+
+/// Per-phase counters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseStats {
+    /// Which phase.
+    pub phase: Phase,
+    /// Iterations (over all starts).
+    pub iters: usize,
+    /// Objective evaluations.
+    pub evals: usize,
+    /// CPU seconds.
+    pub cpu_s: f64,
+}
+
+/// The result of [`crate::design::run`]. Every figure is recomputed from `controller`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DesignOutcome {
+    /// How the run ended.
+    pub status: DesignStatus,
+    /// The returned controller as JSON `{AK, BK, CK, DK}` (see [`crate::lti::Controller`]).
+    pub controller: serde_json::Value,
+    /// ‖Tzw‖∞ of the returned controller (+∞ if the loop is unstable or ill-posed).
+    #[serde(with = "serde_f64_or_string")]
+    pub gamma: f64,
+    /// ‖K‖∞ of the returned controller (+∞ if Ak is unstable; σmax(Dk) for order 0).
+    #[serde(with = "serde_f64_or_string")]
+    pub k_hinf: f64,
+    /// Spectral abscissa of the closed loop.
+    #[serde(with = "serde_f64_or_string")]
+    pub alpha_cl: f64,
+    /// Spectral abscissa of Ak (None for order 0).
+    pub alpha_k: Option<f64>,
+    /// Final objective: max(γ, ε‖K‖∞) (strong) or γ (plain).
+    #[serde(with = "serde_f64_or_string")]
+    pub objective: f64,
+    /// Optimality certificate (dnorm, evaldist) of the final point, if the optimisation ran.
+    pub dnorm: Option<f64>,
+    /// See `dnorm`.
+    pub evaldist: Option<f64>,
+    /// Per-phase counters.
+    pub phases: Vec<PhaseStats>,
+    /// Total iterations.
+    pub iters: usize,
+    /// Total objective evaluations.
+    pub evals: usize,
+    /// Total CPU seconds of the run.
+    pub cpu_s: f64,
+}
+
+/// One iteration as seen by a design observer (the campaign's trace writer).
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignIterRecord {
+    /// Phase.
+    pub phase: Phase,
+    /// Index of the starting point.
+    pub start: usize,
+    /// Iteration within this start and phase.
+    pub iter: usize,
+    /// Objective value.
+    pub f: f64,
+    /// ‖Tzw‖∞ at the iterate (+∞ if unstable; NaN if not computed in this phase).
+    pub hinf_cl: f64,
+    /// ‖K‖∞ at the iterate (NaN if not computed).
+    pub hinf_k: f64,
+    /// α(A_cl).
+    pub alpha_cl: f64,
+    /// α(Ak) (NaN for order 0).
+    pub alpha_k: f64,
+    /// Certificate norm.
+    pub dnorm: f64,
+    /// Line-search step.
+    pub step: f64,
+    /// Evaluations so far in the run.
+    pub evals: usize,
+    /// CPU seconds since the run started.
+    pub cpu_s: f64,
+}
+
+/// Watches a design run; `Break` stops it (status `Interrupted`).
+pub trait DesignObserver {
+    /// Called once per optimiser iteration.
+    fn on_iter(&mut self, _rec: &DesignIterRecord) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+}
+
+/// An observer that watches nothing.
+pub struct NoDesignObserver;
+impl DesignObserver for NoDesignObserver {}
+
+/// A design run that could not produce a trustworthy result.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DesignError {
+    /// Invalid options.
+    #[error("invalid design option `{field}`: {problem}")]
+    Options {
+        /// Field.
+        field: &'static str,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The initial controller does not fit.
+    #[error("initial controller: {0}")]
+    Init(String),
+    /// A numerical failure that left no trustworthy point.
+    #[error("numerical failure: {0}")]
+    Numerical(String),
+}

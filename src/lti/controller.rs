@@ -1,0 +1,194 @@
+//! A dynamic output-feedback controller and its JSON file format.
+//!
+//! ```text
+//! xk' = Ak xk + Bk y,   u = Ck xk + Dk y        (positive feedback u = K y)
+//! ```
+//! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (algorithm.md §1). The file is a JSON object with
+//! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`).
+
+use std::path::{Path, PathBuf};
+
+use faer::Mat;
+use serde_json::Value;
+
+use super::matrix_json::{json_shape, matrix_from_json, matrix_to_json, MatrixJsonError};
+
+/// Controller matrices (Ak, Bk, Ck, Dk).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Controller {
+    /// nk × nk.
+    pub ak: Mat<f64>,
+    /// nk × p.
+    pub bk: Mat<f64>,
+    /// m × nk.
+    pub ck: Mat<f64>,
+    /// m × p.
+    pub dk: Mat<f64>,
+}
+
+/// A controller file that could not be read.
+#[derive(Debug, thiserror::Error)]
+#[error("controller file {}: {kind}", file.display())]
+pub struct ControllerError {
+    /// The file (or a label).
+    pub file: PathBuf,
+    /// What is wrong.
+    #[source]
+    pub kind: ControllerErrorKind,
+}
+
+/// What is wrong with a controller file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ControllerErrorKind {
+    /// Could not be read.
+    #[error("cannot read: {0}")]
+    Io(#[from] std::io::Error),
+    /// Not valid JSON.
+    #[error("invalid JSON at line {line}, column {column}: {message}")]
+    Json {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Parser message.
+        message: String,
+    },
+    /// Not an object with AK, BK, CK, DK.
+    #[error("the top level must be a JSON object with keys AK, BK, CK, DK")]
+    NotObject,
+    /// A matrix is wrong.
+    #[error("matrix `{matrix}` {problem}")]
+    Matrix {
+        /// AK, BK, CK or DK.
+        matrix: &'static str,
+        /// What is wrong.
+        problem: MatrixJsonError,
+    },
+    /// The controller does not fit the plant.
+    #[error("does not fit plant {plant}: {problem}")]
+    Mismatch {
+        /// Plant name.
+        plant: String,
+        /// What does not fit.
+        problem: String,
+    },
+}
+
+impl Controller {
+    /// The zero controller of order `nk` for `m` inputs and `p` measurements.
+    pub fn zeros(nk: usize, m: usize, p: usize) -> Self {
+        Controller { ak: Mat::zeros(nk, nk), bk: Mat::zeros(nk, p), ck: Mat::zeros(m, nk), dk: Mat::zeros(m, p) }
+    }
+
+    /// Order nk (number of controller states).
+    pub fn order(&self) -> usize {
+        self.ak.nrows()
+    }
+
+    /// Number of control inputs m (rows of Dk).
+    pub fn m(&self) -> usize {
+        self.dk.nrows()
+    }
+
+    /// Number of measurements p (columns of Dk).
+    pub fn p(&self) -> usize {
+        self.dk.ncols()
+    }
+
+    /// Reads a controller file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Controller, ControllerError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ControllerError { file: path.to_path_buf(), kind: e.into() })?;
+        Self::from_json_str(&text, path)
+    }
+
+    /// Parses a controller from JSON text; `file` names it in errors. Shapes are taken from DK
+    /// (m × p) and AK (nk × nk) and every block is checked against them.
+    pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Controller, ControllerError> {
+        let err = |kind| ControllerError { file: file.as_ref().to_path_buf(), kind };
+        let doc: Value = serde_json::from_str(text).map_err(|e| {
+            err(ControllerErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() })
+        })?;
+        Self::from_json_value(&doc).map_err(err)
+    }
+
+    /// Reads a controller from a parsed JSON value (`{AK, BK, CK, DK}`).
+    pub fn from_json_value(doc: &Value) -> Result<Controller, ControllerErrorKind> {
+        let obj = doc.as_object().ok_or(ControllerErrorKind::NotObject)?;
+        let mat = |key: &'static str, r: usize, c: usize| {
+            matrix_from_json(obj.get(key), r, c)
+                .map_err(|problem| ControllerErrorKind::Matrix { matrix: key, problem })
+        };
+        let shape = |key: &'static str| -> Result<(usize, usize), ControllerErrorKind> {
+            let v = obj.get(key).ok_or(ControllerErrorKind::Matrix { matrix: key, problem: MatrixJsonError::Missing })?;
+            json_shape(v).ok_or(ControllerErrorKind::Matrix {
+                matrix: key,
+                problem: MatrixJsonError::NotArray { found: "a non-array" },
+            })
+        };
+        let (m, p) = shape("DK")?;
+        let nk = shape("AK")?.0;
+        if m == 0 || p == 0 {
+            return Err(ControllerErrorKind::Matrix {
+                matrix: "DK",
+                problem: MatrixJsonError::RowCount { expected: 1, got: 0 },
+            });
+        }
+        Ok(Controller { ak: mat("AK", nk, nk)?, bk: mat("BK", nk, p)?, ck: mat("CK", m, nk)?, dk: mat("DK", m, p)? })
+    }
+
+    /// The controller as `{AK, BK, CK, DK}`.
+    pub fn to_json(&self) -> Value {
+        serde_json::json!({
+            "AK": matrix_to_json(self.ak.as_ref()),
+            "BK": matrix_to_json(self.bk.as_ref()),
+            "CK": matrix_to_json(self.ck.as_ref()),
+            "DK": matrix_to_json(self.dk.as_ref()),
+        })
+    }
+
+    /// Checks that the controller's m and p match the plant's m2 and p2.
+    pub fn check_fits(&self, plant: &super::Plant) -> Result<(), ControllerErrorKind> {
+        if self.m() != plant.dims.m2 || self.p() != plant.dims.p2 {
+            return Err(ControllerErrorKind::Mismatch {
+                plant: plant.name.clone(),
+                problem: format!(
+                    "DK is {}×{}, the plant needs m2×p2 = {}×{}",
+                    self.m(),
+                    self.p(),
+                    plant.dims.m2,
+                    plant.dims.p2
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Number of free variables (nk+m)(nk+p) in x = [vec Ak; vec Bk; vec Ck; vec Dk].
+    pub fn nvar(&self) -> usize {
+        (self.order() + self.m()) * (self.order() + self.p())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn order_zero_round_trip() {
+        let text = r#"{"AK": [], "BK": [], "CK": [[], []], "DK": [[1.0, 2.0], [3.0, 4.0]]}"#;
+        let k = Controller::from_json_str(text, "k.json").unwrap();
+        assert_eq!((k.order(), k.m(), k.p()), (0, 2, 2));
+        let back = Controller::from_json_value(&k.to_json()).unwrap();
+        assert_eq!(back, k);
+    }
+
+    #[test]
+    fn wrong_block_shape_is_named() {
+        let text = r#"{"AK": [[1.0]], "BK": [[1.0, 2.0]], "CK": [[1.0]], "DK": [[1.0]]}"#;
+        let e = Controller::from_json_str(text, "k.json").unwrap_err();
+        assert!(e.to_string().contains("`BK`"), "{e}");
+    }
+}

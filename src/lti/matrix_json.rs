@@ -1,0 +1,173 @@
+//! Reading and writing dense real matrices as JSON arrays of rows.
+//!
+//! A `r × c` matrix is `[[a11, …, a1c], …, [ar1, …, arc]]`. Empty blocks are unambiguous only
+//! together with the expected shape: a `0 × c` matrix is `[]`, an `r × 0` one is `[[], …, []]`
+//! (`r` empty rows) and is also accepted as `[]`. The reader checks the shape against what the
+//! caller expects and names the row and column of the first bad entry (1-based, as a person
+//! counts them in a file).
+
+use faer::Mat;
+use serde_json::Value;
+
+/// What is wrong with one matrix in a JSON document (the caller adds file and matrix name).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MatrixJsonError {
+    /// The matrix key is absent.
+    #[error("is missing")]
+    Missing,
+    /// The value is not an array of rows.
+    #[error("must be an array of rows (arrays of numbers), found {found}")]
+    NotArray {
+        /// JSON type found.
+        found: &'static str,
+    },
+    /// A row is not an array.
+    #[error("row {row} must be an array of numbers, found {found}")]
+    RowNotArray {
+        /// 1-based row.
+        row: usize,
+        /// JSON type found.
+        found: &'static str,
+    },
+    /// Wrong number of rows.
+    #[error("has {got} rows, expected {expected}")]
+    RowCount {
+        /// Expected rows.
+        expected: usize,
+        /// Rows found.
+        got: usize,
+    },
+    /// A row of the wrong length.
+    #[error("row {row} has {got} entries, expected {expected}")]
+    RowLength {
+        /// 1-based row.
+        row: usize,
+        /// Expected columns.
+        expected: usize,
+        /// Columns found.
+        got: usize,
+    },
+    /// An entry that is not a number (a string such as "NaN", null, …).
+    #[error("entry ({row}, {col}) is not a number: {found}")]
+    NotNumber {
+        /// 1-based row.
+        row: usize,
+        /// 1-based column.
+        col: usize,
+        /// The JSON text found.
+        found: String,
+    },
+    /// A number that is not finite.
+    #[error("entry ({row}, {col}) is not finite ({value})")]
+    NotFinite {
+        /// 1-based row.
+        row: usize,
+        /// 1-based column.
+        col: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
+fn json_type(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// Reads a matrix of the expected shape from `value` (None when the key was absent).
+pub fn matrix_from_json(
+    value: Option<&Value>,
+    rows: usize,
+    cols: usize,
+) -> Result<Mat<f64>, MatrixJsonError> {
+    let value = value.ok_or(MatrixJsonError::Missing)?;
+    let arr = value
+        .as_array()
+        .ok_or(MatrixJsonError::NotArray { found: json_type(value) })?;
+    // `[]` stands for any matrix with no entries.
+    if arr.is_empty() && (rows == 0 || cols == 0) {
+        return Ok(Mat::zeros(rows, cols));
+    }
+    if arr.len() != rows {
+        return Err(MatrixJsonError::RowCount { expected: rows, got: arr.len() });
+    }
+    let mut m = Mat::zeros(rows, cols);
+    for (i, row) in arr.iter().enumerate() {
+        let r = row
+            .as_array()
+            .ok_or(MatrixJsonError::RowNotArray { row: i + 1, found: json_type(row) })?;
+        if r.len() != cols {
+            return Err(MatrixJsonError::RowLength { row: i + 1, expected: cols, got: r.len() });
+        }
+        for (j, e) in r.iter().enumerate() {
+            let x = e.as_f64().ok_or_else(|| MatrixJsonError::NotNumber {
+                row: i + 1,
+                col: j + 1,
+                found: e.to_string(),
+            })?;
+            if !x.is_finite() {
+                return Err(MatrixJsonError::NotFinite { row: i + 1, col: j + 1, value: x });
+            }
+            m[(i, j)] = x;
+        }
+    }
+    Ok(m)
+}
+
+/// Writes a matrix as a JSON array of rows.
+pub fn matrix_to_json(m: faer::MatRef<'_, f64>) -> Value {
+    Value::Array(
+        (0..m.nrows())
+            .map(|i| Value::Array((0..m.ncols()).map(|j| number(m[(i, j)])).collect()))
+            .collect(),
+    )
+}
+
+/// A finite f64 as a JSON number; non-finite values (which valid matrices never hold) as strings.
+fn number(x: f64) -> Value {
+    serde_json::Number::from_f64(x).map(Value::Number).unwrap_or_else(|| Value::String(x.to_string()))
+}
+
+/// Shape of a JSON array of rows, if it is one (rows, length of the first row).
+pub fn json_shape(value: &Value) -> Option<(usize, usize)> {
+    let arr = value.as_array()?;
+    let cols = arr.first().and_then(|r| r.as_array()).map_or(0, |r| r.len());
+    Some((arr.len(), cols))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn reads_and_writes_round_trip() {
+        let v = json!([[1.0, 2.0], [3.0, -4.5]]);
+        let m = matrix_from_json(Some(&v), 2, 2).unwrap();
+        assert_eq!(m[(1, 1)], -4.5);
+        assert_eq!(matrix_to_json(m.as_ref()), v);
+    }
+
+    #[test]
+    fn empty_blocks() {
+        assert_eq!(matrix_from_json(Some(&json!([])), 0, 3).unwrap().nrows(), 0);
+        assert_eq!(matrix_from_json(Some(&json!([])), 2, 0).unwrap().nrows(), 2);
+        assert_eq!(matrix_from_json(Some(&json!([[], []])), 2, 0).unwrap().ncols(), 0);
+    }
+
+    #[test]
+    fn names_the_bad_entry() {
+        let e = matrix_from_json(Some(&json!([[1.0, 2.0], [3.0, "NaN"]])), 2, 2).unwrap_err();
+        assert_eq!(e, MatrixJsonError::NotNumber { row: 2, col: 2, found: "\"NaN\"".into() });
+        let e = matrix_from_json(Some(&json!([[1.0], [3.0, 1.0]])), 2, 2).unwrap_err();
+        assert_eq!(e, MatrixJsonError::RowLength { row: 1, expected: 2, got: 1 });
+        assert_eq!(matrix_from_json(None, 1, 1).unwrap_err(), MatrixJsonError::Missing);
+    }
+}

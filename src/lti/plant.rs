@@ -1,0 +1,326 @@
+//! The generalised plant and its JSON file format.
+//!
+//! ```text
+//! x' = A x + B1 w + B2 u
+//! z  = C1 x + D11 w + D12 u
+//! y  = C2 x + D21 w + D22 u
+//! ```
+//! with n = dim x, m1 = dim w, m2 = dim u, p1 = dim z, p2 = dim y (algorithm.md §1).
+//!
+//! A plant file is a JSON object with `name`, optional `description`, `source` (a citation string
+//! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices
+//! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows. Other keys (`notes`, `check`, …)
+//! are kept as provenance. [`Plant::from_json_str`] validates everything and names the file, the
+//! field and the row/column of the first thing wrong.
+
+use std::path::{Path, PathBuf};
+
+use faer::{Mat, MatRef};
+use serde::Serialize;
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+
+use super::matrix_json::{json_shape, matrix_from_json, MatrixJsonError};
+
+/// Sizes of a generalised plant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct Dims {
+    /// States.
+    pub n: usize,
+    /// Disturbance inputs w.
+    pub m1: usize,
+    /// Control inputs u.
+    pub m2: usize,
+    /// Performance outputs z.
+    pub p1: usize,
+    /// Measured outputs y.
+    pub p2: usize,
+}
+
+/// A validated generalised plant.
+#[derive(Debug, Clone)]
+pub struct Plant {
+    /// Name (as in the reference tables, e.g. `HE1`).
+    pub name: String,
+    /// One-line description.
+    pub description: String,
+    /// Citation of the data's source.
+    pub citation: String,
+    /// The file's whole `source` value (repository, path, commit, …), kept as provenance.
+    pub source: Value,
+    /// Free-text notes on conventions.
+    pub notes: String,
+    /// The file's `check` block (full-order γ computed from the data vs the paper's), if any.
+    pub check: Option<Value>,
+    /// Sizes.
+    pub dims: Dims,
+    /// State matrix (n × n).
+    pub a: Mat<f64>,
+    /// Disturbance input matrix (n × m1).
+    pub b1: Mat<f64>,
+    /// Control input matrix (n × m2).
+    pub b2: Mat<f64>,
+    /// Performance output matrix (p1 × n).
+    pub c1: Mat<f64>,
+    /// Measurement matrix (p2 × n).
+    pub c2: Mat<f64>,
+    /// w → z feedthrough (p1 × m1).
+    pub d11: Mat<f64>,
+    /// u → z feedthrough (p1 × m2).
+    pub d12: Mat<f64>,
+    /// w → y feedthrough (p2 × m1).
+    pub d21: Mat<f64>,
+    /// u → y feedthrough (p2 × m2).
+    pub d22: Mat<f64>,
+}
+
+/// A plant file that could not be read, with the file it came from.
+#[derive(Debug, thiserror::Error)]
+#[error("plant file {}: {kind}", file.display())]
+pub struct PlantError {
+    /// The file (or a label such as `<inline>`).
+    pub file: PathBuf,
+    /// What is wrong.
+    #[source]
+    pub kind: PlantErrorKind,
+}
+
+/// What is wrong with a plant file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlantErrorKind {
+    /// The file could not be read.
+    #[error("cannot read: {0}")]
+    Io(#[from] std::io::Error),
+    /// Not valid JSON.
+    #[error("invalid JSON at line {line}, column {column}: {message}")]
+    Json {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The parser's message.
+        message: String,
+    },
+    /// The document is not a JSON object.
+    #[error("the top level must be a JSON object")]
+    NotObject,
+    /// A required field is absent.
+    #[error("field `{field}` is missing")]
+    MissingField {
+        /// Field name.
+        field: &'static str,
+    },
+    /// A field has the wrong type or an impossible value.
+    #[error("field `{field}`: {problem}")]
+    BadField {
+        /// Field name (e.g. `dims.n`).
+        field: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A matrix is missing, mis-shaped or holds a bad entry.
+    #[error("matrix `{matrix}` {problem}{hint}")]
+    Matrix {
+        /// Matrix name (`A`, `B1`, …).
+        matrix: &'static str,
+        /// What is wrong.
+        problem: MatrixJsonError,
+        /// Extra context (e.g. which dims the expected shape comes from).
+        hint: String,
+    },
+}
+
+/// The nine matrices with the dims their shapes come from.
+const MATRICES: [(&str, &str, &str); 9] = [
+    ("A", "n", "n"),
+    ("B1", "n", "m1"),
+    ("B2", "n", "m2"),
+    ("C1", "p1", "n"),
+    ("C2", "p2", "n"),
+    ("D11", "p1", "m1"),
+    ("D12", "p1", "m2"),
+    ("D21", "p2", "m1"),
+    ("D22", "p2", "m2"),
+];
+
+impl Dims {
+    fn get(&self, name: &str) -> usize {
+        match name {
+            "n" => self.n,
+            "m1" => self.m1,
+            "m2" => self.m2,
+            "p1" => self.p1,
+            "p2" => self.p2,
+            _ => unreachable!("dimension names are fixed in MATRICES"),
+        }
+    }
+}
+
+impl Plant {
+    /// Reads and validates a plant file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Plant, PlantError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| PlantError { file: path.to_path_buf(), kind: e.into() })?;
+        Self::from_json_str(&text, path)
+    }
+
+    /// Parses and validates a plant from JSON text; `file` names it in errors.
+    pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Plant, PlantError> {
+        let err = |kind| PlantError { file: file.as_ref().to_path_buf(), kind };
+        let doc: Value = serde_json::from_str(text).map_err(|e| {
+            err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() })
+        })?;
+        Self::from_json_value(&doc).map_err(err)
+    }
+
+    fn from_json_value(doc: &Value) -> Result<Plant, PlantErrorKind> {
+        let obj = doc.as_object().ok_or(PlantErrorKind::NotObject)?;
+        let name = match obj.get("name") {
+            None => return Err(PlantErrorKind::MissingField { field: "name" }),
+            Some(Value::String(s)) if !s.trim().is_empty() => s.clone(),
+            Some(_) => return Err(bad("name", "must be a non-empty string")),
+        };
+        let description = optional_string(obj.get("description"), "description")?;
+        let notes = optional_string(obj.get("notes"), "notes")?;
+        let source = obj.get("source").cloned().unwrap_or(Value::Null);
+        let citation = match &source {
+            Value::Null => String::new(),
+            Value::String(s) => s.clone(),
+            Value::Object(o) => optional_string(o.get("citation"), "source.citation")?,
+            _ => return Err(bad("source", "must be a citation string or an object")),
+        };
+        let dims = read_dims(obj.get("dims"))?;
+        if let Some(order) = obj.get("order") {
+            if order.as_u64() != Some(dims.n as u64) {
+                return Err(bad("order", &format!("is {order}, but dims.n is {}", dims.n)));
+            }
+        }
+        let mut mats: Vec<Mat<f64>> = Vec::with_capacity(9);
+        for (key, r, c) in MATRICES {
+            let (rows, cols) = (dims.get(r), dims.get(c));
+            let m = matrix_from_json(obj.get(key), rows, cols).map_err(|problem| {
+                let got = obj.get(key).and_then(json_shape);
+                let hint = match (&problem, got) {
+                    (MatrixJsonError::RowCount { .. } | MatrixJsonError::RowLength { .. }, Some((gr, gc))) => {
+                        format!(" (expected {rows}×{cols} = {r}×{c} from dims, file holds {gr}×{gc})")
+                    }
+                    _ => String::new(),
+                };
+                PlantErrorKind::Matrix { matrix: key, problem, hint }
+            })?;
+            mats.push(m);
+        }
+        let mut it = mats.into_iter();
+        let mut next = || it.next().expect("nine matrices were read");
+        Ok(Plant {
+            name,
+            description,
+            citation,
+            source,
+            notes,
+            check: obj.get("check").cloned(),
+            dims,
+            a: next(),
+            b1: next(),
+            b2: next(),
+            c1: next(),
+            c2: next(),
+            d11: next(),
+            d12: next(),
+            d21: next(),
+            d22: next(),
+        })
+    }
+
+    /// The plant as a JSON document in the file format (provenance kept).
+    pub fn to_json(&self) -> Value {
+        use super::matrix_json::matrix_to_json;
+        let mut o = serde_json::Map::new();
+        o.insert("name".into(), self.name.clone().into());
+        o.insert("description".into(), self.description.clone().into());
+        o.insert("source".into(), self.source.clone());
+        o.insert("notes".into(), self.notes.clone().into());
+        o.insert("dims".into(), serde_json::to_value(self.dims).expect("dims serialise"));
+        for ((key, _, _), m) in MATRICES.iter().zip(self.matrices()) {
+            o.insert((*key).into(), matrix_to_json(m));
+        }
+        if let Some(c) = &self.check {
+            o.insert("check".into(), c.clone());
+        }
+        Value::Object(o)
+    }
+
+    /// The nine matrices in file order (A, B1, B2, C1, C2, D11, D12, D21, D22).
+    pub fn matrices(&self) -> [MatRef<'_, f64>; 9] {
+        [
+            self.a.as_ref(),
+            self.b1.as_ref(),
+            self.b2.as_ref(),
+            self.c1.as_ref(),
+            self.c2.as_ref(),
+            self.d11.as_ref(),
+            self.d12.as_ref(),
+            self.d21.as_ref(),
+            self.d22.as_ref(),
+        ]
+    }
+
+    /// Whether D22 is exactly zero (the closed loop then takes its simpler linear form).
+    pub fn d22_is_zero(&self) -> bool {
+        let d = self.d22.as_ref();
+        (0..d.nrows()).all(|i| (0..d.ncols()).all(|j| d[(i, j)] == 0.0))
+    }
+
+    /// A content fingerprint (SHA-256, hex) of the dims and the matrices' exact bits: the
+    /// plant's identity in job ids, independent of formatting and provenance text.
+    pub fn fingerprint(&self) -> String {
+        let mut h = Sha256::new();
+        for d in [self.dims.n, self.dims.m1, self.dims.m2, self.dims.p1, self.dims.p2] {
+            h.update((d as u64).to_le_bytes());
+        }
+        for m in self.matrices() {
+            for j in 0..m.ncols() {
+                for i in 0..m.nrows() {
+                    h.update(m[(i, j)].to_bits().to_le_bytes());
+                }
+            }
+        }
+        h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+fn bad(field: &str, problem: &str) -> PlantErrorKind {
+    PlantErrorKind::BadField { field: field.to_string(), problem: problem.to_string() }
+}
+
+fn optional_string(v: Option<&Value>, field: &str) -> Result<String, PlantErrorKind> {
+    match v {
+        None | Some(Value::Null) => Ok(String::new()),
+        Some(Value::String(s)) => Ok(s.clone()),
+        Some(_) => Err(bad(field, "must be a string")),
+    }
+}
+
+fn read_dims(v: Option<&Value>) -> Result<Dims, PlantErrorKind> {
+    let obj = match v {
+        None => return Err(PlantErrorKind::MissingField { field: "dims" }),
+        Some(Value::Object(o)) => o,
+        Some(_) => return Err(bad("dims", "must be an object {n, m1, m2, p1, p2}")),
+    };
+    if let Some(k) = obj.keys().find(|k| !["n", "m1", "m2", "p1", "p2"].contains(&k.as_str())) {
+        return Err(bad(&format!("dims.{k}"), "unknown key (expected n, m1, m2, p1, p2)"));
+    }
+    let get = |k: &str, min: u64| -> Result<usize, PlantErrorKind> {
+        let field = format!("dims.{k}");
+        match obj.get(k) {
+            None => Err(bad(&field, "is missing")),
+            Some(x) => match x.as_u64() {
+                Some(u) if u >= min => Ok(u as usize),
+                _ => Err(bad(&field, &format!("must be an integer ≥ {min}, found {x}"))),
+            },
+        }
+    };
+    Ok(Dims { n: get("n", 1)?, m1: get("m1", 0)?, m2: get("m2", 1)?, p1: get("p1", 0)?, p2: get("p2", 1)? })
+}
