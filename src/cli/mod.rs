@@ -1,0 +1,70 @@
+//! Command-line interface (clap). Each subcommand lives in its own file; errors become
+//! `anyhow` only here, at the edge, and map to documented exit codes.
+//!
+//! Exit codes: 0 success, 1 error, 2 usage error (clap), 3 some campaign jobs failed,
+//! 130 interrupted.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod campaign;
+mod check;
+mod design;
+mod plants;
+
+/// hinfix: fixed-order H∞ controller design with strong stabilisation (HIFOO method) and a
+/// benchmark-campaign runner.
+#[derive(Parser, Debug)]
+#[command(name = "campaign", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run a campaign file (plants × orders × ε × seeds), resuming where it stopped.
+    Run(campaign::RunArgs),
+    /// Report done/remaining jobs of a campaign file.
+    Status(campaign::StatusArgs),
+    /// Reduce a campaign's journal(s) to best.csv, tables.tex and compare.csv/.tex.
+    Report(campaign::ReportArgs),
+    /// Summarise one MCAP trace file.
+    Trace(campaign::TraceArgs),
+    /// List the benchmark plants shipped in plants/.
+    Plants(plants::PlantsArgs),
+    /// Show one plant in detail.
+    Plant(plants::PlantArgs),
+    /// Check a controller on a plant: stability, ‖Tzw‖∞ and peak frequency, ‖K‖∞.
+    Check(check::CheckArgs),
+    /// Design one fixed-order controller (strong stabilisation by default).
+    Design(design::DesignArgs),
+}
+
+/// Exit code of a run in which some jobs failed.
+pub const EXIT_JOBS_FAILED: u8 = 3;
+/// Exit code after an interrupt.
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Parses the command line and runs it.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(a) => campaign::run(a),
+        Command::Status(a) => campaign::status(a),
+        Command::Report(a) => campaign::report(a),
+        Command::Trace(a) => campaign::trace(a),
+        Command::Plants(a) => plants::list(a),
+        Command::Plant(a) => plants::show(a),
+        Command::Check(a) => check::run(a),
+        Command::Design(a) => design::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
