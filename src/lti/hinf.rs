@@ -305,20 +305,22 @@ impl<'s> Hamiltonian<'s> {
         let k = 2 * n + m + p;
         let mut a = Mat::<f64>::zeros(k, k);
         let mut b = Mat::<f64>::zeros(k, k);
-        let (iq, iv, iu) = (n, 2 * n, 2 * n + m);
+        // columns: x (0), q (n), v (2n, m wide), u (2n+m, p wide);
+        // rows: ẋ (0), q̇ (n), Cx + Dv − γu (2n, p rows), Bᵀq + Dᵀu − γv (2n+p, m rows)
+        let (iq, cv, cu, r3, r4) = (n, 2 * n, 2 * n + m, 2 * n, 2 * n + p);
         a.as_mut().submatrix_mut(0, 0, n, n).copy_from(&s.a);
-        a.as_mut().submatrix_mut(0, iv, n, m).copy_from(&s.b);
+        a.as_mut().submatrix_mut(0, cv, n, m).copy_from(&s.b);
         a.as_mut().submatrix_mut(iq, iq, n, n).copy_from(s.a.transpose() * faer::Scale(-1.0));
-        a.as_mut().submatrix_mut(iq, iu, n, p).copy_from(s.c.transpose() * faer::Scale(-1.0));
-        a.as_mut().submatrix_mut(iv, 0, p, n).copy_from(&s.c);
-        a.as_mut().submatrix_mut(iv, iv, p, m).copy_from(&s.d);
-        a.as_mut().submatrix_mut(iu, iq, m, n).copy_from(s.b.transpose());
-        a.as_mut().submatrix_mut(iu, iu, m, p).copy_from(s.d.transpose());
+        a.as_mut().submatrix_mut(iq, cu, n, p).copy_from(s.c.transpose() * faer::Scale(-1.0));
+        a.as_mut().submatrix_mut(r3, 0, p, n).copy_from(&s.c);
+        a.as_mut().submatrix_mut(r3, cv, p, m).copy_from(&s.d);
+        a.as_mut().submatrix_mut(r4, iq, m, n).copy_from(s.b.transpose());
+        a.as_mut().submatrix_mut(r4, cu, m, p).copy_from(s.d.transpose());
         for i in 0..p {
-            a[(iv + i, iu + i)] = -gamma;
+            a[(r3 + i, cu + i)] = -gamma;
         }
         for i in 0..m {
-            a[(iu + i, iv + i)] = -gamma;
+            a[(r4 + i, cv + i)] = -gamma;
         }
         for i in 0..2 * n {
             b[(i, i)] = 1.0;
