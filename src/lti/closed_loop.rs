@@ -136,9 +136,7 @@ impl<'p> ClosedLoop<'p> {
             l = mul_t(pm.as_ref(), &l);
             r = mul(qm.as_ref(), &r);
         }
-        let (m, p) = (pl.dims.m2, pl.dims.p2);
         let outer = |li: &[c64], rj: &[c64]| Mat::from_fn(li.len(), rj.len(), |i, j| (li[i] * rj[j]).re);
-        let _ = (m, p);
         Controller {
             ak: outer(&l[..nk], &r[..nk]),
             bk: outer(&l[..nk], &r[nk..]),
