@@ -1,6 +1,19 @@
-//! `campaign check` (lands with the LTI-numerics issue).
-use std::path::PathBuf;
+//! `campaign check --plant NAME|PATH --controller K.json [--json]`: closed-loop and controller
+//! spectral abscissas, ‖Tzw‖∞ with its peak frequency, ‖K‖∞, and both stability decisions.
+//!
+//! JSON keys are those of the SLICOT oracle (`closed_loop_spectral_abscissa`,
+//! `controller_spectral_abscissa` (null for nk = 0), `closed_loop_hinf`, `closed_loop_peak_freq`,
+//! `controller_hinf`, `closed_loop_stable`, `controller_stable`); non-finite numbers are written
+//! as the strings "inf" / "-inf" / "nan" (as `design::float_serde`), a frequency that does not
+//! exist (unstable loop) as null.
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+use anyhow::Context;
+use hinfix::lti::{
+    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
+};
+use serde_json::{json, Value};
 
 /// Arguments of `campaign check`.
 #[derive(clap::Args, Debug)]
@@ -16,6 +29,122 @@ pub struct CheckArgs {
     pub json: bool,
 }
 
-pub fn run(_a: CheckArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`campaign check` is not available yet")
+/// Everything `check` reports.
+#[derive(Debug, Clone, Copy)]
+struct CheckReport {
+    alpha_cl: f64,
+    alpha_k: Option<f64>,
+    hinf_cl: f64,
+    peak_freq: f64,
+    hinf_k: f64,
+}
+
+impl CheckReport {
+    fn closed_loop_stable(&self) -> bool {
+        self.alpha_cl < 0.0
+    }
+    fn controller_stable(&self) -> bool {
+        self.alpha_k.is_none_or(|a| a < 0.0)
+    }
+}
+
+/// `plants/NAME.json` (relative to the current directory) if NAME names no existing file,
+/// else NAME as a path. (The lead's `lti::resolve_plant` will replace this.)
+fn plant_path(name_or_path: &str) -> PathBuf {
+    let p = Path::new(name_or_path);
+    if p.is_file() {
+        return p.to_path_buf();
+    }
+    let named = Path::new("plants").join(format!("{name_or_path}.json"));
+    if named.is_file() {
+        named
+    } else {
+        p.to_path_buf()
+    }
+}
+
+pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
+    let plant = Plant::load(plant_path(&a.plant))?;
+    let k = Controller::load(&a.controller)?;
+    k.check_fits(&plant).with_context(|| format!("controller {}", a.controller.display()))?;
+    let r = evaluate(&plant, &k)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&to_json(&r))?);
+    } else {
+        print!("{}", human(&plant, &k, &r));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
+    let cl = closed_loop(plant, k).context("forming the closed loop")?;
+    let alpha_cl = spectral_abscissa(cl.a.as_ref());
+    let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
+    let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
+    let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
+    Ok(CheckReport { alpha_cl, alpha_k, hinf_cl: h.value, peak_freq: h.peak_freq, hinf_k: hk.value })
+}
+
+/// A float as JSON: finite → number, ±∞ / NaN → "inf" / "-inf" / "nan".
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else if x.is_nan() {
+        json!("nan")
+    } else if x > 0.0 {
+        json!("inf")
+    } else {
+        json!("-inf")
+    }
+}
+
+fn to_json(r: &CheckReport) -> Value {
+    json!({
+        "closed_loop_spectral_abscissa": num(r.alpha_cl),
+        "controller_spectral_abscissa": r.alpha_k.map(num),
+        "closed_loop_hinf": num(r.hinf_cl),
+        "closed_loop_peak_freq": if r.peak_freq.is_nan() { Value::Null } else { num(r.peak_freq) },
+        "controller_hinf": num(r.hinf_k),
+        "closed_loop_stable": r.closed_loop_stable(),
+        "controller_stable": r.controller_stable(),
+    })
+}
+
+fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
+    let yes_no = |b: bool| if b { "stable" } else { "UNSTABLE" };
+    let freq = if r.peak_freq.is_nan() {
+        "—".to_string()
+    } else if r.peak_freq.is_infinite() {
+        "ω → ∞".to_string()
+    } else {
+        format!("ω = {:.6} rad/s", r.peak_freq)
+    };
+    let mut s = format!("plant {} (n = {}), controller of order {}\n", plant.name, plant.dims.n, k.order());
+    s += &format!("closed loop: α(A_cl) = {:+.6e}   {}\n", r.alpha_cl, yes_no(r.closed_loop_stable()));
+    s += &format!("             ‖Tzw‖∞  = {:.10}   at {}\n", r.hinf_cl, freq);
+    match r.alpha_k {
+        Some(a) => s += &format!("controller:  α(Ak)    = {:+.6e}   {}\n", a, yes_no(r.controller_stable())),
+        None => s += "controller:  static gain (order 0), trivially stable\n",
+    }
+    s += &format!("             ‖K‖∞    = {:.10}\n", r.hinf_k);
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_keys_and_infinities() {
+        let r = CheckReport { alpha_cl: 0.3, alpha_k: None, hinf_cl: f64::INFINITY, peak_freq: f64::NAN, hinf_k: 1.5 };
+        let v = to_json(&r);
+        assert_eq!(v["closed_loop_hinf"], json!("inf"));
+        assert_eq!(v["closed_loop_peak_freq"], Value::Null);
+        assert_eq!(v["controller_spectral_abscissa"], Value::Null);
+        assert_eq!(v["closed_loop_stable"], json!(false));
+        assert_eq!(v["controller_stable"], json!(true));
+        assert!(!serde_json::to_string(&v).unwrap().contains("Infinity"));
+        let r = CheckReport { alpha_cl: -0.3, alpha_k: Some(-1.0), hinf_cl: 2.0, peak_freq: f64::INFINITY, hinf_k: 1.5 };
+        assert_eq!(to_json(&r)["closed_loop_peak_freq"], json!("inf"));
+    }
 }

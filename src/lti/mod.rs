@@ -1,11 +1,30 @@
 //! Linear time-invariant systems: plants, controllers, closed loops, spectral abscissa, the H∞
 //! norm, their gradients with respect to the controller, and the full-order H∞ bound.
+//!
+//! The H∞ norm and all gradients are hand-written (`hinf.rs`, `gradient.rs`): no Rust crate
+//! offers them. Linear algebra is faer, always single-threaded (`Par::Seq`).
+mod closed_loop;
 mod controller;
+mod error;
+mod freq_response;
+mod gradient;
+mod hinf;
 mod matrix_json;
 mod plant;
 mod plant_library;
+mod spectral;
+mod state_space;
 
+pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use controller::{Controller, ControllerError, ControllerErrorKind};
+pub use error::LtiError;
+pub use gradient::{
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
+    ControllerGradient,
+};
+pub use hinf::{hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
+pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
+pub use state_space::StateSpace;

@@ -1,0 +1,154 @@
+//! The four quantities of the design objectives with their exact gradients with respect to the
+//! controller (Ak, Bk, Ck, Dk): α(Acl), α(Ak), ‖Tzw‖∞ and ‖K‖∞ (algorithm.md §3.1, §4).
+//!
+//! Written by hand because no crate offers H∞ norms or their gradients (rust-numerics.md §6).
+//! Method as in HIFOO (Burke, Henrion, Lewis & Overton 2006; Gumussoy, Millstone & Overton 2008):
+//!
+//! * α: ∇_A α = Re(ū vᵀ)/(uᴴv) from the rightmost eigen-triple (`spectral.rs`).
+//! * ‖·‖∞ at its peak ω with Z = iωI − A and the leading singular pair G(iω) v = σ u:
+//!   with a = Z⁻ᴴ Cᵀ u and b = Z⁻¹ B v,
+//!   ```text
+//!   G_A = Re(ā bᵀ),  G_B = Re(ā vᵀ),  G_C = Re(ū bᵀ),  G_D = Re(ū vᵀ)
+//!   ```
+//!   (§4.2 in vector form; at ω = ∞ only G_D survives). One complex LU of Z gives both b and a.
+//! * Chain rule through the closed loop, D22 ≠ 0 included: `closed_loop.rs`
+//!   ([`ClosedLoop::chain_rule`]). For the controller's own quantities the matrix gradients are the
+//!   gradient (no chain rule).
+//!
+//! The norm is non-smooth where σmax is multiple or the peak is not unique; then one element of the
+//! Clarke subdifferential is returned (any singular pair), as HIFOO does.
+//!
+//! Cost sharing: one eigenvalue computation of Acl serves both the stability test and the norm's
+//! test frequencies; the gradient re-uses the norm's peak (no second norm computation).
+
+use faer::linalg::solvers::Solve;
+use faer::{c64, Mat};
+
+use super::closed_loop::ClosedLoop;
+use super::hinf::{hinf_norm_with_poles, HinfNorm};
+use super::spectral::{eigenvalues, rightmost_eigen};
+use super::{Controller, LtiError, Plant, StateSpace};
+
+/// Gradient with respect to (Ak, Bk, Ck, Dk), same shapes as the controller.
+pub type ControllerGradient = Controller;
+
+/// α(Acl) and its gradient. α is finite for unstable loops; +∞ with a NaN gradient if the
+/// eigensolver fails or the loop has non-finite entries. Err(IllPosed) for an ill-posed loop.
+pub fn closed_loop_abscissa_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
+    let cl = ClosedLoop::new(plant, k)?;
+    Ok(match rightmost_eigen(cl.sys.a.as_ref()) {
+        Some(e) => (e.alpha, cl.chain_rule(&e.u, &e.v_scaled, None)),
+        None => (f64::INFINITY, nan_like(k)),
+    })
+}
+
+/// α(Ak) and its gradient (only the Ak block is nonzero); nk = 0: (−∞, zeros).
+pub fn controller_abscissa_grad(k: &Controller) -> (f64, ControllerGradient) {
+    let nk = k.order();
+    if nk == 0 {
+        return (f64::NEG_INFINITY, Controller::zeros(0, k.m(), k.p()));
+    }
+    match rightmost_eigen(k.ak.as_ref()) {
+        Some(e) => {
+            let mut g = Controller::zeros(nk, k.m(), k.p());
+            g.ak = Mat::from_fn(nk, nk, |i, j| (e.u[i].conj() * e.v_scaled[j]).re);
+            (e.alpha, g)
+        }
+        None => (f64::INFINITY, nan_like(k)),
+    }
+}
+
+/// ‖Tzw‖∞ (+∞ if the loop is unstable, with a NaN gradient) and its gradient.
+pub fn closed_loop_hinf_grad(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    let cl = ClosedLoop::new(plant, k)?;
+    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol) else {
+        return Ok((HinfNorm::UNSTABLE, nan_like(k)));
+    };
+    Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
+}
+
+/// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
+pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
+    let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
+    let Some((norm, pv)) = hinf_with_vectors(&sys, tol) else {
+        return (HinfNorm::UNSTABLE, nan_like(k));
+    };
+    let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
+    let g = Controller { ak: outer(&pv.a, &pv.b), bk: outer(&pv.a, &pv.v), ck: outer(&pv.u, &pv.b), dk: outer(&pv.u, &pv.v) };
+    (norm, g)
+}
+
+/// Vectors of the H∞ gradient at the peak (module docs).
+pub(crate) struct PeakVectors {
+    /// Left singular vector u (p).
+    pub u: Vec<c64>,
+    /// Right singular vector v (m).
+    pub v: Vec<c64>,
+    /// a = Z⁻ᴴ Cᵀ u (n); zero at ω = ∞.
+    pub a: Vec<c64>,
+    /// b = Z⁻¹ B v (n); zero at ω = ∞.
+    pub b: Vec<c64>,
+}
+
+/// Norm and gradient vectors; `None` if unstable (or not finite).
+pub(crate) fn hinf_with_vectors(sys: &StateSpace, tol: f64) -> Option<(HinfNorm, PeakVectors)> {
+    if !sys.is_finite() {
+        return None;
+    }
+    let poles = eigenvalues(sys.a.as_ref())?;
+    let norm = hinf_norm_with_poles(sys, &poles, tol);
+    if !norm.value.is_finite() {
+        return None;
+    }
+    let pv = peak_vectors(sys, norm.peak_freq)?;
+    Some((norm, pv))
+}
+
+/// u, v, a, b at frequency w (module docs); `None` if an SVD fails.
+pub(crate) fn peak_vectors(sys: &StateSpace, w: f64) -> Option<PeakVectors> {
+    let (n, m, p) = (sys.order(), sys.inputs(), sys.outputs());
+    let cz = |x: f64| c64::new(x, 0.0);
+    let zero = c64::new(0.0, 0.0);
+    let finite_w = w.is_finite() && n > 0;
+    let (g, lu_x) = if finite_w {
+        let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
+        let lu = z.partial_piv_lu();
+        let x = lu.solve(Mat::<c64>::from_fn(n, m, |i, j| cz(sys.b[(i, j)]))); // Z⁻¹B
+        let g = Mat::<c64>::from_fn(p, m, |i, j| {
+            (0..n).fold(cz(sys.d[(i, j)]), |s, k| s + x[(k, j)] * sys.c[(i, k)])
+        });
+        (g, Some((lu, x)))
+    } else {
+        (Mat::<c64>::from_fn(p, m, |i, j| cz(sys.d[(i, j)])), None)
+    };
+    if p == 0 || m == 0 {
+        return Some(PeakVectors { u: vec![zero; p], v: vec![zero; m], a: vec![zero; n], b: vec![zero; n] });
+    }
+    let svd = g.thin_svd().ok()?;
+    let s = svd.S();
+    let k = (0..s.dim()).fold(0, |b, i| if s[i].re > s[b].re { i } else { b });
+    let u: Vec<c64> = (0..p).map(|i| svd.U()[(i, k)]).collect();
+    let v: Vec<c64> = (0..m).map(|j| svd.V()[(j, k)]).collect();
+    let (a, b) = match lu_x {
+        Some((lu, x)) => {
+            let b: Vec<c64> = (0..n).map(|i| (0..m).fold(zero, |s, j| s + x[(i, j)] * v[j])).collect();
+            let ctu = Mat::<c64>::from_fn(n, 1, |i, _| (0..p).fold(zero, |s, r| s + u[r] * sys.c[(r, i)]));
+            let a = lu.solve_adjoint(ctu);
+            ((0..n).map(|i| a[(i, 0)]).collect(), b)
+        }
+        None => (vec![zero; n], vec![zero; n]),
+    };
+    if a.iter().chain(&b).chain(&u).chain(&v).any(|z| !(z.re.is_finite() && z.im.is_finite())) {
+        return None;
+    }
+    Some(PeakVectors { u, v, a, b })
+}
+
+fn nan_like(k: &Controller) -> Controller {
+    let f = |m: &Mat<f64>| Mat::from_fn(m.nrows(), m.ncols(), |_, _| f64::NAN);
+    Controller { ak: f(&k.ak), bk: f(&k.bk), ck: f(&k.ck), dk: f(&k.dk) }
+}

@@ -1,0 +1,372 @@
+//! The H∞ norm ‖G‖∞ = sup_ω σmax(G(iω)) of a stable continuous-time system, with its peak
+//! frequency (algorithm.md §5).
+//!
+//! Written by hand because no Rust crate offers it (rust-numerics.md §6: the only one,
+//! control_systems_torbox, links SLICOT Fortran and a GUI stack).
+//!
+//! # Method: Bruinsma–Steinbuch level set with AB13DD's refinements
+//! N. A. Bruinsma and M. Steinbuch, "A fast algorithm to compute the H∞-norm of a transfer
+//! function matrix", Systems & Control Letters 14 (1990); S. Boyd and V. Balakrishnan, "A regularity
+//! result for the singular values of a transfer matrix and a quadratically convergent algorithm for
+//! computing its L∞-norm", Systems & Control Letters 15 (1990).
+//!
+//! 1. Unstable (any Re λ(A) ≥ 0, exactly the HIFOO rule) or non-finite data → +∞.
+//! 2. Lower bound γ_L = max σmax(G(iω)) over ω = ∞ (σmax(D)), ω = 0 and one test frequency per
+//!    mode, ω = |λ|·√max(¼, 1 − 2(Re λ/|λ|)²) (AB13DD's choice; for n > [`MAX_POLE_TEST_FREQS`]
+//!    only the least damped modes). G(iω) is evaluated through a Hessenberg form of A, O(n²m) per
+//!    frequency (`freq_response.rs`).
+//! 3. *(Deviation from AB13DD, a speed-up.)* Golden-section refinement of log ω around the best
+//!    frequency so far. It only ever raises γ_L with genuine values of σmax(G(iω)), so it cannot
+//!    harm correctness; it usually makes the first level-set test the last, which halves the
+//!    number of 2n×2n eigenproblems.
+//! 4. Level-set test at γ = (1 + tol)·γ_L: iω is an eigenvalue of the Hamiltonian
+//!    ```text
+//!    H(γ) = [ A − B R⁻¹DᵀC      −γ B R⁻¹ Bᵀ        ]    R = DᵀD − γ²I,  S = DDᵀ − γ²I
+//!           [ γ Cᵀ S⁻¹ C        −Aᵀ + Cᵀ D R⁻¹ Bᵀ  ]
+//!    ```
+//!    iff γ is a singular value of G(iω). No imaginary eigenvalue → ‖G‖∞ ∈ [γ_L, (1+tol)γ_L],
+//!    return γ_L (an attained value, at the returned frequency). Otherwise evaluate σmax at the
+//!    geometric means of consecutive crossing frequencies (arithmetic next to ω = 0), update γ_L,
+//!    refine, repeat (quadratic convergence). If γ_L grows by less than a factor 1 + tol/10 the
+//!    crossings were spurious and we stop (AB13DD's safeguard); at most [`MAX_LEVEL_SET_ITERS`].
+//!
+//! # Ill-conditioned γ²I − DᵀD
+//! R⁻¹ and S⁻¹ are applied through the SVD of D, exactly. When κ = γ²/(γ² − σmax(D)²) exceeds
+//! [`MAX_EXPLICIT_HAMILTONIAN_COND`] (the peak is at or near ω = ∞, so γ ≈ σmax(D)), forming H
+//! would amplify rounding by κ; we then use the equivalent (2n+m+p) pencil, which needs no
+//! inverse, and its finite generalized eigenvalues (QZ, faer `gevd_real`):
+//! ```text
+//! [ A   0    B    0  ]       [ I       ]
+//! [ 0  −Aᵀ   0   −Cᵀ ]  − λ  [   I     ]      (unknowns x, q, v, u with Gv = γu, Gᴴu = γv)
+//! [ C   0    D   −γI ]       [     0   ]
+//! [ 0   Bᵀ  −γI   Dᵀ ]       [       0 ]
+//! ```
+//!
+//! # Imaginary-axis test
+//! An eigenvalue counts as imaginary if |Re λ| ≤ √ε·√(100 + max|λ|) (AB13DD's rule: a crossing
+//! that is nearly tangent perturbs like √ε). A spurious "crossing" only costs a few extra
+//! frequency evaluations (their midpoints cannot raise γ_L, so the loop stops), whereas a missed
+//! one would under-estimate the norm, so the test errs on the loose side.
+//!
+//! If the Hamiltonian eigensolver fails or the iteration limit is hit, the best lower bound γ_L
+//! found so far is returned (it is an attained value of σmax(G(iω))).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::{evd, gevd};
+use faer::{c64, Mat, Par};
+
+use super::freq_response::FreqResponse;
+use super::spectral::eigenvalues;
+use super::StateSpace;
+
+/// Default relative tolerance of [`hinf_norm`].
+pub const DEFAULT_HINF_TOL: f64 = 1e-10;
+/// Smallest accepted relative tolerance (smaller requests are raised to it: below it rounding
+/// in the Hamiltonian dominates).
+pub const MIN_HINF_TOL: f64 = 1e-14;
+/// Iteration limit of the level-set loop (AB13DD's MAXIT).
+pub const MAX_LEVEL_SET_ITERS: usize = 30;
+/// At most this many mode-based test frequencies are evaluated (the least damped modes first).
+pub const MAX_POLE_TEST_FREQS: usize = 100;
+/// Above this κ = γ²/(γ² − σmax(D)²) the explicit Hamiltonian is replaced by the pencil.
+pub const MAX_EXPLICIT_HAMILTONIAN_COND: f64 = 1e6;
+/// Golden-section refinement stops when the log-frequency bracket is narrower than this.
+const REFINE_LOG_WIDTH: f64 = 1e-9;
+/// At most this many evaluations per refinement.
+const REFINE_MAX_EVALS: usize = 60;
+
+/// The H∞ norm and where it is attained.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HinfNorm {
+    /// ‖G‖∞; +∞ if the system is unstable (or its data are not finite).
+    pub value: f64,
+    /// A frequency (rad/s) attaining it: may be +∞ (peak approached as ω → ∞); NaN if the value
+    /// is +∞.
+    pub peak_freq: f64,
+}
+
+impl HinfNorm {
+    /// The norm of an unstable system.
+    pub const UNSTABLE: HinfNorm = HinfNorm { value: f64::INFINITY, peak_freq: f64::NAN };
+}
+
+/// ‖sys‖∞ to relative tolerance `tol` (use [`DEFAULT_HINF_TOL`]); +∞ if unstable.
+pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
+    if !sys.is_finite() {
+        return HinfNorm::UNSTABLE;
+    }
+    match eigenvalues(sys.a.as_ref()) {
+        Some(poles) => hinf_norm_with_poles(sys, &poles, tol),
+        None => HinfNorm::UNSTABLE,
+    }
+}
+
+/// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
+/// test). The data must be finite.
+pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) -> HinfNorm {
+    let tol = if tol.is_nan() { DEFAULT_HINF_TOL } else { tol.max(MIN_HINF_TOL) };
+    if poles.iter().any(|l| !(l.re < 0.0) || !l.im.is_finite()) {
+        return HinfNorm::UNSTABLE;
+    }
+    let sigma_d = super::freq_response::sigma_max_c(complexify(sys.d.as_ref()).as_ref());
+    if sys.order() == 0 {
+        return HinfNorm { value: sigma_d, peak_freq: f64::INFINITY };
+    }
+    let mut fr = FreqResponse::new(sys);
+    let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
+    best.offer(0.0, fr.sigma_max(0.0));
+
+    // Mode-based test frequencies, least damped first.
+    let mut modes: Vec<(f64, f64)> = poles
+        .iter()
+        .filter(|l| l.im >= 0.0 && l.norm() > 0.0)
+        .map(|l| {
+            let r = l.norm();
+            let zeta = l.re.abs() / r;
+            (zeta, r * (1.0 - 2.0 * zeta * zeta).max(0.25).sqrt())
+        })
+        .collect();
+    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    modes.truncate(MAX_POLE_TEST_FREQS);
+    let mut tested: Vec<f64> = vec![0.0];
+    for &(_, w) in &modes {
+        best.offer(w, fr.sigma_max(w));
+        tested.push(w);
+    }
+    refine(&mut fr, &mut best, &tested);
+    if !best.gamma.is_finite() {
+        return HinfNorm { value: f64::INFINITY, peak_freq: best.freq };
+    }
+
+    let ham = Hamiltonian::new(sys, sigma_d);
+    for _ in 0..MAX_LEVEL_SET_ITERS {
+        let gamma = (1.0 + tol) * best.gamma;
+        if gamma <= 0.0 {
+            break; // G ≡ 0
+        }
+        let Some(ws) = ham.crossings(gamma) else { break };
+        if ws.is_empty() {
+            break;
+        }
+        let before = best.gamma;
+        let mut mids: Vec<f64> = Vec::with_capacity(ws.len());
+        if ws.len() == 1 {
+            mids.push(ws[0]);
+        }
+        for pair in ws.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            mids.push(if a > 0.0 { (a * b).sqrt() } else { 0.5 * b });
+        }
+        for &w in &mids {
+            best.offer(w, fr.sigma_max(w));
+        }
+        let mut all = ws.clone();
+        all.extend(&mids);
+        all.sort_by(f64::total_cmp);
+        refine(&mut fr, &mut best, &all);
+        if !(best.gamma >= before * (1.0 + 0.1 * tol)) {
+            break; // no progress: the crossings were spurious
+        }
+    }
+    HinfNorm { value: best.gamma, peak_freq: best.freq }
+}
+
+/// Best σmax found so far and its frequency.
+struct Best {
+    gamma: f64,
+    freq: f64,
+}
+
+impl Best {
+    fn offer(&mut self, w: f64, s: f64) {
+        if s > self.gamma || s.is_nan() {
+            self.gamma = if s.is_nan() { f64::INFINITY } else { s };
+            self.freq = w;
+        }
+    }
+}
+
+/// Golden-section search for a local maximum of σmax(G(iω)) in log ω around `best.freq`,
+/// bracketed by its neighbours among `tested` (sorted or not).
+fn refine(fr: &mut FreqResponse, best: &mut Best, tested: &[f64]) {
+    let w0 = best.freq;
+    if !(w0 > 0.0 && w0.is_finite()) {
+        return;
+    }
+    let lo = tested.iter().copied().filter(|&w| w < w0 && w > 0.0).fold(f64::NEG_INFINITY, f64::max);
+    let hi = tested.iter().copied().filter(|&w| w > w0 && w.is_finite()).fold(f64::INFINITY, f64::min);
+    let lo = if lo.is_finite() { lo } else { w0 / 10.0 };
+    let hi = if hi.is_finite() { hi } else { w0 * 10.0 };
+    let (mut a, mut b) = (lo.ln(), hi.ln());
+    const INV_PHI: f64 = 0.618_033_988_749_894_8;
+    let mut x1 = b - INV_PHI * (b - a);
+    let mut x2 = a + INV_PHI * (b - a);
+    let mut f1 = fr.sigma_max(x1.exp());
+    let mut f2 = fr.sigma_max(x2.exp());
+    best.offer(x1.exp(), f1);
+    best.offer(x2.exp(), f2);
+    let mut evals = 2;
+    while b - a > REFINE_LOG_WIDTH && evals < REFINE_MAX_EVALS {
+        if f1 >= f2 {
+            b = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = b - INV_PHI * (b - a);
+            f1 = fr.sigma_max(x1.exp());
+            best.offer(x1.exp(), f1);
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + INV_PHI * (b - a);
+            f2 = fr.sigma_max(x2.exp());
+            best.offer(x2.exp(), f2);
+        }
+        evals += 1;
+    }
+}
+
+fn complexify(m: faer::MatRef<'_, f64>) -> Mat<c64> {
+    Mat::from_fn(m.nrows(), m.ncols(), |i, j| c64::new(m[(i, j)], 0.0))
+}
+
+/// The level-set test of one system at varying γ.
+struct Hamiltonian<'s> {
+    sys: &'s StateSpace,
+    sigma_d: f64,
+    /// SVD of D: U (p×p), singular values (min(p,m)), V (m×m).
+    d_u: Mat<f64>,
+    d_s: Vec<f64>,
+    d_v: Mat<f64>,
+}
+
+impl<'s> Hamiltonian<'s> {
+    fn new(sys: &'s StateSpace, sigma_d: f64) -> Self {
+        let (p, m) = (sys.outputs(), sys.inputs());
+        let (d_u, d_s, d_v) = match sys.d.svd() {
+            Ok(s) if p > 0 && m > 0 => {
+                let k = p.min(m);
+                (s.U().to_owned(), (0..k).map(|i| s.S()[i]).collect(), s.V().to_owned())
+            }
+            _ => (Mat::identity(p, p), vec![0.0; p.min(m)], Mat::identity(m, m)),
+        };
+        Hamiltonian { sys, sigma_d, d_u, d_s, d_v }
+    }
+
+    /// Sorted nonnegative frequencies ω with iω an (numerically) imaginary eigenvalue of H(γ);
+    /// `None` if the eigensolver failed.
+    fn crossings(&self, gamma: f64) -> Option<Vec<f64>> {
+        let kappa = gamma * gamma / ((gamma - self.sigma_d) * (gamma + self.sigma_d));
+        let eig = if kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND {
+            self.explicit_eigenvalues(gamma)?
+        } else {
+            self.pencil_eigenvalues(gamma)?
+        };
+        let maxabs = eig.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        let thr = f64::EPSILON.sqrt() * (100.0 + maxabs).sqrt();
+        let mut ws: Vec<f64> = eig.iter().filter(|l| l.re.abs() <= thr && l.im >= 0.0).map(|l| l.im).collect();
+        ws.sort_by(f64::total_cmp);
+        ws.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * b.abs().max(1e-300));
+        Some(ws)
+    }
+
+    /// Eigenvalues of the explicit Hamiltonian, with R⁻¹, S⁻¹ through the SVD of D:
+    /// −R⁻¹ = V diag(1/(γ²−σᵢ²)) Vᵀ, −S⁻¹ = U diag(1/(γ²−σᵢ²)) Uᵀ (σᵢ = 0 beyond min(p,m)).
+    fn explicit_eigenvalues(&self, gamma: f64) -> Option<Vec<c64>> {
+        let s = self.sys;
+        let (n, m, p) = (s.order(), s.inputs(), s.outputs());
+        let g2 = gamma * gamma;
+        let wt = |k: usize| {
+            let sk = self.d_s.get(k).copied().unwrap_or(0.0);
+            1.0 / (g2 - sk * sk)
+        };
+        // −R⁻¹ = V W_m Vᵀ, −S⁻¹ = U W_p Uᵀ
+        let rinv_neg = Mat::from_fn(m, m, |i, j| (0..m).map(|k| self.d_v[(i, k)] * wt(k) * self.d_v[(j, k)]).sum::<f64>());
+        let sinv_neg = Mat::from_fn(p, p, |i, j| (0..p).map(|k| self.d_u[(i, k)] * wt(k) * self.d_u[(j, k)]).sum::<f64>());
+        let br = &s.b * &rinv_neg; // −B R⁻¹
+        let dtc = s.d.transpose() * &s.c; // DᵀC
+        let mut h = Mat::<f64>::zeros(2 * n, 2 * n);
+        // H11 = A − B R⁻¹ DᵀC = A + (−BR⁻¹) DᵀC
+        h.as_mut().submatrix_mut(0, 0, n, n).copy_from(&s.a + &br * &dtc);
+        // H12 = −γ B R⁻¹ Bᵀ
+        h.as_mut().submatrix_mut(0, n, n, n).copy_from((&br * s.b.transpose()) * faer::Scale(gamma));
+        // H21 = γ Cᵀ S⁻¹ C = −γ Cᵀ (−S⁻¹) C
+        h.as_mut().submatrix_mut(n, 0, n, n).copy_from((s.c.transpose() * &sinv_neg * &s.c) * faer::Scale(-gamma));
+        // H22 = −Aᵀ + Cᵀ D R⁻¹ Bᵀ = −(H11)ᵀ
+        let h11t = h.as_ref().submatrix(0, 0, n, n).transpose().to_owned();
+        h.as_mut().submatrix_mut(n, n, n, n).copy_from(h11t * faer::Scale(-1.0));
+        general_eigenvalues(h)
+    }
+
+    /// Finite eigenvalues of the (2n+m+p) pencil of the module docs.
+    fn pencil_eigenvalues(&self, gamma: f64) -> Option<Vec<c64>> {
+        let s = self.sys;
+        let (n, m, p) = (s.order(), s.inputs(), s.outputs());
+        let k = 2 * n + m + p;
+        let mut a = Mat::<f64>::zeros(k, k);
+        let mut b = Mat::<f64>::zeros(k, k);
+        // columns: x (0), q (n), v (2n, m wide), u (2n+m, p wide);
+        // rows: ẋ (0), q̇ (n), Cx + Dv − γu (2n, p rows), Bᵀq + Dᵀu − γv (2n+p, m rows)
+        let (iq, cv, cu, r3, r4) = (n, 2 * n, 2 * n + m, 2 * n, 2 * n + p);
+        a.as_mut().submatrix_mut(0, 0, n, n).copy_from(&s.a);
+        a.as_mut().submatrix_mut(0, cv, n, m).copy_from(&s.b);
+        a.as_mut().submatrix_mut(iq, iq, n, n).copy_from(s.a.transpose() * faer::Scale(-1.0));
+        a.as_mut().submatrix_mut(iq, cu, n, p).copy_from(s.c.transpose() * faer::Scale(-1.0));
+        a.as_mut().submatrix_mut(r3, 0, p, n).copy_from(&s.c);
+        a.as_mut().submatrix_mut(r3, cv, p, m).copy_from(&s.d);
+        a.as_mut().submatrix_mut(r4, iq, m, n).copy_from(s.b.transpose());
+        a.as_mut().submatrix_mut(r4, cu, m, p).copy_from(s.d.transpose());
+        for i in 0..p {
+            a[(r3 + i, cu + i)] = -gamma;
+        }
+        for i in 0..m {
+            a[(r4 + i, cv + i)] = -gamma;
+        }
+        for i in 0..2 * n {
+            b[(i, i)] = 1.0;
+        }
+        let par = Par::Seq;
+        let mut re = faer::diag::Diag::<f64>::zeros(k);
+        let mut im = faer::diag::Diag::<f64>::zeros(k);
+        let mut beta = faer::diag::Diag::<f64>::zeros(k);
+        let mut mem = MemBuffer::new(gevd::gevd_scratch::<f64>(
+            k,
+            evd::ComputeEigenvectors::No,
+            evd::ComputeEigenvectors::No,
+            par,
+            Default::default(),
+        ));
+        gevd::gevd_real(
+            a.as_mut(),
+            b.as_mut(),
+            re.as_mut(),
+            im.as_mut(),
+            beta.as_mut(),
+            None,
+            None,
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .ok()?;
+        // Finite eigenvalues: |λ| below a bound far beyond the system's own scale.
+        let scale = s.a.norm_l2() + 1.0;
+        let big = scale / f64::EPSILON.sqrt();
+        let mut out = Vec::with_capacity(2 * n);
+        for i in 0..k {
+            if beta[i] == 0.0 {
+                continue;
+            }
+            let l = c64::new(re[i] / beta[i], im[i] / beta[i]);
+            if l.re.is_finite() && l.im.is_finite() && l.norm() < big {
+                out.push(l);
+            }
+        }
+        Some(out)
+    }
+}
+
+/// Eigenvalues of a real square matrix (owned), no vectors.
+fn general_eigenvalues(h: Mat<f64>) -> Option<Vec<c64>> {
+    eigenvalues(h.as_ref())
+}

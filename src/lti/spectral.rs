@@ -1,0 +1,207 @@
+//! Spectral abscissa α(M) = max Re λ(M) and its gradient (algorithm.md §4.1).
+//!
+//! For a simple eigenvalue λ with right eigenvector v (M v = λ v) and left eigenvector u
+//! (uᴴ M = λ uᴴ), first-order perturbation theory gives dλ = uᴴ dM v / (uᴴ v), hence
+//!
+//! ```text
+//! ∇α(M) = Re( ū vᵀ ) / (uᴴ v)      (a real matrix; ⟨G, dM⟩ = Σ G_ij dM_ij)
+//! ```
+//!
+//! (Burke, Henrion, Lewis & Overton, "HIFOO — a MATLAB package for fixed-order controller design
+//! and H∞ optimization", IFAC ROCOND 2006.) Left and right eigenvectors come from one call to faer's
+//! `evd_real` (LAPACK `dgeev`-style packing, rust-numerics.md §1.1).
+//!
+//! * **Complex pairs.** Both members of a conjugate pair give the same real gradient; we always
+//!   use the member with Im λ > 0.
+//! * **Ties** between distinct eigenvalues with equal real part: the first one is used (α is not
+//!   differentiable there; any member of the subdifferential is acceptable to BFGS / gradient
+//!   sampling, as in HIFOO).
+//! * **Nearly defective eigenvalues.** Then uᴴv → 0 and the true gradient blows up (α is not
+//!   Lipschitz at a defective eigenvalue). HIFOO perturbs V until V⁻¹ is finite; we instead keep
+//!   the direction and bound the magnitude: |uᴴv| is replaced by
+//!   max(|uᴴv|, [`MIN_EIGVEC_COSINE`]·‖u‖‖v‖) with the phase of uᴴv kept, so the gradient is
+//!   always finite (‖∇α‖ ≤ 1/MIN_EIGVEC_COSINE) and points the right way.
+//! * **NaN / Inf** entries, or an eigensolver failure: α = +∞ (treated as unstable).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{self, ComputeEigenvectors};
+use faer::{c64, Mat, MatRef, Par};
+
+/// Lower bound on the cosine |uᴴv|/(‖u‖‖v‖) between left and right eigenvectors used in the
+/// gradient (the reciprocal of the largest eigenvalue condition number we trust); ≈ 1000 ε.
+pub const MIN_EIGVEC_COSINE: f64 = 1e-13;
+
+/// α(A) = max Re λ(A): −∞ for a 0×0 matrix, +∞ if A has non-finite entries or the eigensolver fails.
+pub fn spectral_abscissa(a: MatRef<'_, f64>) -> f64 {
+    if a.nrows() == 0 {
+        return f64::NEG_INFINITY;
+    }
+    match eigenvalues(a) {
+        Some(ev) => abscissa_of(&ev),
+        None => f64::INFINITY,
+    }
+}
+
+/// Eigenvalues of a real square matrix; `None` on non-finite input or failure.
+pub(crate) fn eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
+    let n = a.nrows();
+    if n == 0 {
+        return Some(Vec::new());
+    }
+    if !super::state_space::all_finite(a) {
+        return None;
+    }
+    let mut wr = faer::diag::Diag::<f64>::zeros(n);
+    let mut wi = faer::diag::Diag::<f64>::zeros(n);
+    let par = Par::Seq;
+    let mut mem = MemBuffer::new(evd::evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::No,
+        par,
+        Default::default(),
+    ));
+    evd::evd_real(a, wr.as_mut(), wi.as_mut(), None, None, par, MemStack::new(&mut mem), Default::default()).ok()?;
+    Some((0..n).map(|i| c64::new(wr[i], wi[i])).collect())
+}
+
+/// max Re λ over a spectrum; +∞ if any eigenvalue is not finite.
+pub(crate) fn abscissa_of(ev: &[c64]) -> f64 {
+    let mut alpha = f64::NEG_INFINITY;
+    for l in ev {
+        if !(l.re.is_finite() && l.im.is_finite()) {
+            return f64::INFINITY;
+        }
+        alpha = alpha.max(l.re);
+    }
+    alpha
+}
+
+/// The rightmost eigenvalue with its left and right eigenvectors.
+#[derive(Debug, Clone)]
+pub(crate) struct RightmostEigen {
+    /// α = Re λ.
+    pub alpha: f64,
+    /// Left eigenvector u (uᴴ A = λ uᴴ).
+    pub u: Vec<c64>,
+    /// Right eigenvector v scaled by 1/(uᴴv) (regularised, see the module docs), so that
+    /// ∇α = Re(ū vᵀ).
+    pub v_scaled: Vec<c64>,
+}
+
+/// Rightmost eigen-triple of A (n ≥ 1); `None` for non-finite input or eigensolver failure.
+pub(crate) fn rightmost_eigen(a: MatRef<'_, f64>) -> Option<RightmostEigen> {
+    let n = a.nrows();
+    if n == 0 || !super::state_space::all_finite(a) {
+        return None;
+    }
+    let par = Par::Seq;
+    let mut wr = faer::diag::Diag::<f64>::zeros(n);
+    let mut wi = faer::diag::Diag::<f64>::zeros(n);
+    let mut vl = Mat::<f64>::zeros(n, n);
+    let mut vr = Mat::<f64>::zeros(n, n);
+    let mut mem = MemBuffer::new(evd::evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::Yes,
+        ComputeEigenvectors::Yes,
+        par,
+        Default::default(),
+    ));
+    evd::evd_real(
+        a,
+        wr.as_mut(),
+        wi.as_mut(),
+        Some(vl.as_mut()),
+        Some(vr.as_mut()),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .ok()?;
+    let mut k = 0;
+    for i in 0..n {
+        if !(wr[i].is_finite() && wi[i].is_finite()) {
+            return None;
+        }
+        if wr[i] > wr[k] {
+            k = i;
+        }
+    }
+    // dgeev packing: a pair occupies columns (j, j+1) with wi[j] > 0, v = vr[:,j] + i vr[:,j+1].
+    let (u, v): (Vec<c64>, Vec<c64>) = if wi[k] == 0.0 {
+        ((0..n).map(|i| c64::new(vl[(i, k)], 0.0)).collect(), (0..n).map(|i| c64::new(vr[(i, k)], 0.0)).collect())
+    } else {
+        let j = if wi[k] > 0.0 { k } else { k - 1 };
+        (
+            (0..n).map(|i| c64::new(vl[(i, j)], vl[(i, j + 1)])).collect(),
+            (0..n).map(|i| c64::new(vr[(i, j)], vr[(i, j + 1)])).collect(),
+        )
+    };
+    let s = u.iter().zip(&v).fold(c64::new(0.0, 0.0), |acc, (ui, vi)| acc + ui.conj() * vi);
+    let norm = |x: &[c64]| x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
+    let floor = MIN_EIGVEC_COSINE * norm(&u) * norm(&v);
+    let s = if s.norm() >= floor {
+        s
+    } else if s.norm() > 0.0 {
+        s * (floor / s.norm())
+    } else {
+        c64::new(floor, 0.0)
+    };
+    if !(s.norm() > 0.0) || !s.re.is_finite() {
+        return None;
+    }
+    // ∇α = Re(ū vᵀ / s): fold 1/s into v.
+    let sinv = s.inv();
+    let v_scaled = v.into_iter().map(|z| z * sinv).collect();
+    Some(RightmostEigen { alpha: wr[k], u, v_scaled })
+}
+
+/// ∇α(A) as a dense real matrix Re(ū vᵀ)/(uᴴv); `None` where α is +∞.
+pub fn spectral_abscissa_grad(a: MatRef<'_, f64>) -> Option<(f64, Mat<f64>)> {
+    let e = rightmost_eigen(a)?;
+    let n = a.nrows();
+    Some((e.alpha, Mat::from_fn(n, n, |i, j| (e.u[i].conj() * e.v_scaled[j]).re)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_and_nan() {
+        assert_eq!(spectral_abscissa(Mat::<f64>::zeros(0, 0).as_ref()), f64::NEG_INFINITY);
+        let mut a = Mat::<f64>::identity(3, 3);
+        a[(1, 2)] = f64::NAN;
+        assert_eq!(spectral_abscissa(a.as_ref()), f64::INFINITY);
+        a[(1, 2)] = f64::INFINITY;
+        assert_eq!(spectral_abscissa(a.as_ref()), f64::INFINITY);
+    }
+
+    #[test]
+    fn complex_pair_gradient_matches_fd() {
+        // rotation-like block with a real eigenvalue further left
+        let a = Mat::from_fn(3, 3, |i, j| [[-0.5, 2.0, 0.3], [-1.5, -0.4, 0.1], [0.2, 0.7, -3.0]][i][j]);
+        let (alpha, g) = spectral_abscissa_grad(a.as_ref()).unwrap();
+        assert!((alpha - spectral_abscissa(a.as_ref())).abs() < 1e-14);
+        let h = 1e-6;
+        for i in 0..3 {
+            for j in 0..3 {
+                let mut ap = a.clone();
+                ap[(i, j)] += h;
+                let mut am = a.clone();
+                am[(i, j)] -= h;
+                let fd = (spectral_abscissa(ap.as_ref()) - spectral_abscissa(am.as_ref())) / (2.0 * h);
+                assert!((fd - g[(i, j)]).abs() < 1e-7, "({i},{j}) fd {fd} vs {}", g[(i, j)]);
+            }
+        }
+    }
+
+    #[test]
+    fn defective_gradient_is_finite() {
+        // Jordan block: uᴴv = 0 exactly in exact arithmetic.
+        let a = Mat::from_fn(3, 3, |i, j| if i == j { -1.0 } else if j == i + 1 { 1.0 } else { 0.0 });
+        let (alpha, g) = spectral_abscissa_grad(a.as_ref()).unwrap();
+        assert!((alpha + 1.0).abs() < 1e-4);
+        assert!((0..3).all(|i| (0..3).all(|j| g[(i, j)].is_finite())));
+    }
+}
