@@ -1,0 +1,236 @@
+//! Job expansion and job identity.
+//!
+//! [`expand`] turns a [`Campaign`] into jobs in a deterministic, order-stable sequence: problems
+//! in file order, then orders ascending, then ε and seeds in file order. The same file always
+//! gives the same jobs in the same order, which a future `--shard i/N` needs (design.md).
+//!
+//! A [`JobId`] is the SHA-256 (hex) of a canonical JSON document holding the plant fingerprint,
+//! every [`DesignOptions`] field (order, ε, seed, cpumax, nrand, objective, tolerances …) and, for
+//! a warm-started job, its predecessor's id. A changed plant, option or default therefore makes
+//! new jobs instead of mixing results. Cosmetic changes (plant name, file formatting, problem
+//! order in the file) keep the ids.
+//!
+//! Warm start: with `warm_start = true`, order k of a (plant, ε, seed) chain starts from the
+//! controller of the next lower order of the same chain (the paper did this for AC10; the paper
+//! took the best controller over all runs, here the chain stays within one seed so that a job
+//! still needs nothing but its spec and its predecessor, and chains can be sharded).
+
+use std::fmt;
+use std::sync::Arc;
+
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+use super::spec::Campaign;
+use crate::design::DesignOptions;
+use crate::lti::Plant;
+
+/// Version of the id recipe; bump it if the hashed document changes meaning.
+pub const JOB_ID_VERSION: u32 = 1;
+
+/// Stable identity of a job (64 hex digits).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, serde::Deserialize)]
+#[serde(transparent)]
+pub struct JobId(pub String);
+
+impl JobId {
+    /// The first 12 hex digits, for display.
+    pub fn short(&self) -> &str {
+        &self.0[..self.0.len().min(12)]
+    }
+}
+
+impl fmt::Display for JobId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// Which runner executes the jobs. Only the test hook's fake runner enters the job id, so its
+/// results can never be mistaken for real ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunnerTag {
+    /// `design::run` (production).
+    Design,
+    /// The deterministic fake runner of the test hook (`HINFIX_FAKE_RUNNER`).
+    Fake,
+}
+
+/// One design run of a campaign.
+#[derive(Debug, Clone)]
+pub struct Job {
+    /// Identity (journal key, trace file name).
+    pub id: JobId,
+    /// Position in the expansion (stable for a given file).
+    pub index: usize,
+    /// Index of its problem in the campaign.
+    pub problem: usize,
+    /// Plant name (from the plant file).
+    pub plant_name: String,
+    /// The plant.
+    pub plant: Arc<Plant>,
+    /// Its fingerprint.
+    pub plant_fingerprint: String,
+    /// Full options of the run, including order, ε, seed and cpumax.
+    pub options: DesignOptions,
+    /// The job whose controller this one starts from (warm-start chains).
+    pub warm_from: Option<JobId>,
+    /// The runner the id was made for.
+    pub runner: RunnerTag,
+}
+
+impl Job {
+    /// `HE1 n_K=2 ε=1e-3 seed=4`.
+    pub fn label(&self) -> String {
+        format!("{} n_K={} ε={:e} seed={}", self.plant_name, self.options.order, self.options.eps, self.options.seed)
+    }
+}
+
+#[derive(Serialize)]
+struct IdDoc<'a> {
+    recipe: &'static str,
+    version: u32,
+    plant: &'a str,
+    options: &'a DesignOptions,
+    warm_from: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    runner: Option<&'static str>,
+}
+
+/// The id of a job with these inputs.
+pub fn job_id(plant_fingerprint: &str, options: &DesignOptions, warm_from: Option<&JobId>, runner: RunnerTag) -> JobId {
+    let doc = IdDoc {
+        recipe: "hinfix-job",
+        version: JOB_ID_VERSION,
+        plant: plant_fingerprint,
+        options,
+        warm_from: warm_from.map(|j| j.0.as_str()),
+        runner: match runner {
+            RunnerTag::Design => None,
+            RunnerTag::Fake => Some("fake"),
+        },
+    };
+    // serde_json writes struct fields in declaration order and floats in shortest round-trip
+    // form, so this document is canonical.
+    let bytes = serde_json::to_vec(&doc).expect("id document serialises");
+    let digest = Sha256::digest(&bytes);
+    JobId(digest.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// Expands a campaign into its jobs (see the module docs for the order).
+pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
+    let mut jobs = Vec::new();
+    for (pi, p) in c.problems.iter().enumerate() {
+        // predecessor of each (ε, seed) chain, by position in p.eps × p.seeds
+        let mut prev: Vec<Option<JobId>> = vec![None; p.eps.len() * p.seeds.len()];
+        for &order in &p.orders {
+            for (ei, &eps) in p.eps.iter().enumerate() {
+                for (si, &seed) in p.seeds.iter().enumerate() {
+                    let options = DesignOptions { order, eps, seed, ..p.base.clone() };
+                    let chain = ei * p.seeds.len() + si;
+                    let warm_from = if p.warm_start { prev[chain].clone() } else { None };
+                    let id = job_id(&p.fingerprint, &options, warm_from.as_ref(), runner);
+                    prev[chain] = Some(id.clone());
+                    jobs.push(Job {
+                        id,
+                        index: jobs.len(),
+                        problem: pi,
+                        plant_name: p.plant.name.clone(),
+                        plant: p.plant.clone(),
+                        plant_fingerprint: p.fingerprint.clone(),
+                        options,
+                        warm_from,
+                        runner,
+                    });
+                }
+            }
+        }
+    }
+    jobs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn campaign(text: &str) -> Campaign {
+        Campaign::from_toml_str(text, Path::new("t.toml")).unwrap()
+    }
+
+    const TEXT: &str = r#"
+name = "t"
+[defaults]
+eps = [1e-2, 1e-3]
+seeds = 2
+[[problem]]
+plant = "HE1"
+orders = [2, 1]
+warm_start = true
+[[problem]]
+plant = "REA2"
+orders = [1]
+"#;
+
+    #[test]
+    fn expansion_is_deterministic_and_ordered() {
+        let a = expand(&campaign(TEXT), RunnerTag::Design);
+        let b = expand(&campaign(TEXT), RunnerTag::Design);
+        assert_eq!(a.len(), 2 * 2 * 2 + 2 * 2);
+        let ids = |v: &[Job]| v.iter().map(|j| j.id.clone()).collect::<Vec<_>>();
+        assert_eq!(ids(&a), ids(&b));
+        let keys: Vec<_> = a.iter().map(|j| (j.problem, j.options.order, j.options.eps, j.options.seed)).collect();
+        assert_eq!(keys[0], (0, 1, 1e-2, 0));
+        assert_eq!(keys[1], (0, 1, 1e-2, 1));
+        assert_eq!(keys[2], (0, 1, 1e-3, 0));
+        assert_eq!(keys[4], (0, 2, 1e-2, 0));
+        assert_eq!(keys[8], (1, 1, 1e-2, 0));
+        assert!(a.iter().enumerate().all(|(i, j)| j.index == i));
+        let mut sorted = ids(&a);
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), a.len(), "ids are distinct");
+    }
+
+    #[test]
+    fn warm_start_chains_within_eps_and_seed() {
+        let jobs = expand(&campaign(TEXT), RunnerTag::Design);
+        for j in &jobs {
+            match (&j.warm_from, j.problem, j.options.order) {
+                (None, 0, 1) | (None, 1, _) => {}
+                (Some(prev), 0, 2) => {
+                    let p = jobs.iter().find(|k| &k.id == prev).unwrap();
+                    assert_eq!((p.options.order, p.options.eps, p.options.seed), (1, j.options.eps, j.options.seed));
+                }
+                other => panic!("unexpected chain {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn ids_are_stable_and_sensitive() {
+        let jobs = expand(&campaign(TEXT), RunnerTag::Design);
+        // Pinned: a change here means every journal in the world loses its resume keys.
+        let he1 = &jobs[0];
+        let again = job_id(&he1.plant_fingerprint, &he1.options, None, RunnerTag::Design);
+        assert_eq!(he1.id, again);
+        assert_eq!(he1.id.0.len(), 64);
+        // cosmetic changes keep ids: reordering problems and re-listing orders
+        let swapped = TEXT.replace("orders = [2, 1]", "orders = { from = 1, to = 2 }");
+        assert_eq!(expand(&campaign(&swapped), RunnerTag::Design)[0].id, he1.id);
+        // any option change makes a new id
+        for (what, opts) in [
+            ("cpumax", DesignOptions { cpumax: he1.options.cpumax + 1.0, ..he1.options.clone() }),
+            ("eps", DesignOptions { eps: 1e-5, ..he1.options.clone() }),
+            ("seed", DesignOptions { seed: 99, ..he1.options.clone() }),
+            ("order", DesignOptions { order: 3, ..he1.options.clone() }),
+            ("nrand", DesignOptions { nrand: 9, ..he1.options.clone() }),
+        ] {
+            assert_ne!(job_id(&he1.plant_fingerprint, &opts, None, RunnerTag::Design), he1.id, "{what}");
+        }
+        assert_ne!(job_id("other-plant", &he1.options, None, RunnerTag::Design), he1.id);
+        assert_ne!(job_id(&he1.plant_fingerprint, &he1.options, None, RunnerTag::Fake), he1.id);
+        let warm = &jobs[4];
+        assert_ne!(job_id(&warm.plant_fingerprint, &warm.options, None, RunnerTag::Design), warm.id);
+    }
+}
