@@ -25,10 +25,9 @@ use super::solver::OptimResult;
 use super::termination::Termination;
 use rand::RngCore;
 use rand_distr::{Distribution, StandardNormal};
-use serde::{Deserialize, Serialize};
 
 /// Result of [`hanso`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct HansoResult {
     /// The best point over all starts and gradient sampling, with its certificate.
     pub best: OptimResult,

@@ -31,6 +31,7 @@ mod options;
 pub mod qp;
 mod solver;
 mod termination;
+pub mod test_problems;
 
 pub use bfgs::{bfgs, BfgsState};
 pub use control::{thread_cpu_time, RunControl};

@@ -58,10 +58,6 @@ impl<'a> Evaluator<'a> {
         Evaluator { obj, ctl, evals: 0, evals_offset }
     }
 
-    pub(crate) fn nvar(&self) -> usize {
-        self.obj.nvar()
-    }
-
     /// Evaluate without any budget check (used for the starting point).
     pub(crate) fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
         self.evals += 1;
