@@ -13,6 +13,7 @@ mod matrix_json;
 mod plant;
 mod spectral;
 mod state_space;
+mod plant_library;
 
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use controller::{Controller, ControllerError, ControllerErrorKind};
@@ -26,3 +27,4 @@ pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;
+pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};

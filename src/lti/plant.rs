@@ -119,6 +119,14 @@ pub enum PlantErrorKind {
         /// What is wrong.
         problem: String,
     },
+    /// No plant of that name in the plant library.
+    #[error("no plant named `{name}` in the library (known: {known}); give a path to use another file")]
+    UnknownName {
+        /// The name asked for.
+        name: String,
+        /// The library's plant names, comma-separated.
+        known: String,
+    },
     /// A matrix is missing, mis-shaped or holds a bad entry.
     #[error("matrix `{matrix}` {problem}{hint}")]
     Matrix {

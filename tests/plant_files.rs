@@ -1,0 +1,118 @@
+//! The shipped plant library loads, and malformed plant files are rejected with errors that name
+//! the file, the field and what is wrong.
+
+use hinfix::lti::{Plant, PlantErrorKind, MatrixJsonError};
+use serde_json::{json, Value};
+
+fn plants_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("plants")
+}
+
+#[test]
+fn every_shipped_plant_loads_with_the_papers_order() {
+    // (name, n) as the paper's Tables VII and VIII state them.
+    let expected = [("AC8", 9), ("HE1", 4), ("REA2", 4), ("AC10", 55), ("BDT2", 82), ("HF1", 130), ("CM4", 240), ("Enns", 8)];
+    for (name, n) in expected {
+        let p = Plant::load(plants_dir().join(format!("{name}.json"))).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(p.name, name);
+        assert_eq!(p.dims.n, n, "{name}");
+        assert!(!p.citation.is_empty(), "{name} has no citation");
+        assert!(p.check.is_some(), "{name} has no check block");
+    }
+    let mut shipped = hinfix::lti::shipped_plants().unwrap();
+    shipped.sort();
+    let mut names: Vec<String> = expected.iter().map(|(n, _)| n.to_string()).collect();
+    names.sort();
+    assert_eq!(shipped, names);
+}
+
+/// A small valid plant document (n = 2, m1 = m2 = p1 = p2 = 1).
+fn good() -> Value {
+    json!({
+        "name": "T", "source": "test",
+        "dims": {"n": 2, "m1": 1, "m2": 1, "p1": 1, "p2": 1},
+        "A": [[-1.0, 0.0], [0.0, -2.0]], "B1": [[1.0], [0.0]], "B2": [[0.0], [1.0]],
+        "C1": [[1.0, 0.0]], "C2": [[0.0, 1.0]],
+        "D11": [[0.0]], "D12": [[1.0]], "D21": [[1.0]], "D22": [[0.0]]
+    })
+}
+
+fn with(edit: impl FnOnce(&mut serde_json::Map<String, Value>)) -> String {
+    let mut v = good();
+    edit(v.as_object_mut().unwrap());
+    v.to_string()
+}
+
+#[test]
+fn a_valid_file_loads() {
+    let p = Plant::from_json_str(&good().to_string(), "t.json").unwrap();
+    assert_eq!(p.dims.n, 2);
+    assert!(p.d22_is_zero());
+}
+
+#[test]
+fn bad_plant_files_each_get_their_own_error() {
+    type Check = fn(&PlantErrorKind) -> bool;
+    let cases: Vec<(&str, String, Check, &str)> = vec![
+        ("malformed JSON", "{\"name\": \"T\", ".to_string(),
+            |k| matches!(k, PlantErrorKind::Json { line: 1, .. }), "invalid JSON at line 1"),
+        ("not an object", "[1, 2]".to_string(),
+            |k| matches!(k, PlantErrorKind::NotObject), "top level"),
+        ("missing name", with(|o| { o.remove("name"); }),
+            |k| matches!(k, PlantErrorKind::MissingField { field: "name" }), "`name` is missing"),
+        ("missing dims", with(|o| { o.remove("dims"); }),
+            |k| matches!(k, PlantErrorKind::MissingField { field: "dims" }), "`dims` is missing"),
+        ("negative dimension", with(|o| { o["dims"]["m1"] = json!(-1); }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.m1"), "dims.m1"),
+        ("unknown dims key", with(|o| { o["dims"]["q"] = json!(1); }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.q"), "unknown key"),
+        ("missing matrix", with(|o| { o.remove("C2"); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "C2", problem: MatrixJsonError::Missing, .. }), "`C2` is missing"),
+        ("wrong row count", with(|o| { o["A"] = json!([[-1.0, 0.0]]); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "A", problem: MatrixJsonError::RowCount { expected: 2, got: 1 }, .. }), "expected 2×2"),
+        ("ragged row", with(|o| { o["B1"] = json!([[1.0], [0.0, 3.0]]); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "B1", problem: MatrixJsonError::RowLength { row: 2, .. }, .. }), "row 2"),
+        ("NaN as a string", with(|o| { o["A"] = json!([[-1.0, "NaN"], [0.0, -2.0]]); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "A", problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. }, .. }), "entry (1, 2)"),
+        ("null entry", with(|o| { o["C1"] = json!([[1.0, null]]); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "C1", problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. }, .. }), "not a number"),
+        ("wrong D22 shape", with(|o| { o["D22"] = json!([[0.0, 0.0]]); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "D22", problem: MatrixJsonError::RowLength { .. }, .. }), "p2×m2"),
+        ("matrix not an array", with(|o| { o["D11"] = json!(0.0); }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "D11", problem: MatrixJsonError::NotArray { .. }, .. }), "array of rows"),
+        ("order disagrees with dims", with(|o| { o.insert("order".into(), json!(3)); }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "order"), "dims.n is 2"),
+        ("name not a string", with(|o| { o["name"] = json!(7); }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "name"), "non-empty string"),
+    ];
+    for (what, text, check, msg) in cases {
+        let e = Plant::from_json_str(&text, "bad/plant.json").expect_err(what);
+        assert!(check(&e.kind), "{what}: unexpected error kind {:?}", e.kind);
+        let shown = e.to_string();
+        assert!(shown.starts_with("plant file bad/plant.json: "), "{what}: {shown}");
+        assert!(shown.contains(msg), "{what}: `{shown}` should mention `{msg}`");
+    }
+}
+
+#[test]
+fn overflowing_number_is_rejected_not_panicked() {
+    // 1e999 is not a finite f64; serde_json refuses it as a number.
+    let text = with(|_| {}).replace("-2.0", "1e999");
+    let e = Plant::from_json_str(&text, "p.json").unwrap_err();
+    assert!(matches!(e.kind, PlantErrorKind::Json { .. }), "{e}");
+}
+
+#[test]
+fn unreadable_file_is_an_io_error_naming_it() {
+    let e = Plant::load("no/such/plant.json").unwrap_err();
+    assert!(matches!(e.kind, PlantErrorKind::Io(_)));
+    assert!(e.to_string().contains("no/such/plant.json"));
+}
+
+#[test]
+fn unknown_name_lists_the_library() {
+    let e = hinfix::lti::resolve_plant("NoSuchPlant").unwrap_err();
+    let s = e.to_string();
+    assert!(s.contains("NoSuchPlant") && s.contains("HE1"), "{s}");
+    assert!(hinfix::lti::resolve_plant("HE1").unwrap().ends_with("plants/HE1.json"));
+}
