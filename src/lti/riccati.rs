@@ -366,7 +366,7 @@ mod tests {
     #[test]
     fn scalar_closed_form() {
         // 2 a x − g x² + q = 0, stabilising root: x = (a + sqrt(a² + g q)) / g.
-        for &(a, g, q) in &[(1.0, 1.0, 1.0), (-2.0, 0.5, 3.0), (-1.0, -0.5, 1.0), (0.3, 2.0, 0.0)] {
+        for &(a, g, q) in &[(1.0f64, 1.0f64, 1.0f64), (-2.0, 0.5, 3.0), (-1.0, -0.5, 1.0), (0.3, 2.0, 0.0)] {
             let x_true = if g != 0.0 { (a + (a * a + g * q).sqrt()) / g } else { 0.0 };
             let sol = solve_care(
                 Mat::from_fn(1, 1, |_, _| a).as_ref(),
