@@ -1,8 +1,8 @@
 //! The optimal full-order H∞ level γ_opt of a generalised plant (the "full" row of the paper's
 //! tables), by γ-iteration on the two Riccati equations.
 //!
-//! # The γ-test (Glover–Doyle 1988; Doyle–Glover–Khargonekar–Francis 1989; Zhou–Doyle–Glover
-//! 1996, §17.? "general case")
+//! # The γ-test (Glover–Doyle 1988; Doyle–Glover–Khargonekar–Francis 1989; the general-D form as
+//! in Zhou–Doyle–Glover 1996, ch. 17, and SLICOT SB10PD/SB10QD)
 //!
 //! With `B = [B1 B2]`, `C = [C1; C2]`, `D1• = [D11 D12]`, `D•1 = [D11; D21]` and
 //!
