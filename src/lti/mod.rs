@@ -7,13 +7,15 @@ mod closed_loop;
 mod controller;
 mod error;
 mod freq_response;
+mod full_order;
 mod gradient;
 mod hinf;
 mod matrix_json;
 mod plant;
+mod plant_library;
+mod riccati;
 mod spectral;
 mod state_space;
-mod plant_library;
 
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use controller::{Controller, ControllerError, ControllerErrorKind};
@@ -28,3 +30,8 @@ pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
+pub use full_order::{
+    full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions,
+    Regularisation, FLAT_RTOL, GAMMA_RTOL, REGULARISATION_EPS,
+};
+pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
