@@ -6,7 +6,7 @@
 //! `controller_hinf`, `closed_loop_stable`, `controller_stable`); non-finite numbers are written
 //! as the strings "inf" / "-inf" / "nan" (as `design::float_serde`), a frequency that does not
 //! exist (unstable loop) as null.
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -48,23 +48,8 @@ impl CheckReport {
     }
 }
 
-/// `plants/NAME.json` (relative to the current directory) if NAME names no existing file,
-/// else NAME as a path. (The lead's `lti::resolve_plant` will replace this.)
-fn plant_path(name_or_path: &str) -> PathBuf {
-    let p = Path::new(name_or_path);
-    if p.is_file() {
-        return p.to_path_buf();
-    }
-    let named = Path::new("plants").join(format!("{name_or_path}.json"));
-    if named.is_file() {
-        named
-    } else {
-        p.to_path_buf()
-    }
-}
-
 pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
-    let plant = Plant::load(plant_path(&a.plant))?;
+    let plant = Plant::load(hinfix::lti::resolve_plant(&a.plant)?)?;
     let k = Controller::load(&a.controller)?;
     k.check_fits(&plant).with_context(|| format!("controller {}", a.controller.display()))?;
     let r = evaluate(&plant, &k)?;

@@ -1,22 +1,130 @@
-//! `campaign plants` and `campaign plant NAME`.
+//! `campaign plants` (the library, one line each) and `campaign plant NAME` (one in detail).
 use std::process::ExitCode;
+
+use anyhow::Context;
+use hinfix::campaign::{load_default_reference, RefMethod};
+use hinfix::lti::{self, Plant};
+use serde_json::{json, Value};
 
 /// Arguments of `campaign plants`.
 #[derive(clap::Args, Debug)]
-pub struct PlantsArgs {}
-/// Arguments of `campaign plant`.
-#[derive(clap::Args, Debug)]
-pub struct PlantArgs {
-    /// Plant name or path.
-    pub name: String,
-    /// Print JSON.
+pub struct PlantsArgs {
+    /// Print JSON (an array of objects) instead of a table.
     #[arg(long)]
     pub json: bool,
 }
 
-pub fn list(_a: PlantsArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not yet")
+/// Arguments of `campaign plant`.
+#[derive(clap::Args, Debug)]
+pub struct PlantArgs {
+    /// Plant name (from the plant library, e.g. HE1) or path to a plant JSON file.
+    pub name: String,
+    /// Print JSON for machines: the plant file's content plus the computed figures.
+    #[arg(long)]
+    pub json: bool,
 }
-pub fn show(_a: PlantArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not yet")
+
+/// One plant's summary line.
+struct Summary {
+    name: String,
+    plant: Plant,
+    alpha: f64,
+}
+
+impl Summary {
+    fn new(plant: Plant) -> Self {
+        let alpha = lti::spectral_abscissa(plant.a.as_ref());
+        Summary { name: plant.name.clone(), plant, alpha }
+    }
+    fn stable(&self) -> bool {
+        self.alpha < 0.0
+    }
+    fn json(&self) -> Value {
+        let d = self.plant.dims;
+        json!({
+            "name": self.name, "n": d.n, "m1": d.m1, "m2": d.m2, "p1": d.p1, "p2": d.p2,
+            "open_loop_stable": self.stable(),
+            "open_loop_spectral_abscissa": self.alpha,
+            "source": self.plant.citation,
+        })
+    }
+}
+
+/// `campaign plants`.
+pub fn list(a: PlantsArgs) -> anyhow::Result<ExitCode> {
+    let dir = lti::plants_dir();
+    let names = lti::shipped_plants().with_context(|| format!("reading the plant library {}", dir.display()))?;
+    let mut rows = Vec::new();
+    for name in names {
+        let plant = Plant::load(dir.join(format!("{name}.json")))?;
+        rows.push(Summary::new(plant));
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&rows.iter().map(Summary::json).collect::<Vec<_>>())?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!("{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} source", "plant", "n", "m1", "m2", "p1", "p2", "open loop");
+    for r in &rows {
+        let d = r.plant.dims;
+        let stab = if r.stable() { "stable" } else { "unstable" };
+        println!("{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} {}", r.name, d.n, d.m1, d.m2, d.p1, d.p2, stab, short(&r.plant.citation, 70));
+    }
+    println!("\n{} plants in {}; problems without public data: {}", rows.len(), dir.display(), dir.join("MISSING.md").display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `campaign plant NAME`.
+pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
+    let path = lti::resolve_plant(&a.name)?;
+    let s = Summary::new(Plant::load(&path)?);
+    let paper_full = load_default_reference()
+        .ok()
+        .and_then(|rows| rows.into_iter().find(|r| r.plant == s.name && r.method == RefMethod::FullOrder))
+        .map(|r| r.gamma);
+    let full = lti::full_order_gamma(&s.plant);
+    if a.json {
+        let mut doc = s.plant.to_json();
+        let o = doc.as_object_mut().expect("plant JSON is an object");
+        o.insert("file".into(), path.display().to_string().into());
+        o.insert("open_loop_stable".into(), s.stable().into());
+        o.insert("open_loop_spectral_abscissa".into(), s.alpha.into());
+        o.insert("d22_zero".into(), s.plant.d22_is_zero().into());
+        o.insert("full_order_gamma".into(), match &full {
+            Ok(f) => json!({"gamma": f.gamma, "regularisation": f.regularisation, "method": f.describe()}),
+            Err(e) => json!({"error": e.to_string()}),
+        });
+        o.insert("paper_full_order_gamma".into(), paper_full.into());
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let p = &s.plant;
+    let d = p.dims;
+    println!("{} — {}", p.name, p.description);
+    println!("  file:        {}", path.display());
+    println!("  source:      {}", p.citation);
+    println!("  sizes:       n = {}, w: m1 = {}, u: m2 = {}, z: p1 = {}, y: p2 = {}", d.n, d.m1, d.m2, d.p1, d.p2);
+    println!("  open loop:   {} (spectral abscissa {:.6e})", if s.stable() { "stable" } else { "unstable" }, s.alpha);
+    println!("  D22:         {}", if p.d22_is_zero() { "zero" } else { "non-zero" });
+    match &full {
+        Ok(f) => println!("  full-order optimal γ: {:.6} ({})", f.gamma, f.describe()),
+        Err(e) => println!("  full-order optimal γ: not computed: {e}"),
+    }
+    if let Some(g) = paper_full {
+        println!("  paper's full-order γ: {g}");
+    }
+    if let Some(check) = &p.check {
+        println!("  file's check block:   {check}");
+    }
+    if !p.notes.is_empty() {
+        println!("  notes:       {}", p.notes);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn short(s: &str, max: usize) -> String {
+    if s.chars().count() <= max {
+        s.to_string()
+    } else {
+        format!("{}…", s.chars().take(max - 1).collect::<String>())
+    }
 }

@@ -1,14 +1,25 @@
-//! The HIFOO method: fixed-order H∞ design with strong stabilisation (algorithm.md §3, §3.1, §7).
+//! The HIFOO method: fixed-order H∞ design with strong stabilisation (algorithm.md §3, §3.1, §7;
+//! Gumussoy, Millstone & Overton, CDC 2008).
 //!
-//! (The optimisation itself lands with the design issue; this file fixes the public types that the
-//! campaign runner codes against.)
+//! * [`params`]: x = [vec Ak; vec Bk; vec Ck; vec Dk] ↔ controller;
+//! * [`starts`]: seeded random starts, perturbations of an initial controller, warm-start padding;
+//! * [`objective`]: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
+//!   observer adapter;
+//! * `phases`: stabilisation (BFGS per start, fvalquit 0, then gradient sampling) and
+//!   optimisation (HANSO);
+//! * [`run`]: the entry point.
 mod float_serde;
+pub mod objective;
 mod options;
 mod outcome;
-// TEMP: stand-in for design::run until the design branch lands (drop at merge).
-mod run_stub;
-pub use run_stub::run;
+pub mod params;
+mod phases;
+mod run;
+pub mod starts;
 
 pub use float_serde::serde_f64_or_string;
+pub use objective::{Components, DesignObjective, ObjectivePhase};
 pub use options::{DesignOptions, ObjectiveKind};
 pub use outcome::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats};
+pub use params::{controller_to_x, x_to_controller, ControllerShape};
+pub use run::{run, run_with_control, validate};

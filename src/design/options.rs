@@ -40,6 +40,9 @@ pub struct DesignOptions {
     pub evaldist: f64,
     /// Run gradient sampling after BFGS (HIFOO `fast = 0`).
     pub gradient_sampling: bool,
+    /// Iteration limit of each gradient-sampling run (HIFOO caps HANSO 2.0's gradient sampling
+    /// at 100 iterations per radius, 3 radii; each iteration costs 2·nvar evaluations).
+    pub gradsamp_maxit: usize,
 }
 
 impl Default for DesignOptions {
@@ -56,6 +59,7 @@ impl Default for DesignOptions {
             normtol: 1e-3,
             evaldist: 1e-3,
             gradient_sampling: true,
+            gradsamp_maxit: 300,
         }
     }
 }

@@ -117,6 +117,13 @@ pub struct DesignIterRecord {
 
 /// Watches a design run; `Break` stops it (status `Interrupted`).
 pub trait DesignObserver {
+    /// Whether the records should carry ‖Tzw‖∞, ‖K‖∞, α(Acl), α(Ak) even where that costs an
+    /// extra computation (α(Acl) in the optimisation phase: one eigenvalue computation per
+    /// iteration). Default true; [`NoDesignObserver`] says false.
+    fn wants_components(&self) -> bool {
+        true
+    }
+
     /// Called once per optimiser iteration.
     fn on_iter(&mut self, _rec: &DesignIterRecord) -> ControlFlow<()> {
         ControlFlow::Continue(())
@@ -125,7 +132,11 @@ pub trait DesignObserver {
 
 /// An observer that watches nothing.
 pub struct NoDesignObserver;
-impl DesignObserver for NoDesignObserver {}
+impl DesignObserver for NoDesignObserver {
+    fn wants_components(&self) -> bool {
+        false
+    }
+}
 
 /// A design run that could not produce a trustworthy result.
 #[derive(Debug, thiserror::Error)]

@@ -7,11 +7,13 @@ mod closed_loop;
 mod controller;
 mod error;
 mod freq_response;
+mod full_order;
 mod gradient;
 mod hinf;
 mod matrix_json;
 mod plant;
 mod plant_library;
+mod riccati;
 mod spectral;
 mod state_space;
 
@@ -25,6 +27,11 @@ pub use gradient::{
 pub use hinf::{hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
-pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;
+pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
+pub use full_order::{
+    full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions,
+    Regularisation, FLAT_RTOL, GAMMA_RTOL, REGULARISATION_EPS,
+};
+pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};

@@ -1,0 +1,308 @@
+//! The two design objectives as [`optim::Objective`](crate::optim::Objective)s
+//! (algorithm.md §3, §3.1), and the observer adapter that reports their components.
+//!
+//! With weights (1, ε) on the plant and on the controller "plant" `'K'` (HIFOO 3.5's strong
+//! stabilisation, Gumussoy–Millstone–Overton 2008):
+//!
+//! ```text
+//! stabilisation:  f_s(x) = max( α(Acl), ε·α(Ak) )        (plain mode: α(Acl))
+//! performance:    f_h(x) = max( ‖Tzw‖∞, ε·‖K‖∞ )        (plain mode: ‖Tzw‖∞)
+//! ```
+//!
+//! f_h = +∞ where Acl or Ak is not Hurwitz (‖·‖∞ = +∞ there) or the loop is ill-posed
+//! (I − Dk·D22 numerically singular, [`LtiError::IllPosed`](crate::lti::LtiError)); f_s = +∞ only
+//! where the loop is ill-posed or an eigenvalue computation fails. The gradient is that of the
+//! term attaining the max (ties: the plant term, HIFOO's "ties broken arbitrarily"); where f is
+//! not finite the gradient is NaN, which the optimiser's line search treats as a failed trial.
+//!
+//! For order 0 the controller term is dropped from f_s (a static gain has no dynamics) but kept
+//! in f_h as ε·σmax(Dk) (algorithm.md §3.1).
+//!
+//! Cost: ε·‖K‖∞ (an nk-state system) is evaluated before ‖Tzw‖∞ (n + nk states), so an unstable
+//! controller costs almost nothing. Each evaluation stores its components (‖Tzw‖∞, ‖K‖∞, α's) in
+//! a small cache keyed by x, from which [`ObserverAdapter`] reports them per iteration.
+
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::ops::ControlFlow;
+use std::rc::Rc;
+
+use crate::lti::{
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
+    spectral_abscissa, Controller, ControllerGradient, Plant,
+};
+use crate::optim::{IterRecord, Objective, Observer, SolverKind};
+
+use super::outcome::{DesignIterRecord, DesignObserver, Phase};
+use super::params::ControllerShape;
+
+/// Number of recently evaluated points whose components are kept for the observer.
+pub const COMPONENT_CACHE_LEN: usize = 32;
+
+/// Which of the two objectives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ObjectivePhase {
+    /// max(α(Acl), ε·α(Ak)).
+    Stabilisation,
+    /// max(‖Tzw‖∞, ε·‖K‖∞).
+    Performance,
+}
+
+/// The values behind one objective evaluation; NaN = not computed at this point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Components {
+    /// The objective value.
+    pub f: f64,
+    /// ‖Tzw‖∞.
+    pub hinf_cl: f64,
+    /// ‖K‖∞.
+    pub hinf_k: f64,
+    /// α(Acl).
+    pub alpha_cl: f64,
+    /// α(Ak) (NaN for order 0).
+    pub alpha_k: f64,
+}
+
+impl Components {
+    const UNKNOWN: Components =
+        Components { f: f64::NAN, hinf_cl: f64::NAN, hinf_k: f64::NAN, alpha_cl: f64::NAN, alpha_k: f64::NAN };
+}
+
+/// Components at the most recently evaluated points (exact bitwise match on x).
+#[derive(Debug, Default)]
+pub struct ComponentCache {
+    entries: VecDeque<(Vec<f64>, Components)>,
+}
+
+impl ComponentCache {
+    /// Components stored for exactly this x.
+    pub fn lookup(&self, x: &[f64]) -> Option<Components> {
+        self.entries.iter().rev().find(|(y, _)| y.as_slice() == x).map(|(_, c)| *c)
+    }
+
+    fn insert(&mut self, x: &[f64], c: Components) {
+        if self.entries.len() == COMPONENT_CACHE_LEN {
+            self.entries.pop_front();
+        }
+        self.entries.push_back((x.to_vec(), c));
+    }
+
+    fn update(&mut self, x: &[f64], c: Components) {
+        if let Some(e) = self.entries.iter_mut().rev().find(|(y, _)| y.as_slice() == x) {
+            e.1 = c;
+        } else {
+            self.insert(x, c);
+        }
+    }
+}
+
+/// A design objective on x = [vec Ak; vec Bk; vec Ck; vec Dk].
+pub struct DesignObjective<'p> {
+    plant: &'p Plant,
+    shape: ControllerShape,
+    phase: ObjectivePhase,
+    strong: bool,
+    eps: f64,
+    hinf_tol: f64,
+    cache: Rc<RefCell<ComponentCache>>,
+}
+
+impl<'p> DesignObjective<'p> {
+    /// The objective `phase` for controllers of `shape` on `plant`; `strong` adds the ε-weighted
+    /// controller term. `cache` receives the components of every evaluation.
+    pub fn new(
+        plant: &'p Plant,
+        shape: ControllerShape,
+        phase: ObjectivePhase,
+        strong: bool,
+        eps: f64,
+        hinf_tol: f64,
+        cache: Rc<RefCell<ComponentCache>>,
+    ) -> Self {
+        DesignObjective { plant, shape, phase, strong, eps, hinf_tol, cache }
+    }
+
+    /// The cache this objective writes to.
+    pub fn cache(&self) -> Rc<RefCell<ComponentCache>> {
+        Rc::clone(&self.cache)
+    }
+
+    /// f and its components at controller `k`; the gradient (as controller matrices) if `grad`.
+    pub fn components(&self, k: &Controller, grad: bool) -> (Components, Option<ControllerGradient>) {
+        match self.phase {
+            ObjectivePhase::Stabilisation => self.stabilisation(k, grad),
+            ObjectivePhase::Performance => self.performance(k, grad),
+        }
+    }
+
+    fn stabilisation(&self, k: &Controller, _grad: bool) -> (Components, Option<ControllerGradient>) {
+        let mut c = Components::UNKNOWN;
+        let nk = k.order();
+        // α(Ak) is cheap (nk × nk); its gradient is needed only when it is in the objective.
+        let (alpha_k, g_k) = if nk > 0 { let (a, g) = controller_abscissa_grad(k); (a, Some(g)) } else { (f64::NAN, None) };
+        c.alpha_k = alpha_k;
+        let (alpha_cl, g_cl) = match closed_loop_abscissa_grad(self.plant, k) {
+            Ok((a, g)) => (a, Some(g)),
+            Err(_) => (f64::INFINITY, None),
+        };
+        c.alpha_cl = alpha_cl;
+        let k_term = if self.strong && nk > 0 { self.eps * alpha_k } else { f64::NEG_INFINITY };
+        // NaN-safe max: a NaN term makes f NaN (treated like +∞ by the line search).
+        let (f, g) = if k_term.is_nan() || k_term > alpha_cl {
+            (k_term, g_k.map(|g| scale(g, self.eps)))
+        } else {
+            (alpha_cl, g_cl)
+        };
+        c.f = f;
+        (c, g)
+    }
+
+    fn performance(&self, k: &Controller, _grad: bool) -> (Components, Option<ControllerGradient>) {
+        let mut c = Components::UNKNOWN;
+        if k.order() > 0 {
+            c.alpha_k = spectral_abscissa(k.ak.as_ref());
+        }
+        let mut k_term = (f64::NEG_INFINITY, None);
+        if self.strong {
+            let (norm, g) = controller_hinf_grad(k, self.hinf_tol);
+            c.hinf_k = norm.value;
+            if !norm.value.is_finite() {
+                c.f = f64::INFINITY;
+                return (c, None);
+            }
+            k_term = (self.eps * norm.value, Some(g));
+        }
+        let (gamma, g_cl) = match closed_loop_hinf_grad(self.plant, k, self.hinf_tol) {
+            Ok((norm, g)) => (norm.value, Some(g)),
+            Err(_) => (f64::INFINITY, None),
+        };
+        c.hinf_cl = gamma;
+        if !gamma.is_finite() {
+            c.f = f64::INFINITY;
+            return (c, None);
+        }
+        if k_term.0 > gamma {
+            c.f = k_term.0;
+            (c, k_term.1.map(|g| scale(g, self.eps)))
+        } else {
+            c.f = gamma;
+            (c, g_cl)
+        }
+    }
+}
+
+fn scale(mut g: ControllerGradient, s: f64) -> ControllerGradient {
+    for m in [&mut g.ak, &mut g.bk, &mut g.ck, &mut g.dk] {
+        for j in 0..m.ncols() {
+            for i in 0..m.nrows() {
+                m[(i, j)] *= s;
+            }
+        }
+    }
+    g
+}
+
+impl Objective for DesignObjective<'_> {
+    fn nvar(&self) -> usize {
+        self.shape.nvar()
+    }
+
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        let k = self.shape.controller(x);
+        let (c, grad) = self.components(&k, true);
+        match grad {
+            Some(gk) if c.f.is_finite() => self.shape.write_x(&gk, g),
+            _ => g.iter_mut().for_each(|v| *v = f64::NAN),
+        }
+        self.cache.borrow_mut().insert(x, c);
+        c.f
+    }
+}
+
+/// Translates the optimiser's [`IterRecord`]s into [`DesignIterRecord`]s for a
+/// [`DesignObserver`], with the objective's components taken from the [`ComponentCache`].
+///
+/// Missing components: if x is no longer cached (e.g. after many gradient-sampling samples) it is
+/// evaluated again without gradient; in the performance phase α(Acl) (one eigenvalue computation
+/// of Acl) is computed here, once per iteration, only if the observer
+/// [wants components](DesignObserver::wants_components).
+pub struct ObserverAdapter<'a, 'p> {
+    inner: &'a mut dyn DesignObserver,
+    objective_for_misses: DesignObjective<'p>,
+    phase: Phase,
+    evals_base: usize,
+    interrupted: bool,
+}
+
+impl<'a, 'p> ObserverAdapter<'a, 'p> {
+    /// An adapter for `inner`, reading components from `objective`'s cache.
+    pub fn new(inner: &'a mut dyn DesignObserver, objective: &DesignObjective<'p>, phase: Phase) -> Self {
+        let o = objective;
+        let objective_for_misses =
+            DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache());
+        ObserverAdapter { inner, objective_for_misses, phase, evals_base: 0, interrupted: false }
+    }
+
+    /// Sets the number of evaluations made in the run before the next optimiser call.
+    pub fn set_evals_base(&mut self, base: usize) {
+        self.evals_base = base;
+    }
+
+    /// Whether the design observer asked to stop.
+    pub fn interrupted(&self) -> bool {
+        self.interrupted
+    }
+
+    /// Gives back the inner observer.
+    pub fn into_inner(self) -> &'a mut dyn DesignObserver {
+        self.inner
+    }
+}
+
+impl Observer for ObserverAdapter<'_, '_> {
+    fn on_iter(&mut self, rec: &IterRecord<'_>) -> ControlFlow<()> {
+        if self.interrupted {
+            return ControlFlow::Break(());
+        }
+        let wants = self.inner.wants_components();
+        let obj = &self.objective_for_misses;
+        let cached = obj.cache.borrow().lookup(rec.x);
+        let mut c = match cached {
+            Some(c) => c,
+            None if wants => {
+                let (c, _) = obj.components(&obj.shape.controller(rec.x), false);
+                obj.cache.borrow_mut().update(rec.x, c);
+                c
+            }
+            None => Components::UNKNOWN,
+        };
+        if wants && c.alpha_cl.is_nan() && obj.phase == ObjectivePhase::Performance {
+            let k = obj.shape.controller(rec.x);
+            c.alpha_cl = closed_loop(obj.plant, &k).map(|cl| spectral_abscissa(cl.a.as_ref())).unwrap_or(f64::INFINITY);
+            obj.cache.borrow_mut().update(rec.x, c);
+        }
+        let phase = match (self.phase, rec.solver) {
+            (Phase::Optimisation, SolverKind::GradientSampling) => Phase::GradientSampling,
+            (p, _) => p,
+        };
+        let out = DesignIterRecord {
+            phase,
+            start: rec.start,
+            iter: rec.iter,
+            f: rec.f,
+            hinf_cl: c.hinf_cl,
+            hinf_k: c.hinf_k,
+            alpha_cl: c.alpha_cl,
+            alpha_k: c.alpha_k,
+            dnorm: rec.dnorm,
+            step: rec.step,
+            evals: self.evals_base + rec.evals,
+            cpu_s: rec.cpu_s,
+        };
+        let flow = self.inner.on_iter(&out);
+        if flow.is_break() {
+            self.interrupted = true;
+        }
+        flow
+    }
+}

@@ -1,0 +1,237 @@
+//! [`run`]: one HIFOO design (algorithm.md §7): validate, build the starting points, stabilise,
+//! optimise, and report figures recomputed from the returned controller.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use crate::lti::{
+    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL,
+};
+use crate::optim::{RunControl, Termination};
+
+use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
+use super::options::{DesignOptions, ObjectiveKind};
+use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase};
+use super::params::{controller_to_x, ControllerShape};
+use super::phases::{optimise, stabilise};
+use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
+
+/// Designs a controller of order `opts.order` for `plant` (HIFOO, strong stabilisation unless
+/// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds.
+///
+/// `init` (optional) is a starting controller of order ≤ `opts.order`; a lower order is padded
+/// with decoupled stable modes (algorithm.md §7.3), and it is used together with `opts.nrand`
+/// relative perturbations of itself. Without `init`, `opts.nrand` standard-normal starts are drawn
+/// from a ChaCha8 generator seeded with `opts.seed`.
+///
+/// Failing to stabilise is an outcome ([`DesignStatus::NotStabilised`]), not an error; `Err` is
+/// for invalid options or an initial controller that does not fit. γ, ‖K‖∞ and the abscissas of
+/// the outcome are recomputed from the returned controller.
+pub fn run(
+    plant: &Plant,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
+    validate(plant, opts, init)?;
+    let ctl = RunControl::new(opts.cpumax);
+    run_validated(plant, opts, init, &ctl, obs)
+}
+
+/// As [`run`], with a caller-made [`RunControl`] (e.g. with a cancel flag:
+/// `RunControl::new(opts.cpumax).with_cancel(flag)`); its budget replaces `opts.cpumax`, and a
+/// cancel gives [`DesignStatus::Interrupted`].
+pub fn run_with_control(
+    plant: &Plant,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    ctl: &RunControl,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
+    validate(plant, opts, init)?;
+    run_validated(plant, opts, init, ctl, obs)
+}
+
+fn opt_err(field: &'static str, problem: impl Into<String>) -> DesignError {
+    DesignError::Options { field, problem: problem.into() }
+}
+
+/// Checks the options and the initial controller against the plant.
+pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) -> Result<(), DesignError> {
+    if !(opts.eps.is_finite() && opts.eps > 0.0) {
+        return Err(opt_err("eps", format!("must be finite and > 0, got {}", opts.eps)));
+    }
+    if !(opts.cpumax > 0.0) {
+        return Err(opt_err("cpumax", format!("must be > 0 CPU seconds (may be infinite), got {}", opts.cpumax)));
+    }
+    if opts.nrand < 1 {
+        return Err(opt_err("nrand", "must be at least 1"));
+    }
+    if opts.order > plant.dims.n {
+        return Err(opt_err(
+            "order",
+            format!("{} exceeds the plant order n = {} of {} (HIFOO's limit)", opts.order, plant.dims.n, plant.name),
+        ));
+    }
+    if !(opts.hinf_tol.is_finite() && opts.hinf_tol >= MIN_HINF_TOL && opts.hinf_tol < 1.0) {
+        return Err(opt_err("hinf_tol", format!("must be in [{MIN_HINF_TOL:e}, 1), got {}", opts.hinf_tol)));
+    }
+    if opts.maxit < 1 {
+        return Err(opt_err("maxit", "must be at least 1"));
+    }
+    for (field, v) in [("normtol", opts.normtol), ("evaldist", opts.evaldist)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(opt_err(field, format!("must be finite and >= 0, got {v}")));
+        }
+    }
+    if let Some(k) = init {
+        k.check_fits(plant).map_err(|e| DesignError::Init(e.to_string()))?;
+        if k.order() > opts.order {
+            return Err(DesignError::Init(format!(
+                "its order {} exceeds the target order {} (warm starts only grow the order)",
+                k.order(),
+                opts.order
+            )));
+        }
+        let finite = [&k.ak, &k.bk, &k.ck, &k.dk]
+            .iter()
+            .all(|m| (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite())));
+        if !finite {
+            return Err(DesignError::Init("has a non-finite entry".into()));
+        }
+    }
+    Ok(())
+}
+
+/// The starting points: perturbations of the (padded) initial controller, or random.
+fn starting_points(
+    plant: &Plant,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    shape: ControllerShape,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Vec<f64>> {
+    match init {
+        Some(k) => {
+            let padded = if k.order() < shape.nk {
+                pad_controller(k, shape.nk, padding_diagonal(plant, k)).expect("order checked by validate")
+            } else {
+                k.clone()
+            };
+            perturbed_starts(&controller_to_x(&padded), opts.nrand, rng)
+        }
+        None => random_starts(shape.nvar(), opts.nrand, rng),
+    }
+}
+
+/// Figures recomputed from a controller (never from optimiser bookkeeping).
+struct Figures {
+    gamma: f64,
+    k_hinf: f64,
+    alpha_cl: f64,
+    alpha_k: Option<f64>,
+    objective: f64,
+}
+
+fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
+    let (alpha_cl, gamma) = match closed_loop(plant, k) {
+        Ok(cl) => {
+            let a = spectral_abscissa(cl.a.as_ref());
+            let g = if a < 0.0 { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
+            (a, g)
+        }
+        Err(_) => (f64::INFINITY, f64::INFINITY),
+    };
+    let k_hinf = controller_hinf_grad(k, opts.hinf_tol).0.value;
+    let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
+    let objective = match opts.objective {
+        ObjectiveKind::Strong => gamma.max(opts.eps * k_hinf),
+        ObjectiveKind::Plain => gamma,
+    };
+    Figures { gamma, k_hinf, alpha_cl, alpha_k, objective }
+}
+
+fn run_validated(
+    plant: &Plant,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    ctl: &RunControl,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
+    let shape = ControllerShape { nk: opts.order, m: plant.dims.m2, p: plant.dims.p2 };
+    let strong = opts.objective == ObjectiveKind::Strong;
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let starts = starting_points(plant, opts, init, shape, &mut rng);
+    let cache = Rc::new(RefCell::new(ComponentCache::default()));
+
+    // Phase 1: stabilisation.
+    let mut stab_obj =
+        DesignObjective::new(plant, shape, ObjectivePhase::Stabilisation, strong, opts.eps, opts.hinf_tol, Rc::clone(&cache));
+    let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
+    let stab = stabilise(&mut stab_obj, &starts, opts, &mut rng, ctl, &mut adapter, 0)?;
+    let mut interrupted = adapter.interrupted() || ctl.cancelled() || stab.stopped == Some(Termination::Interrupted);
+    let obs = adapter.into_inner();
+    let mut phases = vec![stab.stats.clone()];
+    let mut evals = stab.stats.evals;
+
+    let mut final_x = stab.best_x.clone();
+    let mut certificate = (None, None);
+    let status;
+    if stab.stable.is_empty() {
+        status = if interrupted { DesignStatus::Interrupted } else { DesignStatus::NotStabilised { best_alpha: stab.best_f } };
+    } else if interrupted {
+        status = DesignStatus::Interrupted;
+    } else {
+        // Phase 2: optimisation from every stable point.
+        let mut perf_obj =
+            DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
+        let mut adapter = ObserverAdapter::new(obs, &perf_obj, Phase::Optimisation);
+        let opt = optimise(&mut perf_obj, &stab.stable, opts, &mut rng, ctl, &mut adapter, evals)?;
+        interrupted = adapter.interrupted() || ctl.cancelled() || opt.stopped == Some(Termination::Interrupted);
+        phases.push(opt.bfgs_stats.clone());
+        evals += opt.bfgs_stats.evals;
+        if let Some(gs) = &opt.gs_stats {
+            phases.push(gs.clone());
+            evals += gs.evals;
+        }
+        let budget = stab.stopped == Some(Termination::CpuBudget) || opt.stopped == Some(Termination::CpuBudget);
+        match &opt.best {
+            Some(best) => {
+                final_x = best.x.clone();
+                certificate = (Some(best.dnorm), Some(best.evaldist));
+            }
+            None => final_x = stab.stable[0].clone(),
+        }
+        status = if interrupted {
+            DesignStatus::Interrupted
+        } else if budget {
+            DesignStatus::BudgetExhausted
+        } else if opt.best.is_none() || !opt.progress {
+            DesignStatus::StabilisedOnly
+        } else {
+            DesignStatus::Optimised
+        };
+    }
+
+    let k = shape.controller(&final_x);
+    let fig = figures(plant, opts, &k);
+    let iters = phases.iter().map(|p| p.iters).sum();
+    Ok(DesignOutcome {
+        status,
+        controller: k.to_json(),
+        gamma: fig.gamma,
+        k_hinf: fig.k_hinf,
+        alpha_cl: fig.alpha_cl,
+        alpha_k: fig.alpha_k,
+        objective: fig.objective,
+        dnorm: certificate.0,
+        evaldist: certificate.1,
+        phases,
+        iters,
+        evals,
+        cpu_s: ctl.cpu_elapsed(),
+    })
+}

@@ -1,0 +1,171 @@
+//! Starting points of a design run (algorithm.md §7.2–§7.3).
+//!
+//! * No initial controller: `nrand` standard-normal vectors x ~ N(0, I) in ℝ^nvar
+//!   (HIFOO `randn(nvar, nrand)`).
+//! * An initial controller x_init: x_init itself plus `nrand` perturbations
+//!   x_init + ξ ∘ (‖x_init‖₂ · r), ξ ~ N(0, I), with relative sizes r = logspace(−3, −1, nrand)
+//!   (1e-3, 1e-2, 1e-1 for nrand = 3), nrand + 1 starts in total.
+//! * Warm start from a lower order (HIFOO `xinitsetup`): pad Bk with zero rows, Ck with zero
+//!   columns and Ak with zeros plus new diagonal entries d < 0. The added modes are
+//!   uncontrollable and unobservable both in the closed loop and in K itself, so Tzw and K keep
+//!   their transfer functions (‖Tzw‖∞ and ‖K‖∞ do not change) and the spectra only gain the
+//!   eigenvalue d. Choosing d ≤ min(α(Acl), α(Ak), 0) − 1 ([`padding_diagonal`]) also leaves the
+//!   stabilisation objective max(α(Acl), ε·α(Ak)) unchanged, so the warm start is never worse.
+//!
+//! # Deviation
+//! HIFOO pads with d = −(complex stability radius of the closed loop) − 1 for the H∞ objective
+//! (and d = α − 1 for the abscissa objective, d = −1 if the loop is unstable). Any d < 0 keeps the
+//! H∞ objective; we use the abscissa rule for both objectives so that one padding serves both
+//! phases and no extra norm computation is needed.
+//!
+//! All randomness comes from the run's seeded generator (ChaCha8, `DesignOptions::seed`), so the
+//! same seed gives the same starts on every platform.
+
+use faer::Mat;
+use rand::RngCore;
+use rand_distr::{Distribution, StandardNormal};
+
+use crate::lti::{closed_loop, spectral_abscissa, Controller, Plant};
+
+/// Smallest and largest relative perturbation size (log10) around an initial controller.
+pub const PERTURB_LOG10_RANGE: (f64, f64) = (-3.0, -1.0);
+
+/// Distance (in the real-part direction) of padded modes to the left of the rightmost existing
+/// closed-loop / controller eigenvalue (HIFOO: `diagpad0 − 1`).
+pub const PAD_MARGIN: f64 = 1.0;
+
+/// `n` points 10^a … 10^b equally spaced in log10 (MATLAB `logspace`; n = 1 gives 10^b).
+pub fn logspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+    match n {
+        0 => Vec::new(),
+        1 => vec![10f64.powf(b)],
+        _ => (0..n).map(|i| 10f64.powf(a + (b - a) * i as f64 / (n - 1) as f64)).collect(),
+    }
+}
+
+/// `nrand` standard-normal starting points in ℝ^nvar.
+pub fn random_starts(nvar: usize, nrand: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
+    (0..nrand).map(|_| (0..nvar).map(|_| StandardNormal.sample(&mut *rng)).collect()).collect()
+}
+
+/// x_init followed by `nrand` relative perturbations x_init + ξ ∘ (‖x_init‖ · r_i),
+/// r = logspace(−3, −1, nrand).
+pub fn perturbed_starts(x_init: &[f64], nrand: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
+    let norm = x_init.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut out = vec![x_init.to_vec()];
+    for r in logspace(PERTURB_LOG10_RANGE.0, PERTURB_LOG10_RANGE.1, nrand) {
+        let scale = norm * r;
+        out.push(
+            x_init
+                .iter()
+                .map(|&v| {
+                    let xi: f64 = StandardNormal.sample(&mut *rng);
+                    v + xi * scale
+                })
+                .collect(),
+        );
+    }
+    out
+}
+
+/// The diagonal entry for padded modes: min(0, α(Acl), α(Ak)) − [`PAD_MARGIN`], ignoring
+/// non-finite abscissas (an unstable or ill-posed loop gives −PAD_MARGIN, as HIFOO's
+/// `diagpad0 = 0`).
+pub fn padding_diagonal(plant: &Plant, k: &Controller) -> f64 {
+    let alpha_cl = closed_loop(plant, k).map(|cl| spectral_abscissa(cl.a.as_ref())).unwrap_or(f64::INFINITY);
+    let alpha_k = spectral_abscissa(k.ak.as_ref());
+    let mut base = 0.0f64;
+    for a in [alpha_cl, alpha_k] {
+        if a.is_finite() {
+            base = base.min(a);
+        }
+    }
+    base - PAD_MARGIN
+}
+
+/// `k` padded to order `nk ≥ k.order()` with decoupled modes at `diag` (module docs).
+/// Returns `None` if `nk < k.order()`.
+pub fn pad_controller(k: &Controller, nk: usize, diag: f64) -> Option<Controller> {
+    let n0 = k.order();
+    if nk < n0 {
+        return None;
+    }
+    let (m, p) = (k.m(), k.p());
+    let ak = Mat::from_fn(nk, nk, |i, j| {
+        if i < n0 && j < n0 {
+            k.ak[(i, j)]
+        } else if i == j {
+            diag
+        } else {
+            0.0
+        }
+    });
+    let bk = Mat::from_fn(nk, p, |i, j| if i < n0 { k.bk[(i, j)] } else { 0.0 });
+    let ck = Mat::from_fn(m, nk, |i, j| if j < n0 { k.ck[(i, j)] } else { 0.0 });
+    Some(Controller { ak, bk, ck, dk: k.dk.clone() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn logspace_matches_matlab() {
+        let l = logspace(-3.0, -1.0, 3);
+        assert!((l[0] - 1e-3).abs() < 1e-18 && (l[1] - 1e-2).abs() < 1e-17 && (l[2] - 1e-1).abs() < 1e-16);
+        assert_eq!(logspace(-3.0, -1.0, 1), vec![10f64.powf(-1.0)]);
+        assert!(logspace(0.0, 1.0, 0).is_empty());
+    }
+
+    #[test]
+    fn random_starts_are_seeded() {
+        let a = random_starts(5, 3, &mut ChaCha8Rng::seed_from_u64(7));
+        let b = random_starts(5, 3, &mut ChaCha8Rng::seed_from_u64(7));
+        let c = random_starts(5, 3, &mut ChaCha8Rng::seed_from_u64(8));
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        assert_eq!(a.len(), 3);
+        assert!(a.iter().all(|x| x.len() == 5));
+        // standard normal: a mean of many draws is near 0, the variance near 1
+        let big = random_starts(10_000, 1, &mut ChaCha8Rng::seed_from_u64(1)).remove(0);
+        let mean = big.iter().sum::<f64>() / big.len() as f64;
+        let var = big.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / big.len() as f64;
+        assert!(mean.abs() < 0.05 && (var - 1.0).abs() < 0.05, "mean {mean} var {var}");
+    }
+
+    #[test]
+    fn perturbations_have_the_documented_relative_sizes() {
+        let x: Vec<f64> = (0..400).map(|i| ((i as f64) * 0.1).cos()).collect();
+        let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let s = perturbed_starts(&x, 3, &mut ChaCha8Rng::seed_from_u64(3));
+        assert_eq!(s.len(), 4);
+        assert_eq!(s[0], x);
+        for (i, r) in [1e-3, 1e-2, 1e-1].into_iter().enumerate() {
+            let d: f64 = s[i + 1].iter().zip(&x).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
+            // ‖ξ‖ ≈ sqrt(400) = 20
+            let rel = d / (norm * r * 20.0);
+            assert!((0.8..1.2).contains(&rel), "perturbation {i}: relative size {rel}");
+        }
+    }
+
+    #[test]
+    fn padding_keeps_the_old_blocks_and_adds_decoupled_modes() {
+        let k = Controller {
+            ak: Mat::from_fn(1, 1, |_, _| -2.0),
+            bk: Mat::from_fn(1, 2, |_, j| j as f64 + 1.0),
+            ck: Mat::from_fn(1, 1, |_, _| 3.0),
+            dk: Mat::from_fn(1, 2, |_, j| 0.5 * j as f64),
+        };
+        let kp = pad_controller(&k, 3, -4.0).unwrap();
+        assert_eq!(kp.order(), 3);
+        assert_eq!(kp.ak[(0, 0)], -2.0);
+        assert_eq!((kp.ak[(1, 1)], kp.ak[(2, 2)], kp.ak[(0, 1)], kp.ak[(2, 1)]), (-4.0, -4.0, 0.0, 0.0));
+        assert_eq!((kp.bk[(0, 1)], kp.bk[(2, 1)]), (2.0, 0.0));
+        assert_eq!((kp.ck[(0, 0)], kp.ck[(0, 2)]), (3.0, 0.0));
+        assert_eq!(kp.dk, k.dk);
+        assert!(pad_controller(&kp, 2, -1.0).is_none());
+        assert_eq!(pad_controller(&k, 1, -1.0).unwrap(), k);
+    }
+}

@@ -1,0 +1,79 @@
+//! The gradient bundle and the local optimality certificate (HANSO 2.x; algorithm.md §6.2, §6.5).
+//!
+//! BFGS keeps the gradients of consecutive iterates as long as each step is ≤ `evaldist`
+//! (a longer step resets the bundle to the new point), at most `ngrad` of them, newest first.
+//! d = the smallest vector in their convex hull (the simplex QP of [`qp`](super::qp)) approximates
+//! the minimum-norm element of the Clarke ε-subdifferential with ε ≈ evaldist, so
+//!
+//! * dnorm = ‖d‖ small **and** evaldist = maxⱼ ‖x − Xⱼ‖ small ⇒ x is close to a Clarke stationary
+//!   point ("the smaller dnorm and evaldist, the more likely x is an approximate stationary point").
+//!
+//! `evaldist` in the result is the actual largest distance, which may exceed the option of that
+//! name because the reset test is on consecutive steps.
+
+use super::qp::{min_norm_in_hull, MinNormResult};
+use std::collections::VecDeque;
+
+/// Points and their gradients, newest first.
+#[derive(Debug, Clone)]
+pub(crate) struct GradBundle {
+    cap: usize,
+    pub(crate) xs: VecDeque<Vec<f64>>,
+    pub(crate) gs: VecDeque<Vec<f64>>,
+}
+
+pub(crate) fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(u, v)| (u - v) * (u - v)).sum::<f64>().sqrt()
+}
+
+impl GradBundle {
+    pub(crate) fn new(cap: usize, x: &[f64], g: &[f64]) -> Self {
+        let mut b = GradBundle { cap: cap.max(1), xs: VecDeque::new(), gs: VecDeque::new() };
+        b.reset(x, g);
+        b
+    }
+
+    /// Forget everything but (x, g).
+    pub(crate) fn reset(&mut self, x: &[f64], g: &[f64]) {
+        self.xs.clear();
+        self.gs.clear();
+        self.xs.push_front(x.to_vec());
+        self.gs.push_front(g.to_vec());
+    }
+
+    /// Prepend (x, g), dropping the oldest beyond the capacity.
+    pub(crate) fn push(&mut self, x: &[f64], g: &[f64]) {
+        self.xs.push_front(x.to_vec());
+        self.gs.push_front(g.to_vec());
+        while self.xs.len() > self.cap {
+            self.xs.pop_back();
+            self.gs.pop_back();
+        }
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.gs.len()
+    }
+
+    /// The min-norm element of the hull of the gradients.
+    pub(crate) fn min_norm(&self) -> MinNormResult {
+        let cols: Vec<&[f64]> = self.gs.iter().map(|g| g.as_slice()).collect();
+        min_norm_in_hull(&cols)
+    }
+
+    /// maxⱼ ‖x − Xⱼ‖.
+    pub(crate) fn evaldist(&self, x: &[f64]) -> f64 {
+        self.xs.iter().map(|xj| dist(x, xj)).fold(0.0, f64::max)
+    }
+}
+
+/// The certificate at (x, ∇f(x)) from gradients `gs` taken at `xs` (HANSO `postprocess`):
+/// if x is not one of the points, (x, ∇f(x)) is added first. Returns (dnorm, evaldist).
+pub(crate) fn certificate_at(x: &[f64], g: &[f64], xs: &[Vec<f64>], gs: &[Vec<f64>]) -> (f64, f64) {
+    let mut cols: Vec<&[f64]> = gs.iter().map(|v| v.as_slice()).collect();
+    if !xs.iter().any(|xj| xj.as_slice() == x) {
+        cols.insert(0, g);
+    }
+    let ed = xs.iter().map(|xj| dist(x, xj)).fold(0.0, f64::max);
+    (min_norm_in_hull(&cols).dnorm, ed)
+}

@@ -1,0 +1,90 @@
+//! The function to minimise: x ∈ ℝⁿ ↦ (f(x), ∇f(x)), f locally Lipschitz and differentiable
+//! almost everywhere, possibly +∞ outside its domain.
+
+use super::control::RunControl;
+use super::termination::Termination;
+
+/// A function to minimise together with its gradient.
+pub trait Objective {
+    /// Number of variables n.
+    fn nvar(&self) -> usize;
+    /// f(x), writing ∇f(x) into `g` (len nvar). Outside the domain return f = +∞ (g: anything,
+    /// e.g. NaN). NaN f is treated like +∞ by the line search.
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64;
+}
+
+/// Adapts a closure `FnMut(x, g) -> f` with a fixed dimension into an [`Objective`].
+pub struct FnObjective<F> {
+    nvar: usize,
+    f: F,
+}
+
+impl<F: FnMut(&[f64], &mut [f64]) -> f64> FnObjective<F> {
+    /// Wrap `f` as an objective in `nvar` variables.
+    pub fn new(nvar: usize, f: F) -> Self {
+        FnObjective { nvar, f }
+    }
+}
+
+impl<F: FnMut(&[f64], &mut [f64]) -> f64> Objective for FnObjective<F> {
+    fn nvar(&self) -> usize {
+        self.nvar
+    }
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        (self.f)(x, g)
+    }
+}
+
+/// True if f and every gradient entry are finite: the point lies in the domain and its
+/// gradient can be used. Everything else is treated as "outside" (Armijo failure).
+pub(crate) fn usable(f: f64, g: &[f64]) -> bool {
+    f.is_finite() && g.iter().all(|v| v.is_finite())
+}
+
+/// The objective as the solvers see it: counts evaluations and knows the budget, so that every
+/// loop can stop between two evaluations.
+pub(crate) struct Evaluator<'a> {
+    obj: &'a mut dyn Objective,
+    pub(crate) ctl: &'a RunControl,
+    /// Evaluations made through this evaluator.
+    pub(crate) evals: usize,
+    /// Evaluations made before this evaluator (by earlier solver runs of the same call), only
+    /// for reporting.
+    pub(crate) evals_offset: usize,
+}
+
+impl<'a> Evaluator<'a> {
+    pub(crate) fn new(obj: &'a mut dyn Objective, ctl: &'a RunControl, evals_offset: usize) -> Self {
+        Evaluator { obj, ctl, evals: 0, evals_offset }
+    }
+
+    /// Evaluate without any budget check (used for the starting point).
+    pub(crate) fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        self.evals += 1;
+        self.obj.eval(x, g)
+    }
+
+    /// `Some(reason)` if the run must stop before the next evaluation.
+    pub(crate) fn must_stop(&self) -> Option<Termination> {
+        if self.ctl.cancelled() {
+            Some(Termination::Interrupted)
+        } else if self.ctl.cpu_exhausted() {
+            Some(Termination::CpuBudget)
+        } else {
+            None
+        }
+    }
+
+    /// Evaluate unless the budget is spent or the run cancelled.
+    pub(crate) fn eval_checked(&mut self, x: &[f64], g: &mut [f64]) -> Result<f64, Termination> {
+        if let Some(t) = self.must_stop() {
+            return Err(t);
+        }
+        Ok(self.eval(x, g))
+    }
+
+    /// Total for the observer.
+    pub(crate) fn evals_total(&self) -> usize {
+        self.evals_offset + self.evals
+    }
+}

@@ -1,0 +1,188 @@
+//! Seeded end-to-end checks of `design::run` on the shipped plants (plants/ is part of the crate,
+//! not ../shared). Each run takes well under a second in the test profile.
+
+use std::ops::ControlFlow;
+
+use hinfix::design::{
+    controller_to_x, run, DesignError, DesignIterRecord, DesignObserver, DesignOptions, DesignStatus, NoDesignObserver,
+    ObjectiveKind, Phase,
+};
+use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
+
+fn plant(name: &str) -> Plant {
+    Plant::load(format!("{}/plants/{name}.json", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+fn controller(o: &hinfix::design::DesignOutcome) -> Controller {
+    Controller::from_json_value(&o.controller).unwrap()
+}
+
+/// The outcome's figures agree with an independent recomputation from its controller.
+fn check_recomputed(p: &Plant, o: &hinfix::design::DesignOutcome) {
+    let k = controller(o);
+    let cl = closed_loop(p, &k).unwrap();
+    let a = spectral_abscissa(cl.a.as_ref());
+    assert_eq!(a, o.alpha_cl);
+    assert!(a < 0.0);
+    assert_eq!(hinf_norm(&cl, DEFAULT_HINF_TOL).value, o.gamma);
+    if let Some(ak) = o.alpha_k {
+        assert!(ak < 0.0, "controller must be stable, α(Ak) = {ak}");
+    }
+}
+
+#[test]
+fn rea2_order1_reaches_the_published_gamma() {
+    let p = plant("REA2");
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, cpumax: 30.0, ..Default::default() };
+    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    assert_eq!(o.status, DesignStatus::Optimised);
+    assert!(o.gamma <= 1.134 * 1.01, "γ = {}", o.gamma);
+    check_recomputed(&p, &o);
+    assert!(o.objective >= o.gamma && o.objective >= opts.eps * o.k_hinf);
+}
+
+#[test]
+fn he1_order1_reaches_the_published_gamma() {
+    let p = plant("HE1");
+    let opts = DesignOptions { order: 1, eps: 1e-4, seed: 1, cpumax: 30.0, ..Default::default() };
+    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    assert_eq!(o.status, DesignStatus::Optimised);
+    assert!(o.gamma <= 0.1235 * 1.01, "γ = {}", o.gamma);
+    check_recomputed(&p, &o);
+    let cpu: f64 = o.phases.iter().map(|s| s.cpu_s).sum();
+    assert!(cpu <= o.cpu_s + 1e-9);
+    assert_eq!(o.evals, o.phases.iter().map(|s| s.evals).sum::<usize>());
+}
+
+/// A plant with an unstable mode (λ = 1) that u cannot reach: no controller stabilises it.
+fn non_stabilisable() -> Plant {
+    let text = r#"{
+        "name": "uncontrollable-unstable",
+        "dims": {"n": 2, "m1": 1, "m2": 1, "p1": 1, "p2": 1},
+        "A": [[1.0, 0.0], [0.0, -1.0]],
+        "B1": [[1.0], [1.0]], "B2": [[0.0], [1.0]],
+        "C1": [[1.0, 1.0]], "C2": [[1.0, 1.0]],
+        "D11": [[0.0]], "D12": [[1.0]], "D21": [[1.0]], "D22": [[0.0]]
+    }"#;
+    Plant::from_json_str(text, "<inline>").unwrap()
+}
+
+#[test]
+fn non_stabilisable_plant_is_an_outcome_not_an_error() {
+    let p = non_stabilisable();
+    for objective in [ObjectiveKind::Strong, ObjectiveKind::Plain] {
+        let opts = DesignOptions { order: 1, seed: 3, cpumax: 20.0, objective, maxit: 200, gradsamp_maxit: 50, ..Default::default() };
+        let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+        match o.status {
+            DesignStatus::NotStabilised { best_alpha } => {
+                assert!(best_alpha >= 1.0 - 1e-9, "the uncontrollable mode stays at 1: {best_alpha}")
+            }
+            other => panic!("expected NotStabilised, got {other:?}"),
+        }
+        assert_eq!(o.gamma, f64::INFINITY);
+        assert!(o.alpha_cl >= 1.0 - 1e-9);
+        assert_eq!(o.phases.len(), 1);
+        assert_eq!(o.phases[0].phase, Phase::Stabilisation);
+    }
+}
+
+#[test]
+fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
+    let p = plant("HE1");
+    let base = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: 30.0, ..Default::default() };
+    let o1 = run(&p, &base, None, &mut NoDesignObserver).unwrap();
+    let k1 = controller(&o1);
+    let opts2 = DesignOptions { order: 2, cpumax: 10.0, nrand: 2, ..base.clone() };
+    let o2 = run(&p, &opts2, Some(&k1), &mut NoDesignObserver).unwrap();
+    assert_eq!(controller(&o2).order(), 2);
+    assert!(o2.objective <= o1.objective * (1.0 + 1e-9), "{} > {}", o2.objective, o1.objective);
+    check_recomputed(&p, &o2);
+    // With no budget at all beyond the first evaluation the padded start itself comes back
+    // unchanged in value: padding keeps ‖Tzw‖∞ and ‖K‖∞.
+    let opts_same = DesignOptions { order: 1, cpumax: 10.0, ..base };
+    let o_same = run(&p, &opts_same, Some(&k1), &mut NoDesignObserver).unwrap();
+    assert!(o_same.objective <= o1.objective * (1.0 + 1e-9));
+}
+
+#[test]
+fn same_seed_gives_the_same_controller_bits() {
+    let p = plant("REA2");
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: f64::INFINITY, ..Default::default() };
+    let a = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let b = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let bits = |o: &hinfix::design::DesignOutcome| controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.evals, b.evals);
+    let c = run(&p, &DesignOptions { seed: 3, ..opts }, None, &mut NoDesignObserver).unwrap();
+    assert_ne!(bits(&a), bits(&c));
+}
+
+struct StopAfter {
+    n: usize,
+    seen: Vec<DesignIterRecord>,
+}
+impl DesignObserver for StopAfter {
+    fn on_iter(&mut self, rec: &DesignIterRecord) -> ControlFlow<()> {
+        self.seen.push(rec.clone());
+        if self.seen.len() >= self.n {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+#[test]
+fn observer_sees_components_and_break_interrupts() {
+    let p = plant("REA2");
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 0, cpumax: 30.0, ..Default::default() };
+    let mut obs = StopAfter { n: 40, seen: Vec::new() };
+    let o = run(&p, &opts, None, &mut obs).unwrap();
+    assert_eq!(o.status, DesignStatus::Interrupted);
+    assert_eq!(obs.seen.len(), 40, "no records after Break");
+    let opt: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Optimisation).collect();
+    assert!(!opt.is_empty());
+    for r in &opt {
+        assert!(r.hinf_cl.is_finite() && r.hinf_k.is_finite() && r.alpha_cl < 0.0 && r.alpha_k < 0.0, "{r:?}");
+        assert!((r.f - r.hinf_cl.max(opts.eps * r.hinf_k)).abs() <= 1e-12 * r.f, "{r:?}");
+    }
+    let stab: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Stabilisation).collect();
+    for r in &stab {
+        assert!((r.f - r.alpha_cl.max(opts.eps * r.alpha_k)).abs() <= 1e-12 * r.f.abs().max(1.0), "{r:?}");
+    }
+    assert!(obs.seen.windows(2).all(|w| w[0].evals <= w[1].evals));
+}
+
+#[test]
+fn bad_options_and_init_are_errors() {
+    let p = plant("HE1");
+    let ok = DesignOptions { order: 1, ..Default::default() };
+    let cases = [
+        (DesignOptions { eps: 0.0, ..ok.clone() }, "eps"),
+        (DesignOptions { eps: f64::NAN, ..ok.clone() }, "eps"),
+        (DesignOptions { cpumax: 0.0, ..ok.clone() }, "cpumax"),
+        (DesignOptions { nrand: 0, ..ok.clone() }, "nrand"),
+        (DesignOptions { order: 5, ..ok.clone() }, "order"),
+        (DesignOptions { hinf_tol: 0.0, ..ok.clone() }, "hinf_tol"),
+    ];
+    for (opts, field) in cases {
+        match run(&p, &opts, None, &mut NoDesignObserver) {
+            Err(DesignError::Options { field: f, .. }) => assert_eq!(f, field),
+            other => panic!("{field}: expected an options error, got {other:?}"),
+        }
+    }
+    let wrong_shape = Controller::zeros(1, 1, 1); // HE1 has m2 = 2
+    assert!(matches!(run(&p, &ok, Some(&wrong_shape), &mut NoDesignObserver), Err(DesignError::Init(_))));
+    let too_big = Controller::zeros(2, 2, 1);
+    assert!(matches!(run(&p, &ok, Some(&too_big), &mut NoDesignObserver), Err(DesignError::Init(_))));
+}
+
+#[test]
+fn tiny_budget_is_honoured() {
+    let p = plant("HE1");
+    let opts = DesignOptions { order: 2, eps: 1e-3, seed: 0, cpumax: 0.05, ..Default::default() };
+    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    // one evaluation of HE1 takes well under 10 ms
+    assert!(o.cpu_s < 0.05 + 0.1, "cpu {}", o.cpu_s);
+    assert!(matches!(o.status, DesignStatus::BudgetExhausted | DesignStatus::NotStabilised { .. }), "{:?}", o.status);
+}
