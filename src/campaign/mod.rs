@@ -5,6 +5,8 @@
 //! emits [`CampaignEvent`]s without printing or writing anything; the journal, the trace writer,
 //! the progress reporter and the report writers each consume what they need.
 pub mod jobs;
+pub mod record;
+pub mod scheduler;
 mod reference;
 pub mod spec;
 

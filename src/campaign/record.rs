@@ -1,0 +1,221 @@
+//! One finished job as the journal stores it (one JSON line of `runs.jsonl`), and the final
+//! message of its trace.
+
+use serde::{Deserialize, Serialize};
+
+use super::jobs::{Job, JobId, RunnerTag};
+use crate::design::{serde_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats};
+
+/// Version of the journal line format. Readers refuse newer versions.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// How a journaled job ended. (`Interrupted` runs are never journaled: resume reruns them.)
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum JobStatus {
+    /// Both phases ran; stable and stabilising controller.
+    Optimised,
+    /// Stabilised, but the optimisation phase made no progress.
+    StabilisedOnly,
+    /// No (strongly) stabilising controller found.
+    NotStabilised {
+        /// Best max(α(A_cl), ε·α(Ak)) reached.
+        #[serde(with = "serde_f64_or_string")]
+        best_alpha: f64,
+    },
+    /// The CPU budget ran out during optimisation; the best controller so far is kept.
+    BudgetExhausted,
+    /// `design::run` returned an error (or panicked): no trustworthy result.
+    Failed {
+        /// The error.
+        error: String,
+    },
+}
+
+impl JobStatus {
+    /// Short name as in the journal's `kind`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            JobStatus::Optimised => "optimised",
+            JobStatus::StabilisedOnly => "stabilised_only",
+            JobStatus::NotStabilised { .. } => "not_stabilised",
+            JobStatus::BudgetExhausted => "budget_exhausted",
+            JobStatus::Failed { .. } => "failed",
+        }
+    }
+}
+
+/// The optimality certificate of the final point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Certificate {
+    /// Norm of the min-norm element of the gradient bundle.
+    pub dnorm: f64,
+    /// Bundle radius.
+    pub evaldist: f64,
+}
+
+/// One journal line.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct JobRecord {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
+    /// The job's id.
+    pub job_id: JobId,
+    /// Campaign name.
+    pub campaign: String,
+    /// Plant name.
+    pub plant: String,
+    /// Plant content fingerprint.
+    pub plant_fingerprint: String,
+    /// Controller order.
+    pub order: usize,
+    /// Weight ε.
+    pub eps: f64,
+    /// Seed.
+    pub seed: u64,
+    /// CPU budget (s).
+    pub cpumax: f64,
+    /// Every design option (repeats order, eps, seed, cpumax).
+    pub options: DesignOptions,
+    /// Predecessor of a warm-start chain.
+    pub warm_from: Option<JobId>,
+    /// Whether the predecessor's controller was actually passed as the initial point.
+    pub warm_started: bool,
+    /// Set only by the fake runner of the test hook.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runner: Option<String>,
+    /// How it ended.
+    pub status: JobStatus,
+    /// ‖Tzw‖∞ of the returned controller (as reported by the design run).
+    #[serde(with = "serde_f64_or_string")]
+    pub gamma: f64,
+    /// ‖K‖∞.
+    #[serde(with = "serde_f64_or_string")]
+    pub k_hinf: f64,
+    /// α(A_cl).
+    #[serde(with = "serde_f64_or_string")]
+    pub alpha_cl: f64,
+    /// α(Ak) (None for order 0 or failed jobs).
+    pub alpha_k: Option<f64>,
+    /// Final objective value.
+    #[serde(with = "serde_f64_or_string")]
+    pub objective: f64,
+    /// Certificate of the final point, if the optimisation ran.
+    pub certificate: Option<Certificate>,
+    /// Total iterations.
+    pub iterations: usize,
+    /// Total objective evaluations.
+    pub evaluations: usize,
+    /// Per-phase counters.
+    pub phases: Vec<PhaseStats>,
+    /// CPU seconds as counted by the design run.
+    pub design_cpu_s: f64,
+    /// CPU seconds of the worker thread for the whole job.
+    pub cpu_s: f64,
+    /// Wall seconds of the whole job.
+    pub wall_s: f64,
+    /// When it finished (Unix seconds).
+    pub finished_unix_s: f64,
+    /// The controller `{AK, BK, CK, DK}` (None for failed jobs).
+    pub controller: Option<serde_json::Value>,
+}
+
+/// Keys whose values depend on timing, not on the computation.
+pub const TIMING_KEYS: &[&str] = &["design_cpu_s", "cpu_s", "wall_s", "finished_unix_s"];
+
+impl JobRecord {
+    /// The record of `job` after its run; `None` when the run was interrupted (not journaled).
+    pub fn from_run(
+        campaign: &str,
+        job: &Job,
+        warm_started: bool,
+        result: Result<DesignOutcome, String>,
+        cpu_s: f64,
+        wall_s: f64,
+    ) -> Option<JobRecord> {
+        let o = &job.options;
+        let mut r = JobRecord {
+            schema_version: SCHEMA_VERSION,
+            job_id: job.id.clone(),
+            campaign: campaign.to_string(),
+            plant: job.plant_name.clone(),
+            plant_fingerprint: job.plant_fingerprint.clone(),
+            order: o.order,
+            eps: o.eps,
+            seed: o.seed,
+            cpumax: o.cpumax,
+            options: o.clone(),
+            warm_from: job.warm_from.clone(),
+            warm_started,
+            runner: (job.runner == RunnerTag::Fake).then(|| "fake".to_string()),
+            status: JobStatus::Failed { error: String::new() },
+            gamma: f64::NAN,
+            k_hinf: f64::NAN,
+            alpha_cl: f64::NAN,
+            alpha_k: None,
+            objective: f64::NAN,
+            certificate: None,
+            iterations: 0,
+            evaluations: 0,
+            phases: Vec::new(),
+            design_cpu_s: 0.0,
+            cpu_s,
+            wall_s,
+            finished_unix_s: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0.0, |d| d.as_secs_f64()),
+            controller: None,
+        };
+        match result {
+            Err(error) => r.status = JobStatus::Failed { error },
+            Ok(out) => {
+                r.status = match out.status {
+                    DesignStatus::Interrupted => return None,
+                    DesignStatus::Optimised => JobStatus::Optimised,
+                    DesignStatus::StabilisedOnly => JobStatus::StabilisedOnly,
+                    DesignStatus::NotStabilised { best_alpha } => JobStatus::NotStabilised { best_alpha },
+                    DesignStatus::BudgetExhausted => JobStatus::BudgetExhausted,
+                };
+                r.gamma = out.gamma;
+                r.k_hinf = out.k_hinf;
+                r.alpha_cl = out.alpha_cl;
+                r.alpha_k = out.alpha_k;
+                r.objective = out.objective;
+                r.certificate = match (out.dnorm, out.evaldist) {
+                    (Some(dnorm), Some(evaldist)) => Some(Certificate { dnorm, evaldist }),
+                    _ => None,
+                };
+                r.iterations = out.iters;
+                r.evaluations = out.evals;
+                r.phases = out.phases;
+                r.design_cpu_s = out.cpu_s;
+                r.controller = Some(out.controller);
+            }
+        }
+        Some(r)
+    }
+
+    /// The record as JSON without the timing fields (also inside `phases`): two runs of the same
+    /// job on the same machine must agree on this exactly.
+    pub fn comparable(&self) -> serde_json::Value {
+        let mut v = serde_json::to_value(self).expect("record serialises");
+        if let Some(obj) = v.as_object_mut() {
+            for k in TIMING_KEYS {
+                obj.remove(*k);
+            }
+            if let Some(serde_json::Value::Array(phases)) = obj.get_mut("phases") {
+                for p in phases {
+                    if let Some(p) = p.as_object_mut() {
+                        p.remove("cpu_s");
+                    }
+                }
+            }
+        }
+        v
+    }
+
+    /// Whether the job failed (no trustworthy result).
+    pub fn failed(&self) -> bool {
+        matches!(self.status, JobStatus::Failed { .. })
+    }
+}
