@@ -2,14 +2,26 @@
 //! reports — plus the paper's reference numbers they are compared with.
 //!
 //! The pieces are separate, nextest style (style.md §4): [`scheduler::execute`] runs jobs and
-//! emits [`CampaignEvent`]s without printing or writing anything; the journal, the trace writer,
-//! the progress reporter and the report writers each consume what they need.
+//! emits [`scheduler::CampaignEvent`]s without printing or writing anything; the journal
+//! ([`run`]), the trace writer ([`trace`]), the progress reporter ([`progress`]) and the report
+//! writers ([`report`]) each consume what they need.
+pub mod fake;
 pub mod jobs;
+pub mod journal;
+pub mod latex;
+pub mod progress;
 pub mod record;
-pub mod scheduler;
+pub mod reduce;
 mod reference;
+pub mod report;
+pub mod run;
+pub mod scheduler;
 pub mod spec;
+pub mod trace;
 
 pub use jobs::{expand, job_id, Job, JobId, RunnerTag};
+pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
 pub use reference::{load_default_reference, load_reference, RefMethod, ReferenceError, ReferenceRow, REFERENCE_CSV};
+pub use report::{write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary};
 pub use spec::{Campaign, Location, Problem, SpecError, DEFAULT_THREADS};
+pub use trace::{summarise, trace_observers, TraceError, TraceSummary, TraceWriter};

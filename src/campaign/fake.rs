@@ -1,0 +1,119 @@
+//! A deterministic stand-in for `design::run`, for testing the campaign machinery (scheduling,
+//! journal, resume after kill -9) quickly. The command line selects it only through the hidden
+//! environment variable [`FAKE_RUNNER_ENV`]; jobs made for it carry [`RunnerTag::Fake`] in their
+//! id and `"runner": "fake"` in their record, so its results can never pass for real ones.
+//!
+//! A fake job takes [`FAKE_ITERS`] "iterations", sleeping `pause` between them and reporting each
+//! to the observer (so cancellation works exactly as with the real runner), and returns figures
+//! that are a pure function of the job id and the initial controller: the same job gives the same
+//! record, and a warm-started job depends on its predecessor's controller.
+
+use std::ops::ControlFlow;
+use std::time::Duration;
+
+use sha2::{Digest, Sha256};
+
+use super::jobs::{Job, RunnerTag};
+use super::scheduler::JobRunner;
+use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats};
+use crate::lti::Controller;
+
+/// The hidden variable that selects the fake runner; its value is the pause between fake
+/// iterations in milliseconds (empty or unparsable: [`DEFAULT_PAUSE_MS`]).
+pub const FAKE_RUNNER_ENV: &str = "HINFIX_FAKE_RUNNER";
+/// Default pause between fake iterations (ms).
+pub const DEFAULT_PAUSE_MS: u64 = 20;
+/// Iterations of one fake job.
+pub const FAKE_ITERS: usize = 10;
+
+/// The fake runner.
+#[derive(Debug, Clone)]
+pub struct FakeRunner {
+    /// Pause between iterations.
+    pub pause: Duration,
+}
+
+impl FakeRunner {
+    /// The runner the environment asks for, if [`FAKE_RUNNER_ENV`] is set.
+    pub fn from_env() -> Option<FakeRunner> {
+        let v = std::env::var(FAKE_RUNNER_ENV).ok()?;
+        let ms = v.trim().parse().unwrap_or(DEFAULT_PAUSE_MS);
+        Some(FakeRunner { pause: Duration::from_millis(ms) })
+    }
+
+    /// The runner tag for job expansion.
+    pub fn tag(&self) -> RunnerTag {
+        RunnerTag::Fake
+    }
+}
+
+/// A number in [0, 1) from the hash of `parts`.
+fn unit(parts: &[&[u8]]) -> f64 {
+    let mut h = Sha256::new();
+    for p in parts {
+        h.update((p.len() as u64).to_le_bytes());
+        h.update(p);
+    }
+    let d = h.finalize();
+    let mut b = [0u8; 8];
+    b.copy_from_slice(&d[..8]);
+    (u64::from_le_bytes(b) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+impl JobRunner for FakeRunner {
+    fn run(&self, job: &Job, init: Option<&Controller>, obs: &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> {
+        let init_text = init.map(|k| k.to_json().to_string()).unwrap_or_default();
+        let seed = unit(&[job.id.0.as_bytes(), init_text.as_bytes()]);
+        // warm starts improve on the predecessor, as a real chain tends to
+        let base = init.map_or(10.0, |_| 5.0);
+        let gamma = base * (1.0 + seed) / (1.0 + job.options.order as f64);
+        let d = &job.plant.dims;
+        let mut k = Controller::zeros(job.options.order, d.m2, d.p2);
+        if d.m2 > 0 && d.p2 > 0 {
+            k.dk[(0, 0)] = -seed;
+        }
+        for i in 0..job.options.order {
+            k.ak[(i, i)] = -1.0 - seed - i as f64;
+        }
+        let mut status = DesignStatus::Optimised;
+        let mut iters = 0;
+        for iter in 0..FAKE_ITERS {
+            std::thread::sleep(self.pause);
+            iters += 1;
+            let f = gamma * (1.0 + (FAKE_ITERS - 1 - iter) as f64 / FAKE_ITERS as f64);
+            let rec = DesignIterRecord {
+                phase: Phase::Optimisation,
+                start: 0,
+                iter,
+                f,
+                hinf_cl: f,
+                hinf_k: 1.0,
+                alpha_cl: -1.0,
+                alpha_k: -1.0,
+                dnorm: 1.0 / (1.0 + iter as f64),
+                step: 1.0,
+                evals: iter + 1,
+                cpu_s: 0.0,
+            };
+            if obs.on_iter(&rec) == ControlFlow::Break(()) {
+                status = DesignStatus::Interrupted;
+                break;
+            }
+        }
+        Ok(DesignOutcome {
+            status,
+            controller: k.to_json(),
+            gamma,
+            k_hinf: 1.0 + seed,
+            alpha_cl: -1.0,
+            alpha_k: (job.options.order > 0).then_some(-1.0),
+            objective: gamma,
+            dnorm: Some(1e-4),
+            evaldist: Some(job.options.evaldist),
+            phases: vec![PhaseStats { phase: Phase::Optimisation, iters, evals: iters, cpu_s: 0.0 }],
+            iters,
+            evals: iters,
+            cpu_s: 0.0,
+        })
+    }
+}

@@ -1,0 +1,212 @@
+//! The campaign's report files, written atomically (tmp in the same directory, fsync, rename):
+//! `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`. Pure functions of journal records,
+//! the plants and the paper's reference rows, so `campaign report` reruns without jobs.
+//!
+//! Full-order bound: computed with `lti::full_order_gamma` for plants with n ≤
+//! [`FULL_ORDER_MAX_N`]; above that (minutes of CPU, or failure, e.g. AC10) the paper's
+//! full-order value is used and marked `from_paper`.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use super::latex;
+use super::record::JobRecord;
+use super::reduce::{best_per_order, BestRow, PlantMap};
+use super::reference::{RefMethod, ReferenceRow};
+use crate::lti::full_order_gamma;
+
+/// Largest plant order for which the full-order bound is computed here.
+pub const FULL_ORDER_MAX_N: usize = 60;
+
+/// Errors writing the report, naming the file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReportError {
+    /// I/O on a file.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// CSV serialisation.
+    #[error("{}: {source}", path.display())]
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: csv::Error,
+    },
+}
+
+/// The full-order bound of one plant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FullOrderRow {
+    /// Plant.
+    pub plant: String,
+    /// γ_opt (NaN if unavailable).
+    pub gamma: f64,
+    /// True if taken from the paper rather than computed.
+    pub from_paper: bool,
+}
+
+/// One row of `compare.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareRow {
+    /// Plant.
+    pub plant: String,
+    /// n_K.
+    pub order: usize,
+    /// Our best re-verified γ.
+    pub ours: f64,
+    /// The paper's HIFOO γ (NaN if none).
+    pub paper: f64,
+    /// Literature rows (source, γ).
+    pub literature: Vec<(String, f64)>,
+    /// Full-order bound.
+    pub full_order: f64,
+    /// ours / paper.
+    pub ratio: f64,
+}
+
+/// What was written, with a compact compare table as Display.
+#[derive(Debug, Clone)]
+pub struct ReportSummary {
+    /// Files written.
+    pub files: Vec<PathBuf>,
+    /// Best rows.
+    pub best: Vec<BestRow>,
+    /// Compare rows.
+    pub compare: Vec<CompareRow>,
+}
+
+impl fmt::Display for ReportSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}", "plant", "nK", "ours", "paper", "ratio", "verified")?;
+        for r in &self.compare {
+            let b = self.best.iter().find(|b| b.plant == r.plant && b.order == r.order);
+            let v = b.map(|b| format!("{}/{}", b.verified, b.runs)).unwrap_or_default();
+            writeln!(f, "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}", r.plant, r.order, latex::num(r.ours), latex::num(r.paper), latex::num(r.ratio), v)?;
+        }
+        Ok(())
+    }
+}
+
+/// Full-order bounds of the plants that appear in `best`.
+pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<FullOrderRow> {
+    let mut names: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
+    names.dedup();
+    names
+        .into_iter()
+        .map(|name| {
+            let paper = reference
+                .iter()
+                .find(|r| r.plant == name && r.method == RefMethod::FullOrder)
+                .map(|r| r.gamma);
+            let computed = plants
+                .get(name)
+                .filter(|p| p.dims.n <= FULL_ORDER_MAX_N)
+                .and_then(|p| full_order_gamma(p).ok())
+                .map(|g| g.gamma);
+            match computed {
+                Some(g) => FullOrderRow { plant: name.into(), gamma: g, from_paper: false },
+                None => FullOrderRow { plant: name.into(), gamma: paper.unwrap_or(f64::NAN), from_paper: paper.is_some() },
+            }
+        })
+        .collect()
+}
+
+/// Joins our best rows with the reference.
+pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[ReferenceRow]) -> Vec<CompareRow> {
+    best.iter()
+        .map(|b| {
+            let at = |m: RefMethod| reference.iter().filter(move |r| r.plant == b.plant && r.order == b.order && r.method == m);
+            let paper = at(RefMethod::Hifoo).map(|r| r.gamma).fold(f64::NAN, f64::min);
+            let literature = at(RefMethod::Literature).map(|r| (r.source.clone(), r.gamma)).collect();
+            let full_order = full.iter().find(|f| f.plant == b.plant).map_or(f64::NAN, |f| f.gamma);
+            CompareRow { plant: b.plant.clone(), order: b.order, ours: b.gamma, paper, literature, full_order, ratio: b.gamma / paper }
+        })
+        .collect()
+}
+
+/// Writes `bytes` to `path` atomically: `<path>.tmp` in the same directory, fsync, rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
+    let tmp = path.with_extension(format!("{}.tmp", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
+    let io = |source| ReportError::Io { path: path.to_path_buf(), source };
+    let mut f = std::fs::File::create(&tmp).map_err(io)?;
+    f.write_all(bytes).map_err(io)?;
+    f.sync_all().map_err(io)?;
+    drop(f);
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+fn csv_bytes<R: serde::Serialize>(path: &Path, rows: impl IntoIterator<Item = R>) -> Result<Vec<u8>, ReportError> {
+    let err = |source| ReportError::Csv { path: path.to_path_buf(), source };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r).map_err(err)?;
+    }
+    w.into_inner().map_err(|e| ReportError::Io { path: path.to_path_buf(), source: e.into_error() })
+}
+
+#[derive(serde::Serialize)]
+struct CompareCsv<'a> {
+    plant: &'a str,
+    order: usize,
+    ours: String,
+    paper: String,
+    literature: String,
+    full_order: String,
+    ratio: String,
+}
+
+fn csv_num(x: f64) -> String {
+    if x.is_finite() { format!("{x}") } else { String::new() }
+}
+
+/// Reduces `records` and writes the four report files into `out_dir` (created if needed).
+/// `plants` maps the journal's plant names to the plants (as `Job::plant` holds them).
+pub fn write_reports(
+    out_dir: &Path,
+    records: &[JobRecord],
+    plants: &BTreeMap<String, std::sync::Arc<crate::lti::Plant>>,
+    reference: &[ReferenceRow],
+) -> Result<ReportSummary, ReportError> {
+    std::fs::create_dir_all(out_dir).map_err(|source| ReportError::Io { path: out_dir.to_path_buf(), source })?;
+    let best = best_per_order(records, plants);
+    let full = full_order_rows(&best, plants, reference);
+    let compare = compare_rows(&best, &full, reference);
+    let mut files = Vec::new();
+
+    let p = out_dir.join("best.csv");
+    write_atomic(&p, &csv_bytes(&p, &best)?)?;
+    files.push(p);
+
+    let p = out_dir.join("tables.tex");
+    write_atomic(&p, latex::tables_tex(&best, &full).as_bytes())?;
+    files.push(p);
+
+    let p = out_dir.join("compare.csv");
+    let rows = compare.iter().map(|r| CompareCsv {
+        plant: &r.plant,
+        order: r.order,
+        ours: csv_num(r.ours),
+        paper: csv_num(r.paper),
+        literature: r.literature.iter().map(|(s, g)| format!("{s}={g}")).collect::<Vec<_>>().join("; "),
+        full_order: csv_num(r.full_order),
+        ratio: csv_num(r.ratio),
+    });
+    write_atomic(&p, &csv_bytes(&p, rows)?)?;
+    files.push(p);
+
+    let p = out_dir.join("compare.tex");
+    write_atomic(&p, latex::compare_tex(&compare).as_bytes())?;
+    files.push(p);
+
+    Ok(ReportSummary { files, best, compare })
+}

@@ -1,0 +1,414 @@
+//! Per-job optimiser traces in MCAP (Foxglove-readable): `traces/<job_id>.mcap`.
+//!
+//! Two channels, both with message encoding `json` and a JSON Schema (schema encoding
+//! `jsonschema`):
+//! * [`ITER_TOPIC`] — one message per optimiser iteration ([`IterMessage`]: phase, start,
+//!   iteration, f, ‖Tzw‖∞, ‖K‖∞, α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds);
+//! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled.
+//!
+//! Non-finite numbers are written as the strings `"inf"`, `"-inf"` or `"nan"` (JSON has no
+//! such numbers); the schema allows number or string for every float.
+//!
+//! The writer ([`TraceWriter`], a [`JobObserver`]) writes `<job_id>.mcap.tmp`, flushes every
+//! [`FLUSH_EVERY`] iterations or [`FLUSH_INTERVAL`], and on `finish` renames it atomically to
+//! `<job_id>.mcap`; `abandon` deletes the tmp file, so a cut-off run never leaves a
+//! complete-looking trace. An I/O error is kept and stops the job's tracing (never the job).
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::fs::File;
+use std::io::BufWriter;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use serde_json::{json, Value};
+
+use super::jobs::Job;
+use super::record::JobRecord;
+use super::scheduler::JobObserver;
+use crate::design::{DesignIterRecord, Phase};
+
+/// Topic of the per-iteration channel.
+pub const ITER_TOPIC: &str = "/hinfix/iterations";
+/// Topic of the final-result channel.
+pub const RESULT_TOPIC: &str = "/hinfix/result";
+/// Flush after this many iterations …
+pub const FLUSH_EVERY: usize = 50;
+/// … or after this much wall time, whichever comes first.
+pub const FLUSH_INTERVAL: Duration = Duration::from_secs(1);
+
+/// Errors of the trace writer and reader, naming the file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TraceError {
+    /// Reading or writing the file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The MCAP layer failed (bad or truncated file).
+    #[error("{}: MCAP: {source}", path.display())]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: mcap::McapError,
+    },
+    /// A message is not the JSON this module writes.
+    #[error("{}: message {index} on {topic}: {source}", path.display())]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// Topic of the message.
+        topic: String,
+        /// Index of the message in the file.
+        index: usize,
+        /// The cause.
+        #[source]
+        source: serde_json::Error,
+    },
+}
+
+/// A float as JSON: finite → number, otherwise `"inf"`, `"-inf"`, `"nan"`.
+pub fn json_f64(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else if x.is_nan() {
+        json!("nan")
+    } else if x > 0.0 {
+        json!("inf")
+    } else {
+        json!("-inf")
+    }
+}
+
+/// Reads a float written by [`json_f64`] (or null → NaN).
+pub fn f64_from_json(v: &Value) -> f64 {
+    match v {
+        Value::Number(n) => n.as_f64().unwrap_or(f64::NAN),
+        Value::String(s) => match s.as_str() {
+            "inf" => f64::INFINITY,
+            "-inf" => f64::NEG_INFINITY,
+            _ => f64::NAN,
+        },
+        _ => f64::NAN,
+    }
+}
+
+fn phase_name(p: Phase) -> String {
+    match serde_json::to_value(p) {
+        Ok(Value::String(s)) => s,
+        _ => format!("{p:?}"),
+    }
+}
+
+/// One iteration as written on [`ITER_TOPIC`].
+pub fn iter_message(rec: &DesignIterRecord) -> Value {
+    json!({
+        "phase": phase_name(rec.phase),
+        "start": rec.start,
+        "iteration": rec.iter,
+        "f": json_f64(rec.f),
+        "hinf_cl": json_f64(rec.hinf_cl),
+        "hinf_k": json_f64(rec.hinf_k),
+        "alpha_cl": json_f64(rec.alpha_cl),
+        "alpha_k": json_f64(rec.alpha_k),
+        "dnorm": json_f64(rec.dnorm),
+        "step": json_f64(rec.step),
+        "evaluations": rec.evals,
+        "elapsed_cpu_s": json_f64(rec.cpu_s),
+    })
+}
+
+/// JSON Schema of an [`ITER_TOPIC`] message.
+pub fn iter_schema() -> Value {
+    let float = json!({"type": ["number", "string", "null"], "description": "finite number, or \"inf\"/\"-inf\"/\"nan\""});
+    json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "hinfix.Iteration",
+        "type": "object",
+        "properties": {
+            "phase": {"type": "string"},
+            "start": {"type": "integer"},
+            "iteration": {"type": "integer"},
+            "f": float, "hinf_cl": float, "hinf_k": float, "alpha_cl": float, "alpha_k": float,
+            "dnorm": float, "step": float,
+            "evaluations": {"type": "integer"},
+            "elapsed_cpu_s": float,
+        },
+        "required": ["phase", "iteration", "f"],
+    })
+}
+
+/// JSON Schema of a [`RESULT_TOPIC`] message (a journal line; loosely typed).
+pub fn result_schema() -> Value {
+    json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "hinfix.JobRecord",
+        "type": "object",
+        "properties": {"job_id": {"type": "string"}, "plant": {"type": "string"}, "order": {"type": "integer"},
+                       "status": {"type": "object"}, "gamma": {"type": ["number", "string", "null"]}},
+        "required": ["job_id", "status"],
+    })
+}
+
+/// Writes one job's trace; see the module doc.
+pub struct TraceWriter {
+    writer: Option<mcap::Writer<BufWriter<File>>>,
+    tmp: PathBuf,
+    target: PathBuf,
+    iter_channel: u16,
+    result_channel: u16,
+    seq: u32,
+    since_flush: usize,
+    last_flush: Instant,
+    started: Instant,
+    error: Option<TraceError>,
+}
+
+impl TraceWriter {
+    /// Creates `<dir>/<job_id>.mcap.tmp` (and `dir`) and writes the header, schemas and channels.
+    pub fn create(dir: &Path, job_id: &str) -> Result<Self, TraceError> {
+        let target = dir.join(format!("{job_id}.mcap"));
+        let tmp = dir.join(format!("{job_id}.mcap.tmp"));
+        let io = |source| TraceError::Io { path: tmp.clone(), source };
+        std::fs::create_dir_all(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?;
+        let file = File::create(&tmp).map_err(io)?;
+        let mc = |source| TraceError::Mcap { path: tmp.clone(), source };
+        let mut w = mcap::WriteOptions::new()
+            .compression(None)
+            .profile("")
+            .library(concat!("hinfix ", env!("CARGO_PKG_VERSION")))
+            .create(BufWriter::new(file))
+            .map_err(mc)?;
+        let s_iter = w.add_schema("hinfix.Iteration", "jsonschema", iter_schema().to_string().as_bytes()).map_err(mc)?;
+        let s_res = w.add_schema("hinfix.JobRecord", "jsonschema", result_schema().to_string().as_bytes()).map_err(mc)?;
+        let meta = BTreeMap::new();
+        let iter_channel = w.add_channel(s_iter, ITER_TOPIC, "json", &meta).map_err(mc)?;
+        let result_channel = w.add_channel(s_res, RESULT_TOPIC, "json", &meta).map_err(mc)?;
+        Ok(TraceWriter {
+            writer: Some(w),
+            tmp,
+            target,
+            iter_channel,
+            result_channel,
+            seq: 0,
+            since_flush: 0,
+            last_flush: Instant::now(),
+            started: Instant::now(),
+            error: None,
+        })
+    }
+
+    /// The temporary path written while the job runs.
+    pub fn tmp_path(&self) -> &Path {
+        &self.tmp
+    }
+
+    fn write(&mut self, channel: u16, data: &Value) -> Result<(), TraceError> {
+        let Some(w) = self.writer.as_mut() else { return Ok(()) };
+        let t = self.started.elapsed().as_nanos() as u64;
+        let header = mcap::records::MessageHeader { channel_id: channel, sequence: self.seq, log_time: t, publish_time: t };
+        self.seq += 1;
+        let bytes = data.to_string();
+        w.write_to_known_channel(&header, bytes.as_bytes())
+            .map_err(|source| TraceError::Mcap { path: self.tmp.clone(), source })
+    }
+
+    fn flush_if_due(&mut self) -> Result<(), TraceError> {
+        self.since_flush += 1;
+        if self.since_flush >= FLUSH_EVERY || self.last_flush.elapsed() >= FLUSH_INTERVAL {
+            if let Some(w) = self.writer.as_mut() {
+                w.flush().map_err(|source| TraceError::Mcap { path: self.tmp.clone(), source })?;
+            }
+            self.since_flush = 0;
+            self.last_flush = Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Writes one iteration.
+    pub fn record_iter(&mut self, rec: &DesignIterRecord) -> Result<(), TraceError> {
+        self.write(self.iter_channel, &iter_message(rec))?;
+        self.flush_if_due()
+    }
+
+    /// Writes the final result, finishes the file, fsyncs it and renames it into place.
+    pub fn complete(mut self, record: &JobRecord) -> Result<PathBuf, TraceError> {
+        if let Some(e) = self.error.take() {
+            let _ = std::fs::remove_file(&self.tmp);
+            return Err(e);
+        }
+        let data = serde_json::to_value(record).map_err(|source| TraceError::Json {
+            path: self.tmp.clone(),
+            topic: RESULT_TOPIC.into(),
+            index: self.seq as usize,
+            source,
+        })?;
+        self.write(self.result_channel, &data)?;
+        let mc = |source| TraceError::Mcap { path: self.tmp.clone(), source };
+        let mut w = self.writer.take().ok_or_else(|| TraceError::Io {
+            path: self.tmp.clone(),
+            source: std::io::Error::other("trace already closed"),
+        })?;
+        w.finish().map_err(mc)?;
+        let buf = w.into_inner();
+        let io = |source| TraceError::Io { path: self.tmp.clone(), source };
+        let file = buf.into_inner().map_err(|e| io(e.into_error()))?;
+        file.sync_all().map_err(io)?;
+        std::fs::rename(&self.tmp, &self.target).map_err(|source| TraceError::Io { path: self.target.clone(), source })?;
+        Ok(self.target.clone())
+    }
+
+    /// Deletes the temporary file.
+    pub fn discard(mut self) {
+        self.writer.take();
+        let _ = std::fs::remove_file(&self.tmp);
+    }
+}
+
+impl JobObserver for TraceWriter {
+    fn on_iter(&mut self, rec: &DesignIterRecord) -> ControlFlow<()> {
+        if self.error.is_none() {
+            if let Err(e) = self.record_iter(rec) {
+                // Keep the error; stop tracing, not the job.
+                self.writer.take();
+                self.error = Some(e);
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    fn finish(self: Box<Self>, record: &JobRecord) -> Result<(), String> {
+        self.complete(record).map(|_| ()).map_err(|e| e.to_string())
+    }
+
+    fn abandon(self: Box<Self>) {
+        self.discard();
+    }
+}
+
+/// The observer factory for `scheduler::execute`: one [`TraceWriter`] per job in `traces_dir`.
+pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, String> + Sync {
+    let dir = traces_dir.to_path_buf();
+    move |job: &Job| {
+        TraceWriter::create(&dir, &job.id.0)
+            .map(|w| Box::new(w) as Box<dyn JobObserver>)
+            .map_err(|e| e.to_string())
+    }
+}
+
+/// Per-phase counts in a [`TraceSummary`].
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct PhaseSummary {
+    /// Iteration messages of this phase.
+    pub messages: usize,
+    /// First f of the phase.
+    pub first_f: f64,
+    /// Last f of the phase.
+    pub last_f: f64,
+}
+
+/// What `campaign trace FILE` prints.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct TraceSummary {
+    /// The file.
+    pub path: PathBuf,
+    /// Iteration messages.
+    pub iterations: usize,
+    /// Per phase (by name, in first-seen order).
+    pub phases: Vec<(String, PhaseSummary)>,
+    /// First f of the trace.
+    pub first_f: f64,
+    /// Last f of the trace.
+    pub last_f: f64,
+    /// Smallest finite ‖Tzw‖∞ seen at an iterate (NaN if none).
+    pub best_hinf_cl: f64,
+    /// Evaluations at the last iteration.
+    pub evaluations: usize,
+    /// Elapsed CPU seconds at the last iteration.
+    pub elapsed_cpu_s: f64,
+    /// Final status kind from the result message (`None` if the trace has none).
+    pub final_status: Option<String>,
+    /// Recorded γ of the final result.
+    pub final_gamma: Option<f64>,
+}
+
+/// Reads a trace and summarises it.
+pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
+    let bytes = std::fs::read(path).map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
+    let stream = mcap::MessageStream::new(&bytes).map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
+    let mut s = TraceSummary {
+        path: path.to_path_buf(),
+        iterations: 0,
+        phases: Vec::new(),
+        first_f: f64::NAN,
+        last_f: f64::NAN,
+        best_hinf_cl: f64::NAN,
+        evaluations: 0,
+        elapsed_cpu_s: f64::NAN,
+        final_status: None,
+        final_gamma: None,
+    };
+    for (index, msg) in stream.enumerate() {
+        let msg = msg.map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
+        let topic = msg.channel.topic.clone();
+        let v: Value = serde_json::from_slice(&msg.data).map_err(|source| TraceError::Json {
+            path: path.to_path_buf(),
+            topic: topic.clone(),
+            index,
+            source,
+        })?;
+        if topic == ITER_TOPIC {
+            let f = f64_from_json(&v["f"]);
+            if s.iterations == 0 {
+                s.first_f = f;
+            }
+            s.iterations += 1;
+            s.last_f = f;
+            let h = f64_from_json(&v["hinf_cl"]);
+            if h.is_finite() && !(h >= s.best_hinf_cl) {
+                s.best_hinf_cl = h;
+            }
+            s.evaluations = v["evaluations"].as_u64().unwrap_or(0) as usize;
+            s.elapsed_cpu_s = f64_from_json(&v["elapsed_cpu_s"]);
+            let phase = v["phase"].as_str().unwrap_or("?").to_string();
+            let idx = match s.phases.iter().position(|(p, _)| *p == phase) {
+                Some(i) => i,
+                None => {
+                    s.phases.push((phase, PhaseSummary { messages: 0, first_f: f, last_f: f }));
+                    s.phases.len() - 1
+                }
+            };
+            let ps = &mut s.phases[idx].1;
+            ps.messages += 1;
+            ps.last_f = f;
+        } else if topic == RESULT_TOPIC {
+            s.final_status = v["status"]["kind"].as_str().map(str::to_string);
+            s.final_gamma = Some(f64_from_json(&v["gamma"]));
+        }
+    }
+    Ok(s)
+}
+
+impl fmt::Display for TraceSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "trace {}", self.path.display())?;
+        writeln!(f, "  iterations {}  evaluations {}  cpu {:.2} s", self.iterations, self.evaluations, self.elapsed_cpu_s)?;
+        writeln!(f, "  f: first {:.6e}  last {:.6e}  best ‖Tzw‖∞ {:.6}", self.first_f, self.last_f, self.best_hinf_cl)?;
+        for (name, p) in &self.phases {
+            writeln!(f, "  {name:<16} {:>6} msgs  f {:.6e} → {:.6e}", p.messages, p.first_f, p.last_f)?;
+        }
+        match (&self.final_status, self.final_gamma) {
+            (Some(st), Some(g)) => writeln!(f, "  final: {st}  γ = {g:.6}"),
+            (Some(st), None) => writeln!(f, "  final: {st}"),
+            _ => writeln!(f, "  final: none (incomplete trace)"),
+        }
+    }
+}

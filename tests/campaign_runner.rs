@@ -1,0 +1,147 @@
+//! End-to-end tests of `campaign run` through the real binary: resume after `kill -9` at random
+//! moments gives exactly the journal of an uninterrupted run; a torn journal line is reported,
+//! ignored and cut off; a small real-design campaign writes its journal, traces and reports.
+//!
+//! The kill test uses the hidden fake runner (`HINFIX_FAKE_RUNNER`, see `campaign::fake`) so that
+//! it takes seconds; its jobs carry their own ids, so fake records can never pass for real ones.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::Duration;
+
+use hinfix::campaign::fake::FAKE_RUNNER_ENV;
+use hinfix::campaign::journal::read_journal;
+use hinfix::campaign::summarise;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const BIN: &str = env!("CARGO_BIN_EXE_campaign");
+
+fn scratch(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hinfix-runner-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A campaign file in `dir`: HE1 at orders 1–2 warm-started, 2 ε, `seeds` seeds.
+fn campaign_file(dir: &Path, cpumax: f64, seeds: usize) -> PathBuf {
+    let f = dir.join("c.toml");
+    std::fs::write(
+        &f,
+        format!(
+            "name = \"t\"\n[defaults]\neps = [1e-2, 1e-3]\nseeds = {seeds}\ncpumax = {cpumax}\n\n\
+             [[problem]]\nplant = \"HE1\"\norders = [1, 2]\nwarm_start = true\n"
+        ),
+    )
+    .unwrap();
+    f
+}
+
+fn command(file: &Path, results: &Path, fake: bool) -> Command {
+    let mut c = Command::new(BIN);
+    c.arg("run").arg(file).arg("--results").arg(results).arg("--no-progress");
+    c.env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"));
+    if fake {
+        c.env(FAKE_RUNNER_ENV, "15");
+    } else {
+        c.env_remove(FAKE_RUNNER_ENV);
+    }
+    c
+}
+
+fn run_to_end(file: &Path, results: &Path, fake: bool) -> Output {
+    let out = command(file, results, fake).output().unwrap();
+    assert!(out.status.success(), "campaign run failed: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// job id → record without timing fields.
+fn journal(results: &Path) -> BTreeMap<String, serde_json::Value> {
+    let read = read_journal(&results.join("t").join("runs.jsonl")).unwrap();
+    assert!(read.torn.is_none());
+    let mut m = BTreeMap::new();
+    for r in read.records {
+        assert!(m.insert(r.job_id.0.clone(), r.comparable()).is_none(), "job {} journaled twice", r.job_id.0);
+    }
+    m
+}
+
+#[test]
+fn kill_minus_nine_at_random_moments_then_resume_equals_an_uninterrupted_run() {
+    let dir = scratch("kill");
+    let file = campaign_file(&dir, 5.0, 3);
+    let whole = dir.join("whole");
+    run_to_end(&file, &whole, true);
+    let expected = journal(&whole);
+    assert_eq!(expected.len(), 12);
+
+    let killed = dir.join("killed");
+    let mut rng = ChaCha8Rng::seed_from_u64(2026);
+    for _ in 0..5 {
+        let mut child = command(&file, &killed, true).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::null()).spawn().unwrap();
+        std::thread::sleep(Duration::from_millis(rng.random_range(50..700)));
+        child.kill().unwrap(); // SIGKILL on Unix
+        child.wait().unwrap();
+    }
+    let partial = read_journal(&killed.join("t").join("runs.jsonl")).unwrap();
+    assert!(partial.records.len() < 12, "the kills should have interrupted the campaign");
+    run_to_end(&file, &killed, true);
+    assert_eq!(journal(&killed), expected);
+}
+
+#[test]
+fn torn_last_line_is_reported_ignored_and_cut_off() {
+    let dir = scratch("torn");
+    let file = campaign_file(&dir, 5.0, 1);
+    let results = dir.join("r");
+    run_to_end(&file, &results, true);
+    let path = results.join("t").join("runs.jsonl");
+    let complete = std::fs::read(&path).unwrap();
+    let lines: Vec<&[u8]> = complete.split_inclusive(|&b| b == b'\n').collect();
+    // Drop the last record and leave half of it, as a kill in mid-write would.
+    let last = lines[lines.len() - 1];
+    let mut torn: Vec<u8> = lines[..lines.len() - 1].concat();
+    torn.extend_from_slice(&last[..last.len() / 2]);
+    std::fs::write(&path, &torn).unwrap();
+    assert!(read_journal(&path).unwrap().torn.is_some());
+
+    let out = run_to_end(&file, &results, true);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("torn"), "{stderr}");
+    let read = read_journal(&path).unwrap();
+    assert!(read.torn.is_none());
+    assert_eq!(read.records.len(), lines.len());
+}
+
+#[test]
+fn real_design_campaign_writes_journal_traces_and_reports() {
+    let dir = scratch("real");
+    let file = dir.join("c.toml");
+    std::fs::write(&file, "name = \"t\"\n[defaults]\neps = [1e-2]\nseeds = 1\ncpumax = 5.0\n[[problem]]\nplant = \"REA2\"\norders = [1]\n").unwrap();
+    let results = dir.join("r");
+    let out = run_to_end(&file, &results, false);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("REA2"), "{stdout}");
+    let t = results.join("t");
+    for f in ["runs.jsonl", "best.csv", "tables.tex", "compare.csv", "compare.tex"] {
+        assert!(t.join(f).is_file(), "{f} missing");
+    }
+    let recs = read_journal(&t.join("runs.jsonl")).unwrap().records;
+    assert_eq!(recs.len(), 1);
+    assert!(recs[0].gamma <= 1.134 * 1.01, "γ = {}", recs[0].gamma);
+    let traces: Vec<_> = std::fs::read_dir(t.join("traces")).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(traces.len(), 1);
+    assert_eq!(traces[0].extension().unwrap(), "mcap");
+    let s = summarise(&traces[0]).unwrap();
+    // One message per iteration plus one for each start's initial point.
+    assert!(s.iterations >= recs[0].iterations && s.iterations <= recs[0].iterations + 16, "{} vs {}", s.iterations, recs[0].iterations);
+
+    // Bad campaign file: a clear error naming the file and the line, exit code 1, no panic.
+    std::fs::write(&file, "name = \"t\"\n[defaults]\nepz = [1e-2]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n").unwrap();
+    let out = command(&file, &results, false).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("c.toml:3:"), "{stderr}");
+}
