@@ -138,10 +138,43 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     // One message per iteration plus one for each start's initial point.
     assert!(s.iterations >= recs[0].iterations && s.iterations <= recs[0].iterations + 16, "{} vs {}", s.iterations, recs[0].iterations);
 
+    latex_compiles(&t);
+
     // Bad campaign file: a clear error naming the file and the line, exit code 1, no panic.
     std::fs::write(&file, "name = \"t\"\n[defaults]\nepz = [1e-2]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n").unwrap();
     let out = command(&file, &results, false).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("c.toml:3:"), "{stderr}");
+}
+
+/// The LaTeX tables compile with a real `pdflatex` (CI installs it from Debian's packages). Where
+/// none can be installed, `HINFIX_NO_PDFLATEX=1` downgrades this to a structural check.
+fn latex_compiles(dir: &Path) {
+    let have = Command::new("pdflatex").arg("--version").output().is_ok_and(|o| o.status.success());
+    if !have {
+        assert_eq!(
+            std::env::var("HINFIX_NO_PDFLATEX").as_deref(),
+            Ok("1"),
+            "pdflatex is not on PATH: install it (texlive-latex-base, texlive-latex-recommended) or set HINFIX_NO_PDFLATEX=1"
+        );
+        for f in ["tables.tex", "compare.tex"] {
+            let tex = std::fs::read_to_string(dir.join(f)).unwrap();
+            assert_eq!(tex.matches("\\begin{").count(), tex.matches("\\end{").count(), "{f}: unbalanced environments");
+            assert!(tex.contains("\\toprule") && tex.contains("\\bottomrule"), "{f}: not booktabs");
+        }
+        return;
+    }
+    std::fs::write(
+        dir.join("wrap.tex"),
+        "\\documentclass{article}\n\\usepackage{booktabs}\n\\begin{document}\n\\input{tables.tex}\n\\input{compare.tex}\n\\end{document}\n",
+    )
+    .unwrap();
+    let out = Command::new("pdflatex")
+        .args(["-interaction=nonstopmode", "-halt-on-error", "wrap.tex"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "pdflatex failed:\n{}", String::from_utf8_lossy(&out.stdout));
+    assert!(dir.join("wrap.pdf").is_file());
 }
