@@ -1,5 +1,5 @@
 //! The campaign file (TOML): a name, defaults, and a list of problems. The format is documented
-//! with a full example in `docs/campaign-format.md`.
+//! with a full example in `campaigns/FORMAT.md`.
 //!
 //! Every unknown key, wrong type and impossible value is a [`SpecError`] naming the file, line and
 //! column (toml 1.x gives byte spans; values that are checked after parsing are read as

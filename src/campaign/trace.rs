@@ -75,31 +75,7 @@ pub enum TraceError {
     },
 }
 
-/// A float as JSON: finite → number, otherwise `"inf"`, `"-inf"`, `"nan"`.
-pub fn json_f64(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else if x.is_nan() {
-        json!("nan")
-    } else if x > 0.0 {
-        json!("inf")
-    } else {
-        json!("-inf")
-    }
-}
-
-/// Reads a float written by [`json_f64`] (or null → NaN).
-pub fn f64_from_json(v: &Value) -> f64 {
-    match v {
-        Value::Number(n) => n.as_f64().unwrap_or(f64::NAN),
-        Value::String(s) => match s.as_str() {
-            "inf" => f64::INFINITY,
-            "-inf" => f64::NEG_INFINITY,
-            _ => f64::NAN,
-        },
-        _ => f64::NAN,
-    }
-}
+pub use crate::design::{f64_from_json, f64_to_json as json_f64};
 
 fn phase_name(p: Phase) -> String {
     match serde_json::to_value(p) {

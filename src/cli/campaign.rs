@@ -25,7 +25,7 @@ const DEFAULT_RESULTS: &str = "results";
 /// The campaign file and the results root, shared by `run`, `status` and `report`.
 #[derive(clap::Args, Debug)]
 pub struct CampaignFileArgs {
-    /// Campaign file (TOML; format in docs/campaign-format.md).
+    /// Campaign file (TOML; format in campaigns/FORMAT.md).
     pub file: PathBuf,
     /// Results root: the campaign writes into `<RESULTS>/<campaign name>/`.
     #[arg(long, value_name = "DIR", default_value = DEFAULT_RESULTS)]

@@ -70,18 +70,7 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     Ok(CheckReport { alpha_cl, alpha_k, hinf_cl: h.value, peak_freq: h.peak_freq, hinf_k: hk.value })
 }
 
-/// A float as JSON: finite → number, ±∞ / NaN → "inf" / "-inf" / "nan".
-fn num(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else if x.is_nan() {
-        json!("nan")
-    } else if x > 0.0 {
-        json!("inf")
-    } else {
-        json!("-inf")
-    }
-}
+use hinfix::design::f64_to_json as num;
 
 fn to_json(r: &CheckReport) -> Value {
     json!({

@@ -39,3 +39,21 @@ pub mod serde_f64_or_string {
         }
     }
 }
+
+/// A float as a JSON value in the same convention: finite → number, else "inf" / "-inf" / "nan".
+pub fn f64_to_json(x: f64) -> serde_json::Value {
+    serde_f64_or_string::serialize(&x, serde_json::value::Serializer).unwrap_or(serde_json::Value::Null)
+}
+
+/// Reads a float written by [`f64_to_json`] (anything else, e.g. null, reads as NaN).
+pub fn f64_from_json(v: &serde_json::Value) -> f64 {
+    match v {
+        serde_json::Value::Number(n) => n.as_f64().unwrap_or(f64::NAN),
+        serde_json::Value::String(s) => match s.as_str() {
+            "inf" => f64::INFINITY,
+            "-inf" => f64::NEG_INFINITY,
+            _ => f64::NAN,
+        },
+        _ => f64::NAN,
+    }
+}

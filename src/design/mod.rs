@@ -17,7 +17,7 @@ mod phases;
 mod run;
 pub mod starts;
 
-pub use float_serde::serde_f64_or_string;
+pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string};
 pub use objective::{Components, DesignObjective, ObjectivePhase};
 pub use options::{DesignOptions, ObjectiveKind};
 pub use outcome::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats};
