@@ -49,7 +49,7 @@ fn root() -> PathBuf {
 }
 
 fn fixtures(dir: &str) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("tests/fixtures/oracle").join(dir))
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("tests/fixtures").join(dir))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "json"))
@@ -99,8 +99,24 @@ fn system(doc: &Value) -> StateSpace {
 
 #[test]
 fn hinfnorm_cases_match_slicot() {
+    check_hinfnorm_cases("oracle/hinfnorm", 1e-9);
+}
+
+/// Further AB13DD references (scripts/gen_hinf_stress.py): many lightly damped modes over
+/// decades, a slow peak beside fast modes, bad scaling, peaks near ω = ∞ — the cases where the
+/// square-reduced Hamiltonian eigenvalues are least accurate. Their frequency responses are
+/// ill-conditioned (κ(iωI − A) up to ~1e8), so the library's Hessenberg evaluation and the test's
+/// dense one may differ by more than on the shared oracle: `attained_tol` is REL_TOL here.
+#[test]
+fn hinf_stress_cases_match_slicot() {
+    check_hinfnorm_cases("hinf-stress", REL_TOL);
+}
+
+/// Every case in `tests/fixtures/{dir}` matches to REL_TOL, with the same stability decision, and
+/// the returned frequency attains the value to `attained_tol` (dense re-evaluation).
+fn check_hinfnorm_cases(dir: &str, attained_tol: f64) {
     let mut failures = Vec::new();
-    for path in fixtures("hinfnorm") {
+    for path in fixtures(dir) {
         let doc = load(&path);
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         let sys = system(&doc);
@@ -132,7 +148,7 @@ fn hinfnorm_cases_match_slicot() {
         // the returned frequency attains the value
         if got.value.is_finite() {
             let s = sigma_direct(&sys, got.peak_freq);
-            assert!((s - got.value).abs() <= 1e-9 * got.value, "{name}: σ at peak {s} vs {}", got.value);
+            assert!((s - got.value).abs() <= attained_tol * got.value, "{name}: σ at peak {s} vs {}", got.value);
         }
         if got.value.is_finite() && got.peak_freq.is_finite() {
             eprintln!("{name:28} {kind:15} hinf {:.12e} at {:.6e} ({dt:?})", got.value, got.peak_freq);
@@ -144,7 +160,7 @@ fn hinfnorm_cases_match_slicot() {
 #[test]
 fn closed_loop_cases_match_slicot() {
     let mut failures = Vec::new();
-    for path in fixtures("closed-loop") {
+    for path in fixtures("oracle/closed-loop") {
         let doc = load(&path);
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         let plant_file = doc["plant"].as_str().unwrap();

@@ -15,6 +15,7 @@ mod plant;
 mod plant_library;
 mod riccati;
 mod spectral;
+mod square_reduced;
 mod state_space;
 
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};

@@ -1,0 +1,154 @@
+//! Benchmark of the LTI numerics (issue 3): H∞-norm time on random stable 2×2 systems of order
+//! n = 10, 50, 100, 250, 500, and objective+gradient evaluations per second of the design
+//! objective for HE1 (nK = 2) and CM4 (nK = 4). Times are thread CPU time, one thread (faer is
+//! built without its rayon feature), medians over repeated runs.
+//!
+//! Run: `cargo bench --bench lti`. Options:
+//! * `--dump DIR`: also write the random systems as JSON (`hinf_n{n}.json`, keys A, B, C, D) so
+//!   that `scripts/ab13dd_bench.py DIR` can time SLICOT's AB13DD on exactly the same data;
+//! * `--quick`: fewer repetitions;
+//! * `--only N`: just the H∞ norm at order N, 200 times (for a profiler).
+
+use std::cell::RefCell;
+use std::path::PathBuf;
+use std::rc::Rc;
+
+use faer::Mat;
+use hinfix::design::objective::ComponentCache;
+use hinfix::design::{controller_to_x, ControllerShape, DesignObjective, ObjectivePhase};
+use hinfix::lti::{hinf_norm, matrix_to_json, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL};
+use hinfix::optim::{thread_cpu_time, Objective};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+/// A random stable system: A = M − (α(M) + 0.1)·I... computed cheaply as M/√n − 1.2·I (the
+/// spectrum of M/√n lies in the unit disc up to O(n^{-1/2})), with a check that it is stable.
+fn random_stable(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut randn = |r: usize, c: usize, s: f64| {
+        Mat::from_fn(r, c, |_, _| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            s * z
+        })
+    };
+    let mut a = randn(n, n, 1.0 / (n as f64).sqrt());
+    for i in 0..n {
+        a[(i, i)] -= 1.2;
+    }
+    let sys = StateSpace::new(a, randn(n, m, 1.0), randn(p, n, 1.0), randn(p, m, 0.3)).unwrap();
+    assert!(hinf_norm(&sys, DEFAULT_HINF_TOL).value.is_finite(), "random system n={n} not stable");
+    sys
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Median thread-CPU seconds of `f` over `reps` runs.
+fn time<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, R) {
+    let mut out = None;
+    let times = (0..reps)
+        .map(|_| {
+            let t0 = thread_cpu_time();
+            out = Some(f());
+            thread_cpu_time() - t0
+        })
+        .collect();
+    (median(times), out.unwrap())
+}
+
+fn plant(name: &str) -> Plant {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("plants").join(format!("{name}.json"));
+    Plant::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Objective+gradient evaluations per second at controller `k` (performance phase, strong
+/// stabilisation, ε = 1e-3), with a small perturbation per evaluation so no cache can help.
+fn evals_per_second(name: &str, plant: &Plant, k: &Controller, seconds: f64) {
+    let shape = ControllerShape { nk: k.order(), m: k.m(), p: k.p() };
+    let cache = Rc::new(RefCell::new(ComponentCache::default()));
+    let mut obj = DesignObjective::new(plant, shape, ObjectivePhase::Performance, true, 1e-3, DEFAULT_HINF_TOL, cache);
+    let x0 = controller_to_x(k);
+    let mut g = vec![0.0; x0.len()];
+    let f0 = obj.eval(&x0, &mut g);
+    assert!(f0.is_finite(), "{name}: the bench controller does not stabilise (f = {f0})");
+    let t0 = thread_cpu_time();
+    let mut count = 0usize;
+    let mut x = x0.clone();
+    while thread_cpu_time() - t0 < seconds || count < 3 {
+        let i = count % x0.len();
+        x[i] = x0[i] * (1.0 + 1e-9 * (count + 1) as f64);
+        let f = obj.eval(&x, &mut g);
+        assert!(f.is_finite());
+        count += 1;
+    }
+    let cpu = thread_cpu_time() - t0;
+    println!(
+        "{name:<10} n={:<4} nK={:<2} f = {f0:<12.6} {:>10.1} evals/s  {:>9.3} ms/eval  ({count} evals)",
+        plant.dims.n,
+        k.order(),
+        count as f64 / cpu,
+        cpu * 1e3 / count as f64
+    );
+}
+
+/// A stable controller of order `nk` with Ck = 0, Dk = 0: the closed loop is block triangular
+/// with the poles of the (open-loop stable) plant and of Ak, so it is stable however lightly damped
+/// the plant is (CM4's α is −5.7e-6); the objective and its gradient cost the same as for any K.
+fn output_free_controller(nk: usize, m: usize, p: usize, gain: f64) -> Controller {
+    let mut k = Controller::zeros(nk, m, p);
+    for i in 0..nk {
+        k.ak[(i, i)] = -1.0 - i as f64;
+        for j in 0..p {
+            k.bk[(i, j)] = gain * ((i + 2 * j) as f64).sin();
+        }
+    }
+    k
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let dump = args.iter().position(|a| a == "--dump").and_then(|i| args.get(i + 1)).map(PathBuf::from);
+    let only: Option<usize> = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
+
+    println!("H∞ norm, random stable systems, 2 inputs, 2 outputs, tol {DEFAULT_HINF_TOL:e}, thread CPU time (median)");
+    println!("{:>5} {:>12} {:>14} {:>12} {:>5} {:>12}", "n", "seconds", "‖G‖∞", "peak ω", "reps", "eig(A) s");
+    for &n in [10usize, 50, 100, 250, 500].iter().filter(|&&n| only.is_none_or(|o| o == n)) {
+        let sys = random_stable(n, 2, 2, n as u64);
+        if let Some(dir) = &dump {
+            std::fs::create_dir_all(dir).unwrap();
+            let doc = serde_json::json!({
+                "A": matrix_to_json(sys.a.as_ref()), "B": matrix_to_json(sys.b.as_ref()),
+                "C": matrix_to_json(sys.c.as_ref()), "D": matrix_to_json(sys.d.as_ref()),
+            });
+            std::fs::write(dir.join(format!("hinf_n{n}.json")), doc.to_string()).unwrap();
+        }
+        let reps = match (n, quick) {
+            _ if only.is_some() => 200,
+            (_, true) => 3,
+            (0..=100, _) => 21,
+            (101..=250, _) => 9,
+            _ => 5,
+        };
+        let (t, h) = time(reps, || hinf_norm(&sys, DEFAULT_HINF_TOL));
+        let (t_poles, _) = time(reps, || spectral_abscissa(sys.a.as_ref()));
+        println!("{n:>5} {t:>12.6} {:>14.10} {:>12.6} {reps:>5} {t_poles:>12.6}", h.value, h.peak_freq);
+    }
+
+    if only.is_some() {
+        return;
+    }
+    println!();
+    println!("Design objective max(‖Tzw‖∞, ε‖K‖∞) + gradient (ε = 1e-3, strong), thread CPU time");
+    let secs = if quick { 1.0 } else { 5.0 };
+    let he1 = plant("HE1");
+    let k = Controller::load(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/fixtures/HE1_nk2.json"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    evals_per_second("HE1", &he1, &k, secs);
+    let cm4 = plant("CM4");
+    let d = cm4.dims;
+    evals_per_second("CM4", &cm4, &output_free_controller(4, d.m2, d.p2, 1e-2), secs);
+}
