@@ -1,10 +1,10 @@
-//! Benchmark of the LTI numerics (issue 3): H∞-norm time on random stable 2×2 systems of order
-//! n = 10, 50, 100, 250, 500, and objective+gradient evaluations per second of the design
+//! Benchmark of the LTI numerics (issue 3): H∞-norm time on 2×2 systems of order
+//! n = 10, 50, 100, 250, 500 (random stable, and lightly damped modal), and objective+gradient evaluations per second of the design
 //! objective for HE1 (nK = 2) and CM4 (nK = 4). Times are thread CPU time, one thread (faer is
 //! built without its rayon feature), medians over repeated runs.
 //!
 //! Run: `cargo bench --bench lti`. Options:
-//! * `--dump DIR`: also write the random systems as JSON (`hinf_n{n}.json`, keys A, B, C, D) so
+//! * `--dump DIR`: also write the random systems as JSON (`random_n{n}.json`, `damped_n{n}.json`, keys A, B, C, D) so
 //!   that `scripts/ab13dd_bench.py DIR` can time SLICOT's AB13DD on exactly the same data;
 //! * `--quick`: fewer repetitions;
 //! * `--only N`: just the H∞ norm at order N, 200 times (for a profiler).
@@ -39,6 +39,35 @@ fn random_stable(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
     let sys = StateSpace::new(a, randn(n, m, 1.0), randn(p, n, 1.0), randn(p, m, 0.3)).unwrap();
     assert!(hinf_norm(&sys, DEFAULT_HINF_TOL).value.is_finite(), "random system n={n} not stable");
     sys
+}
+
+/// A lightly damped modal system: n/2 modes with natural frequencies log-spaced over
+/// [0.1, 100] rad/s and damping ratios log-spaced over [1e-3, 1e-1], behind a random orthogonal
+/// similarity (so A is full, not block diagonal). Its peak is sharp, and the level set usually
+/// needs several Hamiltonian eigenproblems.
+fn lightly_damped(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut randn = |r: usize, c: usize| {
+        Mat::from_fn(r, c, |_, _| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            z
+        })
+    };
+    let k = n / 2;
+    let mut blocks = Mat::<f64>::zeros(n, n);
+    for i in 0..k {
+        let t = if k > 1 { i as f64 / (k - 1) as f64 } else { 0.5 };
+        let w = 10f64.powf(-1.0 + 3.0 * t);
+        let z = 10f64.powf(-3.0 + 2.0 * ((7 * i) % k) as f64 / k.max(1) as f64);
+        let (re, im) = (-z * w, w * (1.0 - z * z).sqrt());
+        blocks[(2 * i, 2 * i)] = re;
+        blocks[(2 * i + 1, 2 * i + 1)] = re;
+        blocks[(2 * i, 2 * i + 1)] = im;
+        blocks[(2 * i + 1, 2 * i)] = -im;
+    }
+    let q = randn(n, n).qr().compute_Q();
+    let a = &q * &blocks * q.transpose();
+    StateSpace::new(a, randn(n, m), randn(p, n), Mat::zeros(p, m)).unwrap()
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -114,34 +143,39 @@ fn main() {
     let dump = args.iter().position(|a| a == "--dump").and_then(|i| args.get(i + 1)).map(PathBuf::from);
     let only: Option<usize> = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
 
-    println!("H∞ norm, random stable systems, 2 inputs, 2 outputs, tol {DEFAULT_HINF_TOL:e}, thread CPU time (median)");
-    println!("{:>5} {:>12} {:>14} {:>12} {:>5} {:>12}", "n", "seconds", "‖G‖∞", "peak ω", "reps", "eig(A) s");
-    for &n in [10usize, 50, 100, 250, 500].iter().filter(|&&n| only.is_none_or(|o| o == n)) {
-        let sys = random_stable(n, 2, 2, n as u64);
-        if let Some(dir) = &dump {
-            std::fs::create_dir_all(dir).unwrap();
-            let doc = serde_json::json!({
-                "A": matrix_to_json(sys.a.as_ref()), "B": matrix_to_json(sys.b.as_ref()),
-                "C": matrix_to_json(sys.c.as_ref()), "D": matrix_to_json(sys.d.as_ref()),
-            });
-            std::fs::write(dir.join(format!("hinf_n{n}.json")), doc.to_string()).unwrap();
+    for (family, make) in [
+        ("random stable (A = M/√n − 1.2 I)", random_stable as fn(usize, usize, usize, u64) -> StateSpace),
+        ("lightly damped modes (ζ 1e-3…1e-1, ω 0.1…100)", lightly_damped),
+    ] {
+        println!("H∞ norm, {family}, 2 inputs, 2 outputs, tol {DEFAULT_HINF_TOL:e}, thread CPU time (median)");
+        println!("{:>5} {:>12} {:>14} {:>12} {:>5} {:>12}", "n", "seconds", "‖G‖∞", "peak ω", "reps", "eig(A) s");
+        for &n in [10usize, 50, 100, 250, 500].iter().filter(|&&n| only.is_none_or(|o| o == n)) {
+            let sys = make(n, 2, 2, n as u64);
+            if let Some(dir) = &dump {
+                std::fs::create_dir_all(dir).unwrap();
+                let doc = serde_json::json!({
+                    "A": matrix_to_json(sys.a.as_ref()), "B": matrix_to_json(sys.b.as_ref()),
+                    "C": matrix_to_json(sys.c.as_ref()), "D": matrix_to_json(sys.d.as_ref()),
+                });
+                let tag = if family.starts_with("random") { "random" } else { "damped" };
+                std::fs::write(dir.join(format!("{tag}_n{n}.json")), doc.to_string()).unwrap();
+            }
+            let reps = match (n, quick) {
+                _ if only.is_some() => 200,
+                (_, true) => 3,
+                (0..=100, _) => 21,
+                (101..=250, _) => 9,
+                _ => 5,
+            };
+            let (t, h) = time(reps, || hinf_norm(&sys, DEFAULT_HINF_TOL));
+            let (t_poles, _) = time(reps, || spectral_abscissa(sys.a.as_ref()));
+            println!("{n:>5} {t:>12.6} {:>14.10} {:>12.6} {reps:>5} {t_poles:>12.6}", h.value, h.peak_freq);
         }
-        let reps = match (n, quick) {
-            _ if only.is_some() => 200,
-            (_, true) => 3,
-            (0..=100, _) => 21,
-            (101..=250, _) => 9,
-            _ => 5,
-        };
-        let (t, h) = time(reps, || hinf_norm(&sys, DEFAULT_HINF_TOL));
-        let (t_poles, _) = time(reps, || spectral_abscissa(sys.a.as_ref()));
-        println!("{n:>5} {t:>12.6} {:>14.10} {:>12.6} {reps:>5} {t_poles:>12.6}", h.value, h.peak_freq);
+        println!();
     }
-
     if only.is_some() {
         return;
     }
-    println!();
     println!("Design objective max(‖Tzw‖∞, ε‖K‖∞) + gradient (ε = 1e-3, strong), thread CPU time");
     let secs = if quick { 1.0 } else { 5.0 };
     let he1 = plant("HE1");

@@ -18,9 +18,9 @@ def main():
     d = sys.argv[1]
     tol = float(sys.argv[2]) if len(sys.argv) > 2 else 1e-10
     print(f"AB13DD (slycot {slycot.__version__}), tol {tol:g}, thread CPU time (median)")
-    print(f"{'n':>5} {'seconds':>12} {'hinf':>14} {'peak w':>12} {'reps':>5}")
-    for n in (10, 50, 100, 250, 500):
-        path = os.path.join(d, f"hinf_n{n}.json")
+    print(f"{'system':>12} {'n':>5} {'seconds':>12} {'hinf':>14} {'peak w':>12} {'reps':>5}")
+    for tag, n in [(t, n) for t in ("random", "damped") for n in (10, 50, 100, 250, 500)]:
+        path = os.path.join(d, f"{tag}_n{n}.json")
         if not os.path.exists(path):
             continue
         s = json.load(open(path))
@@ -33,7 +33,7 @@ def main():
             t0 = time.thread_time()
             g, w = slycot.ab13dd("C", "I", "N", "D", n, m, p, A.copy(order="F"), E, B, C, D, tol)
             times.append(time.thread_time() - t0)
-        print(f"{n:>5} {sorted(times)[reps // 2]:>12.6f} {g:>14.10f} {w:>12.6f} {reps:>5}")
+        print(f"{tag:>12} {n:>5} {sorted(times)[reps // 2]:>12.6f} {g:>14.10f} {w:>12.6f} {reps:>5}")
 
 
 if __name__ == "__main__":

@@ -325,7 +325,7 @@ impl<'s> Hamiltonian<'s> {
     /// −R⁻¹ = V diag(1/(γ²−σᵢ²)) Vᵀ, −S⁻¹ = U diag(1/(γ²−σᵢ²)) Uᵀ (σᵢ = 0 beyond min(p,m)).
     fn explicit_hamiltonian(&self, gamma: f64) -> [Mat<f64>; 3] {
         let s = self.sys;
-        let (n, m, p) = (s.order(), s.inputs(), s.outputs());
+        let (m, p) = (s.inputs(), s.outputs());
         let g2 = gamma * gamma;
         let wt = |k: usize| {
             let sk = self.d_s.get(k).copied().unwrap_or(0.0);

@@ -102,8 +102,9 @@ impl ColMajor {
     }
 
     /// X ← P X P for P = I − β v vᵀ acting on indices r..r+len. Columns before `first_col` are
-    /// zero in rows r.. and are skipped on the left.
-    fn reflect_two_sided(&mut self, r: usize, v: &[f64], beta: f64, first_col: usize, w: &mut [f64]) {
+    /// zero in rows r.. and are skipped on the left; rows before `first_row` are zero in
+    /// columns r.. and are skipped on the right.
+    fn reflect_two_sided(&mut self, r: usize, v: &[f64], beta: f64, first_col: usize, first_row: usize, w: &mut [f64]) {
         let len = v.len();
         for c in first_col..self.n {
             let seg = &mut self.col_mut(c)[r..r + len];
@@ -112,13 +113,14 @@ impl ColMajor {
                 axpy(-s, v, seg);
             }
         }
-        // Right: w = X[:, r..] v; X[:, r..] −= β w vᵀ.
+        // Right: w = X[first_row.., r..] v; X[first_row.., r..] −= β w vᵀ.
+        let w = &mut w[first_row..];
         w.iter_mut().for_each(|t| *t = 0.0);
         for (k, &vk) in v.iter().enumerate() {
-            axpy(vk, self.col(r + k), w);
+            axpy(vk, &self.col(r + k)[first_row..], w);
         }
         for (k, &vk) in v.iter().enumerate() {
-            axpy(-beta * vk, w, self.col_mut(r + k));
+            axpy(-beta * vk, w, &mut self.col_mut(r + k)[first_row..]);
         }
     }
 }
@@ -157,10 +159,12 @@ impl SkewHamiltonian {
         }
     }
 
-    fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first_col: usize, w: &mut [f64]) {
-        self.a.reflect_two_sided(r, v, beta, first_col, w);
-        self.g.reflect_two_sided(r, v, beta, 0, w);
-        self.q.reflect_two_sided(r, v, beta, first_col, w);
+    /// diag(P, P) similarity at step j (P acting on j+1..n). Q(:, 0..j) = 0 and, by
+    /// skew-symmetry, Q(0..j, :) = 0, so Q's update is confined to its trailing block.
+    fn reflect(&mut self, r: usize, v: &[f64], beta: f64, j: usize, w: &mut [f64]) {
+        self.a.reflect_two_sided(r, v, beta, j, 0, w);
+        self.g.reflect_two_sided(r, v, beta, 0, 0, w);
+        self.q.reflect_two_sided(r, v, beta, j, j, w);
     }
 
     /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the full matrix M
