@@ -22,37 +22,33 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-/// A random stable system: A = M − (α(M) + 0.1)·I... computed cheaply as M/√n − 1.2·I (the
-/// spectrum of M/√n lies in the unit disc up to O(n^{-1/2})), with a check that it is stable.
+/// An r×c matrix of independent N(0, scale²) entries.
+fn randn(rng: &mut ChaCha8Rng, r: usize, c: usize, scale: f64) -> Mat<f64> {
+    Mat::from_fn(r, c, |_, _| {
+        let z: f64 = StandardNormal.sample(rng);
+        scale * z
+    })
+}
+
+/// A random stable system: A = M/√n − 1.2·I with M standard normal (the spectrum of M/√n lies
+/// in the unit disc up to O(n^{-1/2}), so Re λ(A) ≲ −0.2); stability is checked.
 fn random_stable(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut randn = |r: usize, c: usize, s: f64| {
-        Mat::from_fn(r, c, |_, _| {
-            let z: f64 = StandardNormal.sample(&mut rng);
-            s * z
-        })
-    };
-    let mut a = randn(n, n, 1.0 / (n as f64).sqrt());
+    let mut a = randn(&mut rng, n, n, 1.0 / (n as f64).sqrt());
     for i in 0..n {
         a[(i, i)] -= 1.2;
     }
-    let sys = StateSpace::new(a, randn(n, m, 1.0), randn(p, n, 1.0), randn(p, m, 0.3)).unwrap();
+    let (b, c, d) = (randn(&mut rng, n, m, 1.0), randn(&mut rng, p, n, 1.0), randn(&mut rng, p, m, 0.3));
+    let sys = StateSpace::new(a, b, c, d).unwrap();
     assert!(hinf_norm(&sys, DEFAULT_HINF_TOL).value.is_finite(), "random system n={n} not stable");
     sys
 }
 
 /// A lightly damped modal system: n/2 modes with natural frequencies log-spaced over
 /// [0.1, 100] rad/s and damping ratios log-spaced over [1e-3, 1e-1], behind a random orthogonal
-/// similarity (so A is full, not block diagonal). Its peak is sharp, and the level set usually
-/// needs several Hamiltonian eigenproblems.
+/// similarity (so A is full, not block diagonal). Its peak is sharp (ζ = 1e-3 at 0.1 rad/s).
 fn lightly_damped(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut randn = |r: usize, c: usize| {
-        Mat::from_fn(r, c, |_, _| {
-            let z: f64 = StandardNormal.sample(&mut rng);
-            z
-        })
-    };
     let k = n / 2;
     let mut blocks = Mat::<f64>::zeros(n, n);
     for i in 0..k {
@@ -65,9 +61,10 @@ fn lightly_damped(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
         blocks[(2 * i, 2 * i + 1)] = im;
         blocks[(2 * i + 1, 2 * i)] = -im;
     }
-    let q = randn(n, n).qr().compute_Q();
+    let q = randn(&mut rng, n, n, 1.0).qr().compute_Q();
     let a = &q * &blocks * q.transpose();
-    StateSpace::new(a, randn(n, m), randn(p, n), Mat::zeros(p, m)).unwrap()
+    let (b, c) = (randn(&mut rng, n, m, 1.0), randn(&mut rng, p, n, 1.0));
+    StateSpace::new(a, b, c, Mat::zeros(p, m)).unwrap()
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
