@@ -66,6 +66,12 @@ fn main() {
             1,
         );
     }
+    // The relative eigenvalue floor on H lets BFGS follow the valley to the minimiser.
+    let mut floored = opts(1e-8, 1e-6, 100_000, true);
+    floored.bfgs.h_floor = Some(1e-14);
+    for n in 2..=5 {
+        bench("cheb-rosenbrock h_floor +GS", &mut ChebyshevRosenbrock { n }, 0.0, &floored, 3, 1);
+    }
 
     println!();
     println!("simplex QP min ||Gw||^2 (median of repeats): dense interior point vs clarabel");

@@ -11,7 +11,8 @@
 //!    H⁺ = H − ρ(H y sᵀ + s yᵀ H) + (ρ² yᵀHy + ρ) s sᵀ, ρ = 1/sᵀy (the explicitly symmetric form of
 //!    (I − ρsyᵀ)H(I − ρysᵀ) + ρssᵀ). If sᵀy ≤ 0 the update is **skipped** (only happens after a
 //!    failed line search; HANSO); so is an update that would produce a non-finite H (GRANSO).
-//!    Optional GRANSO-style damping (algorithm.md §8), off by default.
+//!    Optional GRANSO-style damping (algorithm.md §8), off by default; optional relative
+//!    eigenvalue floor H ← H + δ·maxᵢHᵢᵢ·I (`h_floor`), off by default.
 //!
 //! Termination tests, in HANSO's order: f < fvalquit, ‖x‖ > xnormquit, line search bracketed but
 //! failed (the usual end at a nonsmooth minimiser, where H becomes very ill conditioned), line
@@ -115,6 +116,10 @@ impl BfgsState {
             for j in 0..n {
                 h[i * n + j] += -rho * (hy[i] * s[j] + s[i] * hy[j]) + coef * s[i] * s[j];
             }
+        }
+        if let Some(floor) = opts.h_floor {
+            let shift = floor * (0..n).map(|i| h[i * n + i]).fold(0.0, f64::max);
+            (0..n).for_each(|i| h[i * n + i] += shift);
         }
         if h.iter().all(|v| v.is_finite()) {
             self.h = h;
