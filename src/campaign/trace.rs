@@ -2,7 +2,7 @@
 //!
 //! Two channels, both with message encoding `json` and a JSON Schema (schema encoding
 //! `jsonschema`):
-//! * [`ITER_TOPIC`] — one message per optimiser iteration ([`IterMessage`]: phase, start,
+//! * [`ITER_TOPIC`] — one message per optimiser iteration ([`iter_message`]: phase, start,
 //!   iteration, f, ‖Tzw‖∞, ‖K‖∞, α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds);
 //! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled.
 //!

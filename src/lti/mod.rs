@@ -33,6 +33,6 @@ pub use state_space::StateSpace;
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub use full_order::{
     full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions,
-    Regularisation, FLAT_RTOL, GAMMA_RTOL, REGULARISATION_EPS,
+    Regularisation, FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_EPS,
 };
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
