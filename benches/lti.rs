@@ -16,7 +16,7 @@ use std::rc::Rc;
 use faer::Mat;
 use hinfix::design::objective::ComponentCache;
 use hinfix::design::{controller_to_x, ControllerShape, DesignObjective, ObjectivePhase};
-use hinfix::lti::{hinf_norm, matrix_to_json, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL};
+use hinfix::lti::{hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL};
 use hinfix::optim::{thread_cpu_time, Objective};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -86,8 +86,7 @@ fn time<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, R) {
 }
 
 fn plant(name: &str) -> Plant {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("plants").join(format!("{name}.json"));
-    Plant::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    resolve_plant(name).and_then(Plant::load).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Objective+gradient evaluations per second at controller `k` (performance phase, strong
