@@ -4,7 +4,7 @@ SLICOT's AB13DD (slycot, tol 1e-12) for systems that stress the level-set method
 eigenvalue step: lightly damped modes spread over many decades, a low-frequency peak beside
 fast modes (|λ| ≪ ‖H‖, the square-reduced method's weak spot), bad scaling, MIMO, D ≠ 0.
 Same keys as the shared oracle's hinfnorm files; kind "modal" (flat enough that only the value, not
-the peak frequency, is compared). Needs numpy, scipy, slycot (pip)."""
+the peak frequency, is compared). Needs numpy and slycot (pip)."""
 import json
 import os
 import sys

@@ -222,10 +222,10 @@ fn refine(fr: &mut FreqResponse, best: &mut Best, tested: &[f64]) {
     let (mut x, mut fx) = (w0.ln(), -best.gamma);
     let (mut v, mut fv, mut w, mut fw) = (x, fx, x, fx);
     let (mut d, mut e) = (0.0f64, 0.0f64);
+    let tol = REFINE_LOG_TOL;
+    let t2 = 2.0 * tol;
     for _ in 0..REFINE_MAX_EVALS {
         let m = 0.5 * (a + b);
-        let tol = REFINE_LOG_TOL;
-        let t2 = 2.0 * tol;
         if (x - m).abs() <= t2 - 0.5 * (b - a) {
             break;
         }
