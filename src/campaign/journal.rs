@@ -12,9 +12,17 @@
 //!
 //! Blank lines are skipped. Records with a newer `schema_version` than this program knows are
 //! refused (an error naming the line) rather than misread.
+//!
+//! Several processes sharing one results folder (see `claims`): each appends to a journal of its
+//! own, the first of `runs.jsonl`, `runs.2.jsonl`, `runs.3.jsonl`, … that no live process holds
+//! ([`JournalWriter::open_in`] keeps an exclusive lock on it for the writer's life), so lines of
+//! different processes never interleave, and only the owner ever cuts a torn tail. Readers take
+//! every `runs*.jsonl` of the folder ([`journals_in`]); a [`Follower`] reads them incrementally
+//! while a run goes on, never consuming a last line that is not complete yet.
 
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
-use std::io::{self, Write};
+use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use super::record::{JobRecord, SCHEMA_VERSION};
@@ -53,6 +61,12 @@ pub enum JournalError {
         line: usize,
         /// The version found.
         found: u32,
+    },
+    /// The journal is locked by another live process.
+    #[error("{}: in use by another running process", path.display())]
+    Busy {
+        /// The journal.
+        path: PathBuf,
     },
     /// A record could not be serialised (cannot happen for well-formed records).
     #[error("cannot serialise the record of job {job}: {message}")]
@@ -164,20 +178,47 @@ pub struct JournalWriter {
 }
 
 impl JournalWriter {
-    /// Opens (creating it and its folder if needed) the journal for appending, after cutting off
-    /// a torn last line if there is one. Returns the writer and what was read.
+    /// Opens (creating it and its folder if needed) the journal for appending, locked
+    /// exclusively for this writer's life, after cutting off a torn last line if there is one.
+    /// Returns the writer and what was read. Fails with [`JournalError::Busy`] if another
+    /// process holds it.
     pub fn open(path: &Path) -> Result<(JournalWriter, JournalRead), JournalError> {
+        Self::try_open(path)?.ok_or_else(|| JournalError::Busy { path: path.to_path_buf() })
+    }
+
+    /// Opens the first journal of `dir` that no live process holds: `runs.jsonl`, then
+    /// `runs.2.jsonl`, `runs.3.jsonl`, … (see the module docs).
+    pub fn open_in(dir: &Path) -> Result<(JournalWriter, JournalRead), JournalError> {
+        for k in 1.. {
+            let name = if k == 1 { JOURNAL_FILE.to_string() } else { format!("runs.{k}.jsonl") };
+            if let Some(w) = Self::try_open(&dir.join(name))? {
+                return Ok(w);
+            }
+        }
+        unreachable!("some journal number is free")
+    }
+
+    /// [`open`](Self::open), or `None` if another process holds the lock. Everything is read
+    /// and repaired through the locked descriptor (under NFS, closing another descriptor of a
+    /// locked file would drop the lock).
+    fn try_open(path: &Path) -> Result<Option<(JournalWriter, JournalRead)>, JournalError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io_err(path))?;
         }
-        let read = read_journal(path)?;
-        if let Some(t) = &read.torn {
-            let f = OpenOptions::new().write(true).open(path).map_err(io_err(path))?;
-            f.set_len(t.offset).map_err(io_err(path))?;
-            f.sync_all().map_err(io_err(path))?;
+        let mut file = OpenOptions::new().create(true).read(true).append(true).open(path).map_err(io_err(path))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => return Ok(None),
+            Err(std::fs::TryLockError::Error(e)) => return Err(io_err(path)(e)),
         }
-        let file = OpenOptions::new().create(true).append(true).open(path).map_err(io_err(path))?;
-        Ok((JournalWriter { path: path.to_path_buf(), file }, read))
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).map_err(io_err(path))?;
+        let read = parse_journal(&bytes, path)?;
+        if let Some(t) = &read.torn {
+            file.set_len(t.offset).map_err(io_err(path))?;
+            file.sync_all().map_err(io_err(path))?;
+        }
+        Ok(Some((JournalWriter { path: path.to_path_buf(), file }, read)))
     }
 
     /// The journal's path.
@@ -194,5 +235,108 @@ impl JournalWriter {
         self.file.write_all(&line).map_err(io_err(path))?;
         self.file.flush().map_err(io_err(path))?;
         self.file.sync_data().map_err(io_err(path))
+    }
+}
+
+/// Whether `name` is a journal's file name: `runs.jsonl` or `runs.<anything>.jsonl`.
+pub fn is_journal_name(name: &str) -> bool {
+    name == JOURNAL_FILE || (name.starts_with("runs.") && name.ends_with(".jsonl") && name.len() > "runs..jsonl".len())
+}
+
+/// The journals in folder `dir` (sorted by name). A missing folder has none.
+pub fn journals_in(dir: &Path) -> Result<Vec<PathBuf>, JournalError> {
+    let rd = match std::fs::read_dir(dir) {
+        Ok(rd) => rd,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(io_err(dir)(e)),
+    };
+    let mut out = Vec::new();
+    for e in rd {
+        let e = e.map_err(io_err(dir))?;
+        if is_journal_name(&e.file_name().to_string_lossy()) && e.path().is_file() {
+            out.push(e.path());
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Where a [`Follower`] is in one journal.
+#[derive(Debug, Clone, Default)]
+struct Tail {
+    offset: u64,
+    lines: usize,
+    torn: Option<TornTail>,
+}
+
+/// Reads the journals of a folder (and extra journal files) incrementally: each
+/// [`poll`](Follower::poll) returns the complete records appended since the last one, including
+/// those of journals that appeared meanwhile. An incomplete last line is left for the next poll
+/// (its writer may still be writing it); if its writer died it stays, and is reported by
+/// [`torn`](Follower::torn).
+#[derive(Debug, Clone)]
+pub struct Follower {
+    dirs: Vec<PathBuf>,
+    files: Vec<PathBuf>,
+    skip: Option<PathBuf>,
+    tails: BTreeMap<PathBuf, Tail>,
+}
+
+impl Follower {
+    /// Follows every journal in `dirs` and the journal `files`, except `skip` (a writer's own
+    /// journal, which it must not open a second time).
+    pub fn new(dirs: Vec<PathBuf>, files: Vec<PathBuf>, skip: Option<PathBuf>) -> Follower {
+        Follower { dirs, files, skip, tails: BTreeMap::new() }
+    }
+
+    /// The journals followed so far.
+    pub fn journals(&self) -> Vec<PathBuf> {
+        self.tails.keys().cloned().collect()
+    }
+
+    /// Torn (incomplete or unparsable) last lines seen at the last poll, by journal.
+    pub fn torn(&self) -> Vec<(PathBuf, TornTail)> {
+        self.tails.iter().filter_map(|(p, t)| t.torn.clone().map(|t| (p.clone(), t))).collect()
+    }
+
+    /// The records appended since the last poll, journal by journal in name order.
+    pub fn poll(&mut self) -> Result<Vec<JobRecord>, JournalError> {
+        let mut paths = self.files.clone();
+        for d in &self.dirs {
+            paths.extend(journals_in(d)?);
+        }
+        // one file named twice (`--journal` repeating the folder's) is read once
+        let canon = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+        let skip = self.skip.as_deref().map(canon);
+        let mut out = Vec::new();
+        let mut done = std::collections::HashSet::new();
+        for path in paths {
+            let path = canon(&path);
+            if skip.as_ref() == Some(&path) || !done.insert(path.clone()) {
+                continue;
+            }
+            let tail = self.tails.entry(path.clone()).or_default();
+            let mut bytes = Vec::new();
+            match File::open(&path) {
+                Ok(mut f) => {
+                    f.seek(SeekFrom::Start(tail.offset)).map_err(io_err(&path))?;
+                    f.read_to_end(&mut bytes).map_err(io_err(&path))?;
+                }
+                Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+                Err(e) => return Err(io_err(&path)(e)),
+            }
+            let read = parse_journal(&bytes, &path).map_err(|e| match e {
+                JournalError::Corrupt { path, line, message } => JournalError::Corrupt { path, line: line + tail.lines, message },
+                JournalError::NewerSchema { path, line, found } => JournalError::NewerSchema { path, line: line + tail.lines, found },
+                e => e,
+            })?;
+            let consumed = read.torn.as_ref().map_or(bytes.len(), |t| t.offset as usize);
+            let base = (tail.offset, tail.lines);
+            tail.offset += consumed as u64;
+            tail.lines += bytes[..consumed].iter().filter(|&&b| b == b'\n').count();
+            tail.torn = read.torn.map(|t| TornTail { line: t.line + base.1, offset: t.offset + base.0, ..t });
+            out.extend(read.records);
+        }
+        Ok(out)
     }
 }

@@ -5,17 +5,20 @@
 //! emits [`scheduler::CampaignEvent`]s without printing or writing anything; the journal
 //! ([`run`]), the trace writer ([`trace`]), the progress reporter ([`progress`]) and the report
 //! writers ([`report`]) each consume what they need.
+pub mod claims;
 pub mod fake;
 pub mod jobs;
 pub mod journal;
 pub mod latex;
 pub mod progress;
+pub mod provenance;
 pub mod record;
 pub mod reduce;
 mod reference;
 pub mod report;
 pub mod run;
 pub mod scheduler;
+pub mod shard;
 pub mod spec;
 pub mod trace;
 

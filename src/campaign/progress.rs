@@ -119,6 +119,12 @@ impl<'a> Reporter<'a> {
                     b.inc(1);
                 }
             }
+            CampaignEvent::JobDoneElsewhere { index } => {
+                self.line(format!("done elsewhere {} (another process journaled it)", self.label(*index)));
+                if let Some(b) = &self.overall {
+                    b.inc(1);
+                }
+            }
             CampaignEvent::JobInterrupted { index, .. } => {
                 self.line(format!("stopped {} (not journaled; a rerun redoes it)", self.label(*index)))
             }

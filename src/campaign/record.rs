@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::jobs::{Job, JobId, RunnerTag};
+use super::provenance::Provenance;
 use crate::design::{serde_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats};
 
 /// Version of the journal line format. Readers refuse newer versions.
@@ -118,10 +119,15 @@ pub struct JobRecord {
     pub finished_unix_s: f64,
     /// The controller `{AK, BK, CK, DK}` (None for failed jobs).
     pub controller: Option<serde_json::Value>,
+    /// Where and with what it ran (absent in journals written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
 }
 
 /// Keys whose values depend on timing, not on the computation.
 pub const TIMING_KEYS: &[&str] = &["design_cpu_s", "cpu_s", "wall_s", "finished_unix_s"];
+/// Keys that say where a job ran, not what it computed.
+pub const WHERE_KEYS: &[&str] = &["provenance"];
 
 impl JobRecord {
     /// The record of `job` after its run; `None` when the run was interrupted (not journaled).
@@ -165,6 +171,7 @@ impl JobRecord {
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0.0, |d| d.as_secs_f64()),
             controller: None,
+            provenance: None,
         };
         match result {
             Err(error) => r.status = JobStatus::Failed { error },
@@ -195,12 +202,12 @@ impl JobRecord {
         Some(r)
     }
 
-    /// The record as JSON without the timing fields (also inside `phases`): two runs of the same
-    /// job on the same machine must agree on this exactly.
+    /// The record as JSON without the timing fields (also inside `phases`) and the provenance:
+    /// two runs of the same job on the same machine must agree on this exactly.
     pub fn comparable(&self) -> serde_json::Value {
         let mut v = serde_json::to_value(self).expect("record serialises");
         if let Some(obj) = v.as_object_mut() {
-            for k in TIMING_KEYS {
+            for k in TIMING_KEYS.iter().chain(WHERE_KEYS) {
                 obj.remove(*k);
             }
             if let Some(serde_json::Value::Array(phases)) = obj.get_mut("phases") {

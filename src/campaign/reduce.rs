@@ -2,6 +2,14 @@
 //! are re-verified by recomputation: the closed loop is formed again (`lti::closed_loop`), both
 //! α(A_cl) < 0 and α(Ak) < 0 are checked, and γ = ‖Tzw‖∞ is recomputed. The reported γ is
 //! always the recomputed one, never the journal's.
+//!
+//! A plant is identified by its content fingerprint, never by its name: records are verified
+//! against the plant with their `plant_fingerprint` and grouped by it, so two different plants
+//! that share a name are never merged, and a renamed plant keeps its results (shown under its
+//! current name). Two plants of one name in one report are told apart as `name@<8 hex digits>`.
+//!
+//! Several records of one job id (a job run twice, e.g. by two folders merged with
+//! `--journal`) count once: its best re-verified record.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -9,8 +17,26 @@ use std::sync::Arc;
 use super::record::JobRecord;
 use crate::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
 
-/// Plants by name (the journal's `plant` field), as `Job::plant` holds them.
+/// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
+/// them.
 pub type PlantMap = BTreeMap<String, Arc<Plant>>;
+
+/// Display names of plants given as (fingerprint, name) pairs: the name, or `name@<first 8 hex
+/// digits of the fingerprint>` when several fingerprints share it.
+pub fn plant_labels<'a>(plants: impl IntoIterator<Item = (&'a str, &'a str)>) -> BTreeMap<String, String> {
+    let pairs: BTreeMap<&str, &str> = plants.into_iter().collect();
+    let mut per_name: BTreeMap<&str, usize> = BTreeMap::new();
+    for name in pairs.values() {
+        *per_name.entry(name).or_default() += 1;
+    }
+    pairs
+        .iter()
+        .map(|(fp, name)| {
+            let label = if per_name[name] > 1 { format!("{name}@{}", &fp[..fp.len().min(8)]) } else { name.to_string() };
+            (fp.to_string(), label)
+        })
+        .collect()
+}
 
 /// Result of re-verifying one record.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,8 +91,10 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
 /// Best result of one (plant, order).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BestRow {
-    /// Plant name.
+    /// Plant name (its current name; `name@fingerprint` if two plants share it).
     pub plant: String,
+    /// Plant content fingerprint (the plant's identity).
+    pub plant_fingerprint: String,
     /// Controller order n_K.
     pub order: usize,
     /// Best recomputed γ (NaN if no job verified).
@@ -78,7 +106,7 @@ pub struct BestRow {
     pub eps: Option<f64>,
     /// Its seed.
     pub seed: Option<u64>,
-    /// Journaled jobs of this (plant, order).
+    /// Journaled jobs of this (plant, order) (a job journaled twice counts once).
     pub runs: usize,
     /// Jobs whose controller re-verified stable and stabilising.
     pub verified: usize,
@@ -86,13 +114,41 @@ pub struct BestRow {
     pub failed: usize,
 }
 
-/// Best γ per (plant, order), sorted by plant then order. Records of plants missing from
-/// `plants` count as runs that failed verification.
+/// Best γ per (plant, order), sorted by plant label then order. Records of plants missing
+/// from `plants` count as runs that failed verification; duplicate records of a job count once,
+/// by their best verified one.
 pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> {
-    let mut rows: BTreeMap<(String, usize), BestRow> = BTreeMap::new();
+    let labels = plant_labels(records.iter().map(|r| {
+        let name = plants.get(&r.plant_fingerprint).map_or(r.plant.as_str(), |p| p.name.as_str());
+        (r.plant_fingerprint.as_str(), name)
+    }));
+    // job id → (record, verified γ) of its best record
+    let mut per_job: BTreeMap<&str, (&JobRecord, Option<f64>)> = BTreeMap::new();
     for r in records {
-        let row = rows.entry((r.plant.clone(), r.order)).or_insert_with(|| BestRow {
-            plant: r.plant.clone(),
+        let gamma = match plants.get(&r.plant_fingerprint).map(|p| verify(r, p)) {
+            Some(Verdict::Verified { gamma, .. }) => Some(gamma),
+            _ => None,
+        };
+        let better = |old: Option<f64>| match (gamma, old) {
+            (Some(g), Some(o)) => g < o,
+            (Some(_), None) => true,
+            (None, _) => false,
+        };
+        per_job
+            .entry(r.job_id.0.as_str())
+            .and_modify(|e| {
+                if better(e.1) {
+                    *e = (r, gamma);
+                }
+            })
+            .or_insert((r, gamma));
+    }
+    let mut rows: BTreeMap<(String, usize), BestRow> = BTreeMap::new();
+    for (r, gamma) in per_job.into_values() {
+        let label = labels[&r.plant_fingerprint].clone();
+        let row = rows.entry((label.clone(), r.order)).or_insert_with(|| BestRow {
+            plant: label,
+            plant_fingerprint: r.plant_fingerprint.clone(),
             order: r.order,
             gamma: f64::NAN,
             job_id: None,
@@ -103,12 +159,8 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
             failed: 0,
         });
         row.runs += 1;
-        let verdict = match plants.get(&r.plant) {
-            Some(p) => verify(r, p),
-            None => Verdict::Rejected("unknown plant".into()),
-        };
-        match verdict {
-            Verdict::Verified { gamma, .. } => {
+        match gamma {
+            Some(gamma) => {
                 row.verified += 1;
                 if !(gamma >= row.gamma) {
                     row.gamma = gamma;
@@ -117,8 +169,88 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
                     row.seed = Some(r.seed);
                 }
             }
-            Verdict::Rejected(_) => row.failed += 1,
+            None => row.failed += 1,
         }
     }
     rows.into_values().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::campaign::jobs::{job_id, RunnerTag};
+    use crate::design::DesignOptions;
+
+    /// ẋ = −x + w + u, z = c·x, y = x: with K = 0, ‖Tzw‖∞ = c.
+    fn plant(name: &str, c: f64) -> Arc<Plant> {
+        let text = format!(
+            r#"{{"name":"{name}","dims":{{"n":1,"m1":1,"m2":1,"p1":1,"p2":1}},
+            "A":[[-1]],"B1":[[1]],"B2":[[1]],"C1":[[{c}]],"C2":[[1]],
+            "D11":[[0]],"D12":[[0]],"D21":[[0]],"D22":[[0]]}}"#
+        );
+        Arc::new(Plant::from_json_str(&text, "test.json").unwrap())
+    }
+
+    /// A record of the zero static controller on `p`, journaled under plant name `name`.
+    fn record(p: &Plant, name: &str, seed: u64) -> JobRecord {
+        let options = DesignOptions { order: 0, seed, ..DesignOptions::default() };
+        let fp = p.fingerprint();
+        let id = job_id(&fp, &options, None, RunnerTag::Design);
+        let mut v = serde_json::json!({
+            "schema_version": 1, "job_id": id, "campaign": "t", "plant": name, "plant_fingerprint": fp,
+            "order": 0, "eps": options.eps, "seed": seed, "cpumax": options.cpumax, "options": options,
+            "warm_from": null, "warm_started": false, "status": {"kind": "optimised"},
+            "gamma": 0.5, "k_hinf": 0.0, "alpha_cl": -1.0, "alpha_k": null, "objective": 0.5,
+            "certificate": null, "iterations": 1, "evaluations": 1, "phases": [], "design_cpu_s": 0.0,
+            "cpu_s": 0.0, "wall_s": 0.0, "finished_unix_s": 0.0,
+            "controller": crate::lti::Controller::zeros(0, 1, 1).to_json(),
+        });
+        // a journal line of an older hinfix: no provenance
+        v.as_object_mut().unwrap().remove("provenance");
+        serde_json::from_value(v).unwrap()
+    }
+
+    fn map(plants: &[&Arc<Plant>]) -> PlantMap {
+        plants.iter().map(|p| (p.fingerprint(), Arc::clone(p))).collect()
+    }
+
+    #[test]
+    fn two_plants_with_one_name_are_never_merged() {
+        let (p1, p2) = (plant("P", 1.0), plant("P", 2.0));
+        let recs = [record(&p1, "P", 0), record(&p2, "P", 0)];
+        let rows = best_per_order(&recs, &map(&[&p1, &p2]));
+        assert_eq!(rows.len(), 2, "{rows:?}");
+        for (p, c) in [(&p1, 1.0), (&p2, 2.0)] {
+            let fp = p.fingerprint();
+            let row = rows.iter().find(|r| r.plant_fingerprint == fp).unwrap();
+            assert_eq!(row.plant, format!("P@{}", &fp[..8]));
+            assert_eq!((row.runs, row.verified), (1, 1));
+            assert!((row.gamma - c).abs() < 1e-8, "{row:?}");
+        }
+    }
+
+    #[test]
+    fn a_renamed_plant_keeps_its_results_under_its_new_name() {
+        let p = plant("NEW", 1.0);
+        let recs = [record(&p, "OLD", 0), record(&p, "OLD", 1)];
+        let rows = best_per_order(&recs, &map(&[&p]));
+        assert_eq!(rows.len(), 1);
+        assert_eq!((rows[0].plant.as_str(), rows[0].runs, rows[0].verified), ("NEW", 2, 2));
+        assert!((rows[0].gamma - 1.0).abs() < 1e-8);
+        // and a record of a plant the campaign no longer has does not verify against another
+        let other = plant("NEW", 3.0);
+        let rows = best_per_order(&[record(&other, "NEW", 0)], &map(&[&p]));
+        assert_eq!((rows[0].verified, rows[0].failed), (0, 1));
+    }
+
+    #[test]
+    fn duplicate_records_of_a_job_count_once_by_the_best_verified() {
+        let p = plant("P", 1.0);
+        let good = record(&p, "P", 0);
+        let mut bad = good.clone();
+        bad.controller = Some(crate::lti::Controller::zeros(0, 2, 2).to_json()); // does not fit
+        let rows = best_per_order(&[bad.clone(), good.clone(), bad], &map(&[&p]));
+        assert_eq!((rows[0].runs, rows[0].verified, rows[0].failed), (1, 1, 0));
+        assert_eq!(rows[0].job_id.as_deref(), Some(good.job_id.0.as_str()));
+    }
 }

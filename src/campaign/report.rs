@@ -97,19 +97,18 @@ impl fmt::Display for ReportSummary {
     }
 }
 
-/// Full-order bounds of the plants that appear in `best`.
+/// Full-order bounds of the plants that appear in `best` (`plants` keyed by fingerprint).
 pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<FullOrderRow> {
-    let mut names: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
-    names.dedup();
-    names
-        .into_iter()
-        .map(|name| {
+    let mut seen: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
+    seen.dedup();
+    seen.into_iter()
+        .map(|(name, fp)| {
             let paper = reference
                 .iter()
                 .find(|r| r.plant == name && r.method == RefMethod::FullOrder)
                 .map(|r| r.gamma);
             let computed = plants
-                .get(name)
+                .get(fp)
                 .filter(|p| p.dims.n <= FULL_ORDER_MAX_N)
                 .and_then(|p| full_order_gamma(p).ok())
                 .map(|g| g.gamma);
@@ -134,15 +133,24 @@ pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[Refere
         .collect()
 }
 
-/// Writes `bytes` to `path` atomically: `<path>.tmp` in the same directory, fsync, rename.
+/// Writes `bytes` to `path` atomically: a temporary file unique to this process and call in the
+/// same directory, fsync, rename (several processes may write the same report at once; each
+/// rename installs one complete file).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
-    let tmp = path.with_extension(format!("{}.tmp", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
+    static SEQ: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let seq = SEQ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let host = super::provenance::host_name();
+    let tmp = path.with_file_name(format!(".{name}.{host}.{}.{seq}.tmp", std::process::id()));
     let io = |source| ReportError::Io { path: path.to_path_buf(), source };
     let mut f = std::fs::File::create(&tmp).map_err(io)?;
     f.write_all(bytes).map_err(io)?;
     f.sync_all().map_err(io)?;
     drop(f);
-    std::fs::rename(&tmp, path).map_err(io)
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })
 }
 
 fn csv_bytes<R: serde::Serialize>(path: &Path, rows: impl IntoIterator<Item = R>) -> Result<Vec<u8>, ReportError> {
@@ -170,7 +178,7 @@ fn csv_num(x: f64) -> String {
 }
 
 /// Reduces `records` and writes the four report files into `out_dir` (created if needed).
-/// `plants` maps the journal's plant names to the plants (as `Job::plant` holds them).
+/// `plants` maps plant fingerprints to the plants (as `Job::plant` holds them).
 pub fn write_reports(
     out_dir: &Path,
     records: &[JobRecord],

@@ -13,6 +13,12 @@
 //!   status `Interrupted`; such jobs produce [`CampaignEvent::JobInterrupted`] and no record, so a
 //!   resumed run reruns them.
 //! * Workers send events over one `std::sync::mpsc` channel; the calling thread owns the callback.
+//! * Other processes on the same jobs: an injected [`Coordinator`] is asked to claim each job
+//!   before it starts (a job claimed elsewhere is skipped for [`BUSY_RETRY`] and tried again),
+//!   told when it ended, and polled every `poll_interval` for records journaled elsewhere (those
+//!   jobs are dropped from the queue, their controllers feed warm starts). When nothing runs here
+//!   and nothing left can be claimed, the run ends: the remaining jobs are being run by other
+//!   processes (or wait for a predecessor that is). [`Solo`] is the coordinator of a lone run.
 
 use std::collections::{HashMap, VecDeque};
 use std::ops::ControlFlow;
@@ -23,6 +29,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::jobs::{Job, JobId};
+use super::provenance::Provenance;
 use super::record::JobRecord;
 use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, Phase};
 use crate::lti::Controller;
@@ -50,6 +57,45 @@ impl JobRunner for DesignRunner {
         crate::design::run(&job.plant, &job.options, init, obs)
     }
 }
+
+/// What [`Coordinator::claim`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Claim {
+    /// The job is ours to run.
+    Mine,
+    /// Another process is running it.
+    Busy,
+    /// Another process has finished it (its record comes with the next [`Coordinator::poll`]).
+    Done,
+}
+
+/// Coordination with other processes working on the same jobs (see the module docs). Errors
+/// stop the run like a failing callback.
+pub trait Coordinator<E> {
+    /// Claims `job` before it starts.
+    fn claim(&mut self, job: &Job) -> Result<Claim, E>;
+    /// `job` (claimed) ended: its record, if any, has been handed to the callback.
+    fn release(&mut self, job: &Job);
+    /// Records finished elsewhere since the last poll.
+    fn poll(&mut self) -> Result<Vec<JobRecord>, E>;
+}
+
+/// A run alone on its jobs: every claim succeeds, nothing happens elsewhere.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Solo;
+
+impl<E> Coordinator<E> for Solo {
+    fn claim(&mut self, _job: &Job) -> Result<Claim, E> {
+        Ok(Claim::Mine)
+    }
+    fn release(&mut self, _job: &Job) {}
+    fn poll(&mut self) -> Result<Vec<JobRecord>, E> {
+        Ok(Vec::new())
+    }
+}
+
+/// How long a job found claimed elsewhere is left alone before it is tried again.
+pub const BUSY_RETRY: Duration = Duration::from_secs(5);
 
 /// Watches one job on its worker (the trace writer is one).
 pub trait JobObserver: Send {
@@ -79,7 +125,7 @@ pub fn no_observers(_: &Job) -> Result<Box<dyn JobObserver>, String> {
 /// Why scheduling stopped early; ordered by severity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum CancelReason {
-    /// The event callback failed (e.g. the journal could not be written).
+    /// The event callback or the coordinator failed (e.g. the journal could not be written).
     CallbackError,
     /// The cancel flag was set (Ctrl-C).
     Interrupt,
@@ -96,9 +142,11 @@ pub struct RunStats {
     pub finished: usize,
     /// Of those, failed (`design::run` error or panic).
     pub failed: usize,
+    /// Finished meanwhile by other processes (found in their journals).
+    pub done_elsewhere: usize,
     /// Stopped in flight by a cancel (not journaled).
     pub interrupted: usize,
-    /// Never started.
+    /// Never started (without a cancel: claimed by other processes, or behind such a job).
     pub not_started: usize,
     /// Why scheduling stopped early, if it did.
     pub cancel: Option<CancelReason>,
@@ -151,6 +199,11 @@ pub enum CampaignEvent {
         /// The record.
         record: Box<JobRecord>,
     },
+    /// Another process finished a job that was still queued here.
+    JobDoneElsewhere {
+        /// Job index.
+        index: usize,
+    },
     /// A job was stopped by a cancel; nothing is journaled.
     JobInterrupted {
         /// Job index.
@@ -187,6 +240,10 @@ pub struct ExecuteOptions {
     pub cancel: Arc<AtomicBool>,
     /// Minimum time between two progress events of one job.
     pub progress_interval: Duration,
+    /// Time between two [`Coordinator::poll`]s.
+    pub poll_interval: Duration,
+    /// Written into every record.
+    pub provenance: Provenance,
 }
 
 impl ExecuteOptions {
@@ -197,6 +254,8 @@ impl ExecuteOptions {
             campaign: campaign.to_string(),
             cancel: Arc::new(AtomicBool::new(false)),
             progress_interval: Duration::from_millis(200),
+            poll_interval: Duration::from_secs(1),
+            provenance: Provenance::here(threads.max(1)),
         }
     }
 }
@@ -230,14 +289,16 @@ enum WorkerMsg {
     Interrupted { index: usize, worker: usize },
 }
 
-/// Runs every job of `jobs` that is not in `done` (the journal), respecting warm-start chains,
-/// and reports events to `on_event` on the calling thread. Returns the counts, or the first
-/// callback error (after cancelling and draining in-flight jobs).
+/// Runs every job of `jobs` that is not in `done` (the journals), respecting warm-start chains
+/// and `coord`'s claims, and reports events to `on_event` on the calling thread. Returns the
+/// counts, or the first callback or coordinator error (after cancelling and draining in-flight
+/// jobs).
 pub fn execute<E>(
     jobs: &[Job],
     done: &HashMap<JobId, JobRecord>,
     runner: &dyn JobRunner,
     observers: &ObserverFactory<'_>,
+    coord: &mut dyn Coordinator<E>,
     opts: &ExecuteOptions,
     mut on_event: impl FnMut(CampaignEvent) -> Result<(), E>,
 ) -> Result<RunStats, ExecuteError<E>> {
@@ -245,7 +306,8 @@ pub fn execute<E>(
         .num_threads(opts.threads)
         .thread_name(|i| format!("campaign-worker-{i}"))
         .build()?;
-    // Controllers of finished jobs (journal + this run), for warm starts.
+    let index_of: HashMap<&JobId, usize> = jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
+    // Controllers of finished jobs (journals + this run), for warm starts.
     let mut finished: HashMap<JobId, Option<serde_json::Value>> =
         done.iter().map(|(id, r)| (id.clone(), r.controller.clone())).collect();
     let mut pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
@@ -255,8 +317,10 @@ pub fn execute<E>(
         ..RunStats::default()
     };
     let mut first_err: Option<E> = None;
-    let mut emit = |ev: CampaignEvent, first_err: &mut Option<E>, stats: &mut RunStats| {
-        if let Err(e) = on_event(ev) {
+    // Hands an event to the callback (Ok) or takes a coordinator error (Err); the first error
+    // of either kind cancels the run.
+    let mut emit = |ev: Result<CampaignEvent, E>, first_err: &mut Option<E>, stats: &mut RunStats| {
+        if let Err(e) = ev.and_then(&mut on_event) {
             if first_err.is_none() {
                 *first_err = Some(e);
                 opts.cancel.store(true, Ordering::SeqCst);
@@ -268,7 +332,7 @@ pub fn execute<E>(
         }
     };
     emit(
-        CampaignEvent::Started { total: stats.total, already_done: stats.already_done, to_run: pending.len(), threads: opts.threads },
+        Ok(CampaignEvent::Started { total: stats.total, already_done: stats.already_done, to_run: pending.len(), threads: opts.threads }),
         &mut first_err,
         &mut stats,
     );
@@ -279,53 +343,119 @@ pub fn execute<E>(
     let campaign = opts.campaign.as_str();
     let cancel = &opts.cancel;
     let interval = opts.progress_interval;
+    let provenance = &opts.provenance;
+    // Jobs found claimed elsewhere, with when to try them again.
+    let mut busy_until: HashMap<usize, Instant> = HashMap::new();
+    let mut last_poll = Instant::now();
+    let mut force_poll = false;
+    // Set when nothing ran here and every claimable job was just retried: the next idle pass ends.
+    let mut idle_sweep = false;
 
     pool.in_place_scope(|scope| loop {
         if cancel.load(Ordering::SeqCst) && stats.cancel.is_none() {
             stats.cancel = Some(CancelReason::Interrupt);
-            emit(CampaignEvent::CancelRequested { reason: CancelReason::Interrupt }, &mut first_err, &mut stats);
+            emit(Ok(CampaignEvent::CancelRequested { reason: CancelReason::Interrupt }), &mut first_err, &mut stats);
+        }
+        if stats.cancel.is_none() && (force_poll || last_poll.elapsed() >= opts.poll_interval) {
+            force_poll = false;
+            last_poll = Instant::now();
+            match coord.poll() {
+                Ok(records) => {
+                    for r in records {
+                        if finished.contains_key(&r.job_id) {
+                            continue;
+                        }
+                        let queued = index_of.get(&r.job_id).and_then(|i| pending.iter().position(|p| p == i));
+                        finished.insert(r.job_id.clone(), r.controller);
+                        if let Some(pos) = queued {
+                            let index = pending.remove(pos).expect("position is in range");
+                            stats.done_elsewhere += 1;
+                            emit(Ok(CampaignEvent::JobDoneElsewhere { index }), &mut first_err, &mut stats);
+                        }
+                    }
+                }
+                Err(e) => emit(Err(e), &mut first_err, &mut stats),
+            }
         }
         if stats.cancel.is_none() {
-            while !free.is_empty() {
-                let ready = pending.iter().position(|&i| match &jobs[i].warm_from {
-                    None => true,
-                    Some(p) => finished.contains_key(p),
+            let now = Instant::now();
+            let mut skip = 0usize;
+            while !free.is_empty() && stats.cancel.is_none() {
+                let ready = pending.iter().skip(skip).position(|&i| {
+                    busy_until.get(&i).is_none_or(|t| *t <= now)
+                        && match &jobs[i].warm_from {
+                            None => true,
+                            Some(p) => finished.contains_key(p),
+                        }
                 });
-                let Some(pos) = ready else { break };
-                let index = pending.remove(pos).expect("position is in range");
+                let Some(pos) = ready.map(|p| p + skip) else { break };
+                let index = pending[pos];
                 let job = &jobs[index];
+                match coord.claim(job) {
+                    Ok(Claim::Mine) => {}
+                    Ok(Claim::Busy) => {
+                        busy_until.insert(index, now + BUSY_RETRY);
+                        skip = pos + 1;
+                        continue;
+                    }
+                    Ok(Claim::Done) => {
+                        // its record arrives with the poll at the top of the next pass
+                        busy_until.insert(index, now + BUSY_RETRY);
+                        force_poll = true;
+                        skip = pos + 1;
+                        continue;
+                    }
+                    Err(e) => {
+                        emit(Err(e), &mut first_err, &mut stats);
+                        break;
+                    }
+                }
+                pending.remove(pos);
+                busy_until.remove(&index);
+                idle_sweep = false;
                 let worker = free.pop().expect("a free worker");
                 let mut init = None;
                 if let Some(Some(k)) = job.warm_from.as_ref().and_then(|p| finished.get(p)) {
                     match Controller::from_json_value(k) {
                         Ok(k) => init = Some(k),
                         Err(e) => emit(
-                            CampaignEvent::Warning {
+                            Ok(CampaignEvent::Warning {
                                 index: Some(index),
                                 message: format!("{}: predecessor's controller unusable ({e}); starting cold", job.label()),
-                            },
+                            }),
                             &mut first_err,
                             &mut stats,
                         ),
                     }
                 }
                 running += 1;
-                emit(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }, &mut first_err, &mut stats);
+                emit(Ok(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }), &mut first_err, &mut stats);
                 let tx = tx.clone();
-                scope.spawn(move |_| run_one(campaign, job, index, worker, init, runner, observers, cancel, interval, tx));
+                scope.spawn(move |_| run_one(campaign, provenance, job, index, worker, init, runner, observers, cancel, interval, tx));
             }
         }
         if running == 0 {
-            break;
+            // Nothing in flight here. Unless stopped or done, retry every job at once (claims
+            // may have been dropped by processes that died, records may have arrived); if that
+            // pass starts nothing either, the rest belongs to other processes.
+            if stats.cancel.is_some() || pending.is_empty() || (idle_sweep && !force_poll) {
+                break;
+            }
+            idle_sweep = true;
+            busy_until.clear();
+            force_poll = true;
+            continue;
         }
         let msg = match rx.recv_timeout(Duration::from_millis(100)) {
             Ok(m) => m,
             Err(mpsc::RecvTimeoutError::Timeout) => continue,
             Err(mpsc::RecvTimeoutError::Disconnected) => unreachable!("the scheduler holds a sender"),
         };
-        let ev = match msg {
-            WorkerMsg::Progress { index, worker, phase, iter, f, gamma } => CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma },
-            WorkerMsg::Warning { index, message } => CampaignEvent::Warning { index: Some(index), message },
+        match msg {
+            WorkerMsg::Progress { index, worker, phase, iter, f, gamma } => {
+                emit(Ok(CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma }), &mut first_err, &mut stats)
+            }
+            WorkerMsg::Warning { index, message } => emit(Ok(CampaignEvent::Warning { index: Some(index), message }), &mut first_err, &mut stats),
             WorkerMsg::Finished { index, worker, record } => {
                 running -= 1;
                 free.push(worker);
@@ -334,21 +464,23 @@ pub fn execute<E>(
                     stats.failed += 1;
                 }
                 finished.insert(record.job_id.clone(), record.controller.clone());
-                CampaignEvent::JobFinished { index, worker, record }
+                emit(Ok(CampaignEvent::JobFinished { index, worker, record }), &mut first_err, &mut stats);
+                // journaled (or the journal failed and the run stops): the claim can go
+                coord.release(&jobs[index]);
             }
             WorkerMsg::Interrupted { index, worker } => {
                 running -= 1;
                 free.push(worker);
                 stats.interrupted += 1;
-                CampaignEvent::JobInterrupted { index, worker }
+                emit(Ok(CampaignEvent::JobInterrupted { index, worker }), &mut first_err, &mut stats);
+                coord.release(&jobs[index]);
             }
-        };
-        emit(ev, &mut first_err, &mut stats);
+        }
     });
     drop(tx);
     stats.not_started = pending.len();
     let final_stats = stats.clone();
-    emit(CampaignEvent::Finished { stats: final_stats }, &mut first_err, &mut stats);
+    emit(Ok(CampaignEvent::Finished { stats: final_stats }), &mut first_err, &mut stats);
     match first_err {
         Some(e) => Err(ExecuteError::Callback(e)),
         None => Ok(stats),
@@ -393,6 +525,7 @@ impl DesignObserver for WorkerObserver<'_> {
 #[allow(clippy::too_many_arguments)]
 fn run_one(
     campaign: &str,
+    provenance: &Provenance,
     job: &Job,
     index: usize,
     worker: usize,
@@ -423,7 +556,10 @@ fn run_one(
     let cpu = thread_cpu_time() - cpu0;
     let wall = t0.elapsed().as_secs_f64();
     let user = obs.user.take();
-    match JobRecord::from_run(campaign, job, warm, result, cpu, wall) {
+    match JobRecord::from_run(campaign, job, warm, result, cpu, wall).map(|mut r| {
+        r.provenance = Some(provenance.clone());
+        r
+    }) {
         None => {
             if let Some(u) = user {
                 u.abandon();

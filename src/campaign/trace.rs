@@ -9,10 +9,13 @@
 //! Non-finite numbers are written as the strings `"inf"`, `"-inf"` or `"nan"` (JSON has no
 //! such numbers); the schema allows number or string for every float.
 //!
-//! The writer ([`TraceWriter`], a [`JobObserver`]) writes `<job_id>.mcap.tmp`, flushes every
+//! The writer ([`TraceWriter`], a [`JobObserver`]) writes `<job_id>.mcap.<host>.<pid>.tmp` (a
+//! name no other process uses, even on another machine sharing the folder), flushes every
 //! [`FLUSH_EVERY`] iterations or [`FLUSH_INTERVAL`], and on `finish` renames it atomically to
 //! `<job_id>.mcap`; `abandon` deletes the tmp file, so a cut-off run never leaves a
-//! complete-looking trace. An I/O error is kept and stops the job's tracing (never the job).
+//! complete-looking trace. The job's claim is held while it runs, so on creation the leftover
+//! tmp files of the same job (from a killed process) are deleted. An I/O error is kept and stops
+//! the job's tracing (never the job).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -149,12 +152,22 @@ pub struct TraceWriter {
 }
 
 impl TraceWriter {
-    /// Creates `<dir>/<job_id>.mcap.tmp` (and `dir`) and writes the header, schemas and channels.
+    /// Creates `<dir>/<job_id>.mcap.<host>.<pid>.tmp` (and `dir`), deleting other tmp files of
+    /// the job (the caller runs the job, so they are leftovers), and writes the header, schemas
+    /// and channels.
     pub fn create(dir: &Path, job_id: &str) -> Result<Self, TraceError> {
         let target = dir.join(format!("{job_id}.mcap"));
-        let tmp = dir.join(format!("{job_id}.mcap.tmp"));
+        let host = super::provenance::host_name();
+        let tmp = dir.join(format!("{job_id}.mcap.{host}.{}.tmp", std::process::id()));
         let io = |source| TraceError::Io { path: tmp.clone(), source };
         std::fs::create_dir_all(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?;
+        let stale = format!("{job_id}.mcap.");
+        for e in std::fs::read_dir(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?.flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            if name.starts_with(&stale) && name.ends_with(".tmp") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
         let file = File::create(&tmp).map_err(io)?;
         let mc = |source| TraceError::Mcap { path: tmp.clone(), source };
         let mut w = mcap::WriteOptions::new()

@@ -7,12 +7,15 @@ use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
 use anyhow::Context;
+use hinfix::campaign::claims::{unix_now, ClaimDir};
 use hinfix::campaign::fake::FakeRunner;
-use hinfix::campaign::journal::read_journal;
+use hinfix::campaign::journal::{journals_in, Follower};
 use hinfix::campaign::progress::{Display, Reporter};
 use hinfix::campaign::record::JobRecord;
-use hinfix::campaign::run::{campaign_dir, journal_path, records_by_id, records_of_jobs, run_jobs};
+use hinfix::campaign::reduce::plant_labels;
+use hinfix::campaign::run::{campaign_dir, duplicate_ids, records_for, run_jobs};
 use hinfix::campaign::scheduler::{DesignRunner, ExecuteOptions, JobRunner};
+use hinfix::campaign::shard::{self, Shard};
 use hinfix::campaign::{
     expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
 };
@@ -44,6 +47,20 @@ pub struct RunArgs {
     /// Plain log lines instead of live progress bars (automatic when stderr is not a terminal).
     #[arg(long)]
     pub no_progress: bool,
+    /// Run only shard K of N (1-based): a deterministic partition of the jobs that keeps
+    /// warm-start chains together and balances the CPU budgets. Any number of runs (shards or
+    /// not) may share one results folder.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<Shard>,
+}
+
+/// Extra journals merged into `status` and `report`.
+#[derive(clap::Args, Debug)]
+pub struct JournalArgs {
+    /// A journal file, or a results folder whose `runs*.jsonl` are all read, to merge with the
+    /// campaign's own folder (e.g. results copied from another machine). Repeatable.
+    #[arg(long = "journal", value_name = "PATH")]
+    pub journals: Vec<PathBuf>,
 }
 
 /// Arguments of `campaign status`.
@@ -51,6 +68,15 @@ pub struct RunArgs {
 pub struct StatusArgs {
     #[command(flatten)]
     pub campaign: CampaignFileArgs,
+    #[command(flatten)]
+    pub extra: JournalArgs,
+    /// Also show how `--shard K/N` splits the campaign into N shards: jobs, CPU budget and a wall
+    /// time bound per shard, and the time limit to give each task of a job array.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub shards: Option<u32>,
+    /// Worker threads per shard assumed by `--shards` (default: as `campaign run` would use).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256), requires = "shards")]
+    pub threads: Option<u32>,
 }
 
 /// Arguments of `campaign report`.
@@ -58,6 +84,8 @@ pub struct StatusArgs {
 pub struct ReportArgs {
     #[command(flatten)]
     pub campaign: CampaignFileArgs,
+    #[command(flatten)]
+    pub extra: JournalArgs,
 }
 
 /// Arguments of `campaign trace`.
@@ -89,15 +117,25 @@ fn load(a: &CampaignFileArgs) -> anyhow::Result<Loaded> {
     Ok(Loaded { campaign, jobs, dir, fake })
 }
 
+/// The campaign's plants by content fingerprint (their identity in records).
 fn plant_map(c: &Campaign) -> PlantMap {
-    c.problems.iter().map(|p| (p.plant.name.clone(), p.plant.clone())).collect::<BTreeMap<_, _>>()
+    c.problems.iter().map(|p| (p.fingerprint.clone(), p.plant.clone())).collect::<BTreeMap<_, _>>()
 }
 
-/// Reduces `records` to the report files in `dir` and prints the comparison.
+/// Reduces `records` (the campaign's, duplicates included) to the report files in `dir` and
+/// prints the comparison, and how many jobs were journaled more than once.
 fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Result<()> {
     let reference = load_default_reference().context("reading the paper's reference table")?;
     let summary = write_reports(dir, records, &plant_map(c), &reference)?;
     print!("{summary}");
+    let dups = duplicate_ids(records);
+    if !dups.is_empty() {
+        let extra: usize = dups.iter().map(|(_, n)| n - 1).sum();
+        eprintln!(
+            "note: {} job(s) have more than one record ({extra} extra); each counts once, by its best verified record",
+            dups.len()
+        );
+    }
     Ok(())
 }
 
@@ -105,6 +143,10 @@ fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Resul
 pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
     std::fs::create_dir_all(&l.dir).with_context(|| format!("creating {}", l.dir.display()))?;
+    let jobs = match a.shard {
+        Some(s) => shard::select(&l.jobs, s),
+        None => l.jobs.clone(),
+    };
     let threads = l.campaign.threads(a.threads.map(|t| t as usize));
     let opts = ExecuteOptions::new(&l.campaign.name, threads);
     let cancel = opts.cancel.clone();
@@ -115,9 +157,12 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         None => &DesignRunner,
     };
     let observers = trace_observers(&l.dir.join("traces"));
-    let mut reporter = Reporter::new(&l.jobs, Display::choose(a.no_progress));
-    eprintln!("campaign {} → {}", l.campaign.name, l.dir.display());
-    let outcome = run_jobs(&l.jobs, &l.dir, runner, &observers, &opts, |ev| reporter.on_event(ev))?;
+    let mut reporter = Reporter::new(&jobs, Display::choose(a.no_progress));
+    match a.shard {
+        Some(s) => eprintln!("campaign {} shard {s}: {} of {} jobs → {}", l.campaign.name, jobs.len(), l.jobs.len(), l.dir.display()),
+        None => eprintln!("campaign {} → {}", l.campaign.name, l.dir.display()),
+    }
+    let outcome = run_jobs(&jobs, &l.dir, runner, &observers, &opts, |ev| reporter.on_event(ev))?;
     if let Some(t) = &outcome.torn {
         eprintln!(
             "warning: {}: line {} was torn ({}); it was ignored and cut off",
@@ -126,70 +171,162 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
             t.reason
         );
     }
+    warn_torn(&outcome.torn_elsewhere);
     let s = &outcome.stats;
     eprintln!(
-        "{} jobs: {} were already done, {} finished now ({} failed), {} interrupted, {} not started",
-        s.total, s.already_done, s.finished, s.failed, s.interrupted, s.not_started
+        "{} jobs: {} were already done, {} finished now ({} failed), {} done by other processes meanwhile, {} interrupted, {} not started",
+        s.total, s.already_done, s.finished, s.failed, s.done_elsewhere, s.interrupted, s.not_started
     );
-    report_into(&l.dir, &l.campaign, &outcome.records)?;
+    if s.cancel.is_none() && s.not_started > 0 {
+        eprintln!(
+            "{} job(s) left to other processes that hold them (or their predecessors); `campaign status` shows them",
+            s.not_started
+        );
+    }
+    report_into(&l.dir, &l.campaign, &records_for(&l.jobs, &outcome.records))?;
     if outcome.interrupted() {
         eprintln!("interrupted: rerun the same command to resume");
         return Ok(ExitCode::from(EXIT_INTERRUPTED));
     }
     if outcome.failed() > 0 {
-        eprintln!("{} job(s) failed: see `status` in {}", outcome.failed(), outcome.journal.display());
+        eprintln!("{} job(s) failed: see `campaign status` and the journals in {}", outcome.failed(), l.dir.display());
         return Ok(ExitCode::from(EXIT_JOBS_FAILED));
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// The journal's records of this campaign's jobs (torn tail reported on stderr).
-fn journaled(l: &Loaded) -> anyhow::Result<Vec<JobRecord>> {
-    let path = journal_path(&l.dir);
-    let read = read_journal(&path)?;
-    if let Some(t) = &read.torn {
+fn warn_torn(torn: &[(PathBuf, hinfix::campaign::journal::TornTail)]) {
+    for (path, t) in torn {
         eprintln!("warning: {}: line {} is torn ({}); ignored", path.display(), t.line, t.reason);
     }
-    Ok(records_of_jobs(&l.jobs, &records_by_id(read.records)))
+}
+
+/// Every record of this campaign's jobs (duplicates included) in every journal of its folder
+/// and of `--journal` (torn tails reported on stderr), and the journals read.
+fn journaled(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<(Vec<JobRecord>, Vec<PathBuf>)> {
+    let mut dirs = vec![l.dir.clone()];
+    let mut files = Vec::new();
+    for p in &extra.journals {
+        if p.is_dir() {
+            if journals_in(p)?.is_empty() {
+                anyhow::bail!("--journal {}: the folder holds no journal (runs*.jsonl)", p.display());
+            }
+            dirs.push(p.clone());
+        } else if p.is_file() {
+            files.push(p.clone());
+        } else {
+            anyhow::bail!("--journal {}: no such file or folder", p.display());
+        }
+    }
+    let mut follower = Follower::new(dirs, files, None);
+    let records = follower.poll()?;
+    warn_torn(&follower.torn());
+    Ok((records_for(&l.jobs, &records), follower.journals()))
 }
 
 /// `campaign status FILE`.
 pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
-    let records = journaled(&l)?;
-    let done: HashMap<_, _> = records.iter().map(|r| (&r.job_id, r)).collect();
-    // plant → (jobs, done, failed), in campaign order.
-    let mut rows: Vec<(String, usize, usize, usize)> = Vec::new();
+    let (records, journals) = journaled(&l, &a.extra)?;
+    // job id → whether some record of it did not fail
+    let mut done: HashMap<_, bool> = HashMap::new();
+    for r in &records {
+        *done.entry(&r.job_id).or_default() |= !r.failed();
+    }
+    let claims = ClaimDir::new(&l.dir).list()?;
+    let index: HashMap<_, _> = l.jobs.iter().map(|j| (&j.id, j)).collect();
+    let running: HashMap<_, _> =
+        claims.iter().filter(|c| c.held && !done.contains_key(&c.job)).filter_map(|c| index.get(&c.job).map(|j| (&j.id, c))).collect();
+    let labels = plant_labels(l.jobs.iter().map(|j| (j.plant_fingerprint.as_str(), j.plant_name.as_str())));
+    // plant → (jobs, done, running, failed), in campaign order; plants by fingerprint.
+    let mut rows: Vec<(&str, usize, usize, usize, usize)> = Vec::new();
     for j in &l.jobs {
-        let i = match rows.iter().position(|r| r.0 == j.plant_name) {
+        let label = labels[&j.plant_fingerprint].as_str();
+        let i = match rows.iter().position(|r| r.0 == label) {
             Some(i) => i,
             None => {
-                rows.push((j.plant_name.clone(), 0, 0, 0));
+                rows.push((label, 0, 0, 0, 0));
                 rows.len() - 1
             }
         };
         rows[i].1 += 1;
-        if let Some(r) = done.get(&j.id) {
+        if let Some(ok) = done.get(&j.id) {
             rows[i].2 += 1;
-            rows[i].3 += r.failed() as usize;
+            rows[i].4 += !ok as usize;
+        } else if running.contains_key(&j.id) {
+            rows[i].3 += 1;
         }
     }
-    println!("campaign {} ({})", l.campaign.name, journal_path(&l.dir).display());
-    println!("{:<16} {:>6} {:>6} {:>9} {:>7}", "plant", "jobs", "done", "remaining", "failed");
-    for (p, n, d, f) in &rows {
-        println!("{p:<16} {n:>6} {d:>6} {:>9} {f:>7}", n - d);
+    let names: Vec<String> = journals.iter().map(|p| p.display().to_string()).collect();
+    println!("campaign {} ({} journal(s): {})", l.campaign.name, names.len(), names.join(", "));
+    println!("{:<16} {:>6} {:>6} {:>8} {:>9} {:>7}", "plant", "jobs", "done", "running", "remaining", "failed");
+    for (p, n, d, r, f) in &rows {
+        println!("{p:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", n - d - r);
     }
-    let (n, d, f) = rows.iter().fold((0, 0, 0), |acc, r| (acc.0 + r.1, acc.1 + r.2, acc.2 + r.3));
-    println!("{:<16} {n:>6} {d:>6} {:>9} {f:>7}", "total", n - d);
+    let (n, d, r, f) = rows.iter().fold((0, 0, 0, 0), |acc, x| (acc.0 + x.1, acc.1 + x.2, acc.2 + x.3, acc.3 + x.4));
+    println!("{:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", "total", n - d - r);
+    if !running.is_empty() {
+        println!("running:");
+        for j in l.jobs.iter().filter(|j| running.contains_key(&j.id)) {
+            let who = match &running[&j.id].owner {
+                Some(o) => format!("{}:{} for {:.0} s", o.host, o.pid, (unix_now() - o.since_unix_s).max(0.0)),
+                None => "(owner not written yet)".into(),
+            };
+            println!("  {}  {}  {who}", j.id.short(), j.label());
+        }
+    }
+    let stale = claims.iter().filter(|c| !c.held && !done.contains_key(&c.job)).count();
+    if stale > 0 {
+        println!("{stale} claim(s) left by processes that died: those jobs run again at the next `campaign run`");
+    }
+    let dups = duplicate_ids(&records);
+    if !dups.is_empty() {
+        println!("{} job(s) have more than one record; reports count each once, by its best verified record:", dups.len());
+        for (id, n) in &dups {
+            let label = index.get(id).map_or_else(String::new, |j| j.label());
+            println!("  {}  {label}  {n} records", id.short());
+        }
+    }
+    if let Some(n) = a.shards {
+        print_shards(&l, n as usize, l.campaign.threads(a.threads.map(|t| t as usize)));
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The shard plan of `status --shards N`. A shard's wall time is bounded by list scheduling on
+/// `threads` workers: Σ cpumax / threads + its longest warm-start chain (Graham's bound; jobs
+/// stop at their CPU budget, and a worker thread gets a CPU to itself). The array time limit
+/// adds 25 % and 10 minutes for start-up, reports and a loaded node.
+fn print_shards(l: &Loaded, n: usize, threads: usize) {
+    let assign = shard::assign(&l.jobs, n);
+    let index: HashMap<_, _> = l.jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
+    // budget of the chain up to and including each job
+    let mut chain = vec![0.0f64; l.jobs.len()];
+    for (i, j) in l.jobs.iter().enumerate() {
+        let before = j.warm_from.as_ref().and_then(|p| index.get(p)).map_or(0.0, |&p| chain[p]);
+        chain[i] = before + j.options.cpumax;
+    }
+    println!("{n} shard(s) at {threads} thread(s) each:");
+    println!("{:>8} {:>6} {:>12} {:>14}", "shard", "jobs", "cpu budget", "wall bound");
+    let mut worst = 0.0f64;
+    for k in 0..n {
+        let mine: Vec<usize> = (0..l.jobs.len()).filter(|&i| assign[i] == k).collect();
+        let cpu: f64 = mine.iter().map(|&i| l.jobs[i].options.cpumax).sum();
+        let longest = mine.iter().map(|&i| chain[i]).fold(0.0, f64::max);
+        let wall = cpu / threads as f64 + longest;
+        worst = worst.max(wall);
+        println!("{:>8} {:>6} {:>10.0} s {:>12.0} s", format!("{}/{n}", k + 1), mine.len(), cpu, wall);
+    }
+    let limit = (worst * 1.25 + 600.0).ceil() as u64;
+    println!("slurm time per task: {}-{:02}:{:02}:{:02}", limit / 86400, limit % 86400 / 3600, limit % 3600 / 60, limit % 60);
 }
 
 /// `campaign report FILE`.
 pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
-    let records = journaled(&l)?;
+    let (records, journals) = journaled(&l, &a.extra)?;
     if records.is_empty() {
-        anyhow::bail!("{}: no finished jobs of this campaign yet (run it first)", journal_path(&l.dir).display());
+        anyhow::bail!("{}: no finished jobs of this campaign in {} journal(s) (run it first)", l.dir.display(), journals.len());
     }
     report_into(&l.dir, &l.campaign, &records)?;
     Ok(ExitCode::SUCCESS)

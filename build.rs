@@ -1,0 +1,35 @@
+//! Build script: records the git commit the binary is built from (for the provenance of every
+//! journal record, `campaign::provenance`). Outside a git checkout (a source tarball, a crate
+//! download) `git` fails and the commit is simply unknown; the build never fails because of it.
+//! `HINFIX_GIT_COMMIT` set at build time overrides (for packagers building from an export).
+use std::process::Command;
+
+fn git(args: &[&str]) -> Option<String> {
+    let out = Command::new("git").args(args).output().ok()?;
+    let s = String::from_utf8(out.stdout).ok()?.trim().to_string();
+    (out.status.success() && !s.is_empty()).then_some(s)
+}
+
+fn main() {
+    println!("cargo:rerun-if-env-changed=HINFIX_GIT_COMMIT");
+    let commit = match std::env::var("HINFIX_GIT_COMMIT") {
+        Ok(c) if !c.trim().is_empty() => Some(c.trim().to_string()),
+        _ => git(&["rev-parse", "HEAD"]),
+    };
+    if commit.is_some() {
+        // Rebuild when HEAD moves: HEAD itself, the branch it points to, and packed refs.
+        let mut watch = vec![git(&["rev-parse", "--git-path", "HEAD"])];
+        if let Some(r) = git(&["symbolic-ref", "-q", "HEAD"]) {
+            watch.push(git(&["rev-parse", "--git-path", &r]));
+        }
+        watch.push(git(&["rev-parse", "--git-path", "packed-refs"]));
+        for p in watch.into_iter().flatten() {
+            if std::path::Path::new(&p).exists() {
+                println!("cargo:rerun-if-changed={p}");
+            }
+        }
+    } else {
+        println!("cargo:rerun-if-changed=build.rs");
+    }
+    println!("cargo:rustc-env=HINFIX_GIT_COMMIT={}", commit.unwrap_or_default());
+}
