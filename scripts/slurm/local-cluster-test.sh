@@ -70,7 +70,7 @@ install -d -o munge -g munge -m 755 "$mdir"
 sock=$mdir/munge.socket
 setpriv --reuid=munge --regid=munge --init-groups \
     munged -F --socket="$sock" --pid-file="$mdir/munged.pid" --log-file="$mdir/munged.log" \
-    --seed-file="$mdir/munged.seed" --key-file=/etc/munge/munge.key &
+    --seed-file="$mdir/munged.seed" --key-file=/etc/munge/munge.key 2>"$mdir/munged.err" &
 pids+=($!)
 for _ in $(seq 50); do [ -S "$sock" ] && break; sleep 0.1; done
 [ -S "$sock" ] || { echo "munged did not start"; exit 1; }
@@ -78,7 +78,9 @@ munge -S "$sock" -n | unmunge -S "$sock" >/dev/null
 say "munged up (pid ${pids[-1]})"
 
 host=$(hostname -s)
-cpus=$(nproc)
+# Six CPUs whatever the machine has (config_overrides), so that the three 2-CPU tasks run at the
+# same time and really share the results folder; CPU budgets make the results independent of it.
+cpus=6
 mkdir -p "$work/state" "$work/spool"
 cat > "$work/slurm.conf" <<CONF
 ClusterName=hinfixtest
@@ -106,6 +108,7 @@ SelectTypeParameters=CR_CPU
 SchedulerType=sched/backfill
 MpiDefault=none
 ReturnToService=2
+SlurmdParameters=config_overrides
 NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
@@ -120,7 +123,7 @@ for _ in $(seq 100); do
     sleep 0.3
 done
 [ "$state" = idle ] || { echo "the node did not come up (state '$state')"; sinfo || true; exit 1; }
-say "slurmctld (pid ${pids[-2]}) and slurmd (pid ${pids[-1]}) up; node $host idle with $cpus CPUs"
+say "slurmctld (pid ${pids[-2]}) and slurmd (pid ${pids[-1]}) up; node $host idle with $cpus CPUs ($(nproc) real)"
 
 # ---- 3. the array ----
 results=$work/results
@@ -130,8 +133,14 @@ sub=$(bash scripts/slurm/campaign.sbatch campaigns/smoke.toml 3 "$results")
 echo "$sub"
 jobid=$(echo "$sub" | awk '/Submitted batch job/ {print $4}')
 [ -n "$jobid" ] || { echo "submission failed"; exit 1; }
+shown=0
 while [ -n "$(squeue -h -j "$jobid" 2>/dev/null)" ]; do
     sleep 5
+    if [ $shown -eq 0 ] && [ $(( $(date +%s) - t0 )) -ge 20 ]; then
+        shown=1
+        squeue -j "$jobid" || true
+        "$bin" status campaigns/smoke.toml --results "$results" || true
+    fi
     [ $(( $(date +%s) - t0 )) -lt 3600 ] || { echo "the array did not finish within an hour"; exit 1; }
 done
 say "array $jobid finished after $(( $(date +%s) - t0 )) s"
@@ -156,5 +165,6 @@ tmps=$(find "$results/smoke/traces" -name '*.tmp' | wc -l)
 for k in 1 2 3; do
     grep -q "hinfix shard $k/3" "$work"/slurm-"$jobid"_*.out || { echo "FAIL: no output of shard $k/3"; fail=1; }
 done
+grep -h -o '"host":"[^"]*"' "${journals[@]}" | sort | uniq -c | sed 's/^/[local-cluster-test] provenance /'
 [ $fail -eq 0 ] && say "PASS: all 24 jobs done exactly once by a 3-task array into one folder"
 exit $fail

@@ -16,8 +16,15 @@
 //! dropped).
 //!
 //! Stale claims need no detection: the kernel drops the lock when its process dies, `kill -9`
-//! included, so the file left behind is free for the next claimant. (A process that only holds
-//! the file without the lock — a stale leftover — shows in `status` as "stale".)
+//! included, so the file left behind is free for the next claimant. (A claim file without its
+//! lock — left by a dead process — shows in `status` as stale.)
+//!
+//! One case keeps a dead owner's lock: a machine that crashed while holding locks on an NFSv3
+//! share keeps them until it reboots. As a safety net, a claim held by a process on *another*
+//! host for longer than [`overdue_after`] (twice the job's CPU budget plus [`OVERDUE_MARGIN`]) is
+//! broken: under the job's break lock (`<job id>.break`, so that only one process breaks it), the
+//! file is renamed away and claimed afresh. If its owner was in fact alive the job then runs
+//! twice, which costs time but no result (readers count a job once).
 //!
 //! NFS: `flock` on an NFS mount is a whole-file POSIX lock at the server (Linux ≥ 2.6.12; NFSv4
 //! locks, or NFSv3 with the NLM lock daemon). This needs locking to be enabled (not the `nolock`
@@ -27,13 +34,22 @@
 //! second descriptor would drop the lock); this module never does.
 
 use std::fs::{File, OpenOptions};
-use std::io::{self, Read, Write};
+use std::io::{self, Read, Seek, Write};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use super::jobs::JobId;
+
+/// Slack of [`overdue_after`] (s): clock skew between hosts, a loaded node, journal and trace I/O.
+pub const OVERDUE_MARGIN: f64 = 600.0;
+
+/// How long (s) a job with CPU budget `cpumax` may stay claimed by a process on another host
+/// before its claim is broken: 2·cpumax + [`OVERDUE_MARGIN`].
+pub fn overdue_after(cpumax: f64) -> f64 {
+    2.0 * cpumax + OVERDUE_MARGIN
+}
 
 /// The claims folder inside a campaign's results folder.
 pub const CLAIMS_DIR: &str = "claims";
@@ -128,17 +144,25 @@ impl ClaimDir {
         self.dir.join(format!("{job}.claim"))
     }
 
-    /// Tries to claim `job` for `owner` (see the module docs).
-    pub fn try_claim(&self, job: &JobId, owner: &ClaimOwner) -> Result<TryClaim, ClaimError> {
+    /// Tries to claim `job` (CPU budget `cpumax` s) for `owner` (see the module docs).
+    pub fn try_claim(&self, job: &JobId, cpumax: f64, owner: &ClaimOwner) -> Result<TryClaim, ClaimError> {
         let path = self.path(job);
         let err = |source| ClaimError { path: path.clone(), source };
         std::fs::create_dir_all(&self.dir).map_err(|source| ClaimError { path: self.dir.clone(), source })?;
-        // A few rounds at most: each retry means a finishing owner unlinked the file in between.
+        let mut broke = false;
+        // A few rounds at most: each retry means a finishing owner unlinked the file in between
+        // (or we broke an overdue claim).
         for _ in 0..16 {
-            let file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).map_err(err)?;
+            let mut file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).map_err(err)?;
             match file.try_lock() {
                 Ok(()) => {}
-                Err(std::fs::TryLockError::WouldBlock) => return Ok(TryClaim::Busy),
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    if !broke && self.break_if_overdue(job, &mut file, cpumax, owner)? {
+                        broke = true;
+                        continue;
+                    }
+                    return Ok(TryClaim::Busy);
+                }
                 Err(std::fs::TryLockError::Error(e)) => return Err(err(e)),
             }
             let ours = file.metadata().map_err(err)?;
@@ -154,6 +178,43 @@ impl ClaimDir {
             return Ok(TryClaim::Claimed(ClaimGuard { path, file }));
         }
         Ok(TryClaim::Busy)
+    }
+
+    /// Breaks the held claim open in `file` if its owner is on another host and has held it for
+    /// longer than [`overdue_after`]`(cpumax)`; true if it did.
+    fn break_if_overdue(&self, job: &JobId, file: &mut File, cpumax: f64, me: &ClaimOwner) -> Result<bool, ClaimError> {
+        let overdue = |f: &mut File| -> bool {
+            let mut text = String::new();
+            let read = f.seek(std::io::SeekFrom::Start(0)).and_then(|_| f.read_to_string(&mut text));
+            match (read, serde_json::from_str::<ClaimOwner>(&text)) {
+                (Ok(_), Ok(o)) => o.host != me.host && unix_now() - o.since_unix_s > overdue_after(cpumax),
+                _ => false,
+            }
+        };
+        if !overdue(file) {
+            return Ok(false);
+        }
+        let path = self.path(job);
+        let lock_path = self.dir.join(format!("{job}.break"));
+        let err = |p: &Path| {
+            let p = p.to_path_buf();
+            move |source| ClaimError { path: p, source }
+        };
+        let lock = OpenOptions::new().write(true).create(true).truncate(false).open(&lock_path).map_err(err(&lock_path))?;
+        lock.lock().map_err(err(&lock_path))?;
+        // Under the break lock, look again: another process may have broken it already.
+        let mut again = match File::open(&path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(true),
+            Err(e) => return Err(err(&path)(e)),
+        };
+        let still = matches!(again.try_lock_shared(), Err(std::fs::TryLockError::WouldBlock)) && overdue(&mut again);
+        if still {
+            let away = self.dir.join(format!("{job}.claim.broken.{}.{}", me.host, me.pid));
+            std::fs::rename(&path, &away).map_err(err(&path))?;
+            let _ = std::fs::remove_file(&away);
+        }
+        Ok(true)
     }
 
     /// Every claim file, held or left behind, sorted by job id. A missing folder is no claims.
@@ -221,16 +282,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let claims = ClaimDir::new(dir.path());
         let id = JobId("ab".repeat(32));
-        let TryClaim::Claimed(g) = claims.try_claim(&id, &owner()).unwrap() else { panic!("free claim refused") };
+        let TryClaim::Claimed(g) = claims.try_claim(&id, 10.0, &owner()).unwrap() else { panic!("free claim refused") };
         // A second claimant (another open file description, as another process would have).
-        assert!(matches!(claims.try_claim(&id, &owner()).unwrap(), TryClaim::Busy));
+        assert!(matches!(claims.try_claim(&id, 10.0, &owner()).unwrap(), TryClaim::Busy));
         let list = claims.list().unwrap();
         assert_eq!(list.len(), 1);
         assert!(list[0].held);
         assert_eq!(list[0].owner.as_ref().unwrap().pid, std::process::id());
         g.release();
         assert!(claims.list().unwrap().is_empty(), "release removes the file");
-        assert!(matches!(claims.try_claim(&id, &owner()).unwrap(), TryClaim::Claimed(_)));
+        assert!(matches!(claims.try_claim(&id, 10.0, &owner()).unwrap(), TryClaim::Claimed(_)));
     }
 
     #[test]
@@ -238,10 +299,35 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let claims = ClaimDir::new(dir.path());
         let id = JobId("cd".repeat(32));
-        let TryClaim::Claimed(g) = claims.try_claim(&id, &owner()).unwrap() else { panic!() };
+        let TryClaim::Claimed(g) = claims.try_claim(&id, 10.0, &owner()).unwrap() else { panic!() };
         drop(g); // as a killed process: lock gone, file left
         let list = claims.list().unwrap();
         assert_eq!((list.len(), list[0].held), (1, false));
-        assert!(matches!(claims.try_claim(&id, &owner()).unwrap(), TryClaim::Claimed(_)));
+        assert!(matches!(claims.try_claim(&id, 10.0, &owner()).unwrap(), TryClaim::Claimed(_)));
+    }
+
+    #[test]
+    fn only_an_overdue_claim_of_another_host_is_broken() {
+        let dir = tempfile::tempdir().unwrap();
+        let claims = ClaimDir::new(dir.path());
+        let id = JobId("ef".repeat(32));
+        let old = unix_now() - overdue_after(10.0) - 1.0;
+        for (host, since, broken) in [("elsewhere", old, true), ("elsewhere", unix_now(), false), (owner().host.as_str(), old, false)] {
+            let ghost = ClaimOwner { host: host.to_string(), since_unix_s: since, ..owner() };
+            let TryClaim::Claimed(g) = claims.try_claim(&id, 10.0, &ghost).unwrap() else { panic!() };
+            match claims.try_claim(&id, 10.0, &owner()).unwrap() {
+                TryClaim::Claimed(mine) => {
+                    assert!(broken, "{host} {since}: broken");
+                    // the ghost's late release does not remove the new claim
+                    g.release();
+                    assert!(mine.path().exists());
+                    mine.release();
+                }
+                TryClaim::Busy => {
+                    assert!(!broken, "{host} {since}: not broken");
+                    g.release();
+                }
+            }
+        }
     }
 }

@@ -148,7 +148,7 @@ impl SharedFolder {
 impl Coordinator<RunError> for SharedFolder {
     fn claim(&mut self, job: &Job) -> Result<Claim, RunError> {
         self.owner.since_unix_s = super::claims::unix_now();
-        let guard = match self.claims.try_claim(&job.id, &self.owner)? {
+        let guard = match self.claims.try_claim(&job.id, job.options.cpumax, &self.owner)? {
             TryClaim::Busy => return Ok(Claim::Busy),
             TryClaim::Claimed(g) => g,
         };

@@ -240,7 +240,8 @@ pub struct ExecuteOptions {
     pub cancel: Arc<AtomicBool>,
     /// Minimum time between two progress events of one job.
     pub progress_interval: Duration,
-    /// Time between two [`Coordinator::poll`]s.
+    /// Time between two [`Coordinator::poll`]s (claims re-read the journals anyway; polling only
+    /// drops jobs finished elsewhere from the queue sooner).
     pub poll_interval: Duration,
     /// Written into every record.
     pub provenance: Provenance,
@@ -254,7 +255,7 @@ impl ExecuteOptions {
             campaign: campaign.to_string(),
             cancel: Arc::new(AtomicBool::new(false)),
             progress_interval: Duration::from_millis(200),
-            poll_interval: Duration::from_secs(1),
+            poll_interval: Duration::from_secs(5),
             provenance: Provenance::here(threads.max(1)),
         }
     }
