@@ -12,9 +12,13 @@ fn git(args: &[&str]) -> Option<String> {
 
 fn main() {
     println!("cargo:rerun-if-env-changed=HINFIX_GIT_COMMIT");
+    // Only a checkout of this crate itself counts (not an enclosing repository it is vendored in).
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").ok().and_then(|d| std::fs::canonicalize(d).ok());
+    let toplevel = git(&["rev-parse", "--show-toplevel"]).and_then(|d| std::fs::canonicalize(d).ok());
     let commit = match std::env::var("HINFIX_GIT_COMMIT") {
         Ok(c) if !c.trim().is_empty() => Some(c.trim().to_string()),
-        _ => git(&["rev-parse", "HEAD"]),
+        _ if manifest.is_some() && manifest == toplevel => git(&["rev-parse", "HEAD"]),
+        _ => None,
     };
     if commit.is_some() {
         // Rebuild when HEAD moves: HEAD itself, the branch it points to, and packed refs.
