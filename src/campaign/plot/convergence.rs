@@ -75,9 +75,12 @@ impl ConvergenceFigure {
             .collect()
     }
 
-    fn x_range(&self) -> (f64, f64) {
+    /// x range of a panel: the whole run for the objective; for the stabilisation panel only
+    /// its own iterations (it usually takes a small fraction of the run and would be a sliver).
+    fn x_range(&self, stab: bool) -> (f64, f64) {
         let n = self.iterations.len();
-        let hi = (0..n).map(|i| self.x_of(i)).filter(|x| x.is_finite()).fold(0f64, f64::max);
+        let xs = (0..n).filter(|&i| !stab || self.iterations[i].phase == STABILISATION).map(|i| self.x_of(i));
+        let hi = xs.filter(|x| x.is_finite()).fold(0f64, f64::max);
         (0.0, if hi > 0.0 { hi * 1.02 } else { 1.0 })
     }
 
@@ -86,14 +89,18 @@ impl ConvergenceFigure {
         Y: AsRangedCoord<Value = f64>,
         Y::CoordDescType: ValueFormatter<f64>,
     {
-        let (x0, x1) = self.x_range();
+        let (x0, x1) = self.x_range(stab);
         let mut b = ChartBuilder::on(area);
         b.margin(14).x_label_area_size(50).y_label_area_size(90);
         if let Some(c) = caption {
             b.caption(c, (FONT_FAMILY, 24));
         }
         let mut chart = b.build_cartesian_2d(x0..x1, y).map_err(msg)?;
-        let x_desc = if self.x_is_cpu() { "CPU time (s)" } else { "iteration (no CPU time in the trace)" };
+        let x_desc = match (self.x_is_cpu(), stab) {
+            (true, false) => "CPU time (s)",
+            (true, true) => "CPU time (s), stabilisation phase only",
+            (false, _) => "iteration (no CPU time in the trace)",
+        };
         let y_desc = if stab { "max(α(A_cl), ε·α(A_K))" } else { "objective max(‖T_zw‖∞, ε‖K‖∞)" };
         chart
             .configure_mesh()
@@ -101,6 +108,7 @@ impl ConvergenceFigure {
             .y_desc(y_desc)
             .y_label_formatter(&|v| tick(*v))
             .x_label_formatter(&|v| tick(*v))
+            .max_light_lines(2)
             .label_style((FONT_FAMILY, 15))
             .axis_desc_style((FONT_FAMILY, 17))
             .draw()
@@ -109,14 +117,14 @@ impl ConvergenceFigure {
             let r = chart.plotting_area().get_y_range();
             (r.start, r.end)
         };
-        for m in self.phase_markers() {
+        for m in self.phase_markers().into_iter().filter(|m| m.x <= x1) {
             let style = ShapeStyle::from(&colour::MARK).stroke_width(2);
             chart.draw_series(DashedLineSeries::new(vec![(m.x, ylo), (m.x, yhi)], 8, 5, style)).map_err(msg)?;
             chart
                 .draw_series(std::iter::once(Text::new(format!(" {}", m.label), (m.x, yhi), (FONT_FAMILY, 15).into_font().color(&colour::MARK))))
                 .map_err(msg)?;
         }
-        for m in self.restart_markers() {
+        for m in self.restart_markers().into_iter().filter(|m| m.x <= x1) {
             chart.draw_series(DashedLineSeries::new(vec![(m.x, ylo), (m.x, yhi)], 2, 4, ShapeStyle::from(&colour::MARK.mix(0.6)))).map_err(msg)?;
         }
         if stab {
@@ -124,7 +132,7 @@ impl ConvergenceFigure {
         }
         // One line per (phase, start) run, so that restarts are not joined to their predecessor.
         let pts = self.points(stab);
-        let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+        let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
         let mut prev: Option<usize> = None;
         for i in 0..self.iterations.len() {
             let it = &self.iterations[i];
@@ -133,20 +141,21 @@ impl ConvergenceFigure {
             }
             let key_changed = prev.is_none_or(|p| self.iterations[p].phase != it.phase || self.iterations[p].start != it.start);
             if key_changed {
-                runs.push(Vec::new());
+                let restart = prev.is_some_and(|p| self.iterations[p].phase == it.phase);
+                runs.push((restart, Vec::new()));
             }
-            runs.last_mut().expect("pushed above").push((self.x_of(i), it.f));
+            runs.last_mut().expect("pushed above").1.push((self.x_of(i), it.f));
             prev = Some(i);
         }
         let line_colour = if stab { colour::PAPER } else { colour::OURS };
-        for (n, run) in runs.iter().enumerate() {
+        for (n, (restart, run)) in runs.iter().enumerate() {
             let s = chart.draw_series(LineSeries::new(run.clone(), line_colour.stroke_width(2))).map_err(msg)?;
             if n == 0 {
                 let label = if stab { "stabilisation objective" } else { "objective (BFGS, gradient sampling)" };
                 s.label(label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], line_colour.stroke_width(2)));
             }
-            // restart marker at the first point of every run after the first
-            if n > 0 {
+            // restart marker at the first point of a new start within the same phase
+            if *restart {
                 let p = run[0];
                 chart.draw_series(std::iter::once(TriangleMarker::new(p, 8, colour::MARK.filled()))).map_err(msg)?;
             }

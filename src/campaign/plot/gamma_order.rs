@@ -56,6 +56,7 @@ impl GammaOrderFigure {
             .x_labels(kmax - kmin + 3)
             .x_label_formatter(&|v| if (v - v.round()).abs() < 1e-9 && *v >= 0.0 { format!("{}", v.round()) } else { String::new() })
             .y_label_formatter(&|v| tick(*v))
+            .max_light_lines(2)
             .label_style((FONT_FAMILY, 16))
             .axis_desc_style((FONT_FAMILY, 18))
             .draw()

@@ -55,6 +55,7 @@ pub fn png_bytes(fig: &impl Figure, path: &Path) -> Result<Vec<u8>, PlotError> {
     let mut enc = png::Encoder::new(&mut out, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Best);
     let mut writer = enc.write_header().map_err(encode)?;
     writer.write_image_data(&rgb).map_err(encode)?;
     writer.finish().map_err(encode)?;
