@@ -28,7 +28,8 @@ use serde_json::{Map, Value};
 
 use super::controller::{Controller, ControllerErrorKind};
 use super::matrix_json::MatrixJsonError;
-use super::plant::{Plant, PlantErrorKind};
+// The plant variables in file order, with the dims their rows and columns give.
+use super::plant::{Plant, PlantErrorKind, MATRICES as PLANT_VARS};
 
 /// A real 2-D variable of a MAT-file, column-major.
 #[derive(Debug, Clone, PartialEq)]
@@ -251,19 +252,6 @@ fn element(out: &mut Vec<u8>, ty: u32, data: &[u8]) {
     out.resize(out.len() + (8 - data.len() % 8) % 8, 0);
 }
 
-/// The plant variables in file order with the dims their rows and columns give.
-const PLANT_VARS: [(&str, &str, &str); 9] = [
-    ("A", "n", "n"),
-    ("B1", "n", "m1"),
-    ("B2", "n", "m2"),
-    ("C1", "p1", "n"),
-    ("C2", "p2", "n"),
-    ("D11", "p1", "m1"),
-    ("D12", "p1", "m2"),
-    ("D21", "p2", "m1"),
-    ("D22", "p2", "m2"),
-];
-
 const PLANT_HINT: &str =
     " (a plant .mat file holds A B1 B2 C1 C2 D11 D12 D21 D22 as real full numeric arrays; character, cell, struct and sparse variables are not read)";
 
@@ -279,6 +267,11 @@ fn infer(vars: &BTreeMap<String, MatVar>, dim: &str) -> usize {
         }
     }
     0
+}
+
+/// A variable as a JSON array of rows.
+fn var_to_json(v: &MatVar) -> Value {
+    Value::Array((0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect())).collect())
 }
 
 fn json_number(x: f64) -> Value {
@@ -321,7 +314,7 @@ fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
             let (rows, cols) = (dims[r], dims[c]);
             Value::Array((0..rows).map(|_| Value::Array(vec![json_number(0.0); cols])).collect())
         } else {
-            Value::Array((0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect())).collect())
+            var_to_json(v)
         };
         doc.insert(key.into(), value);
     }
@@ -353,8 +346,7 @@ pub(crate) fn controller_from_mat(bytes: &[u8]) -> Result<Controller, Controller
             let problem = MatrixJsonError::NotFinite { row, col, value: v.data[i] };
             return Err(ControllerErrorKind::Matrix { matrix: key, problem });
         }
-        let rows = (0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect()));
-        doc.insert(key.into(), Value::Array(rows.collect()));
+        doc.insert(key.into(), var_to_json(v));
     }
     // `[]` (a 0×0 AK, BK, CK of a static gain) is accepted for any block without entries.
     Controller::from_json_value(&Value::Object(doc))

@@ -143,7 +143,7 @@ pub enum PlantErrorKind {
 }
 
 /// The nine matrices with the dims their shapes come from.
-const MATRICES: [(&str, &str, &str); 9] = [
+pub(crate) const MATRICES: [(&str, &str, &str); 9] = [
     ("A", "n", "n"),
     ("B1", "n", "m1"),
     ("B2", "n", "m2"),

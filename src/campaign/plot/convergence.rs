@@ -11,7 +11,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
+use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
 use crate::campaign::trace::TraceIteration;
 
 /// Name of the stabilisation phase in traces.
@@ -175,14 +175,7 @@ impl ConvergenceFigure {
                 .label("restart (new starting point)")
                 .legend(|(x, y)| TriangleMarker::new((x + 12, y), 7, colour::MARK.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 15))
-            .draw()
-            .map_err(msg)
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 
     fn panel_auto<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, stab: bool, caption: Option<&str>) -> Result<(), String> {

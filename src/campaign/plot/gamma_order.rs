@@ -6,7 +6,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
+use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
 
 /// Data of one γ-vs-order figure.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,14 +99,7 @@ impl GammaOrderFigure {
                         + Circle::new((0, 0), 5, c.filled())
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 16))
-            .draw()
-            .map_err(msg)
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
 

@@ -138,6 +138,21 @@ pub fn tick(x: f64) -> String {
     }
 }
 
+/// Draws the legend of `chart` at `pos` (white box, black border), as every figure does.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    pos: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(pos)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT_FAMILY, 15))
+        .draw()
+        .map_err(msg)
+}
+
 /// Colours of the series (colour-blind-safe Okabe–Ito palette).
 pub mod colour {
     use plotters::style::RGBColor;

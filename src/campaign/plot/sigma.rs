@@ -9,7 +9,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, msg, tick, Figure, FONT_FAMILY};
+use super::render::{colour, draw_legend, msg, tick, Figure, FONT_FAMILY};
 use crate::lti::freq_response::FreqResponse;
 use crate::lti::{closed_loop, hinf_norm, Controller, LtiError, Plant, StateSpace, DEFAULT_HINF_TOL};
 
@@ -127,13 +127,6 @@ impl Figure for SigmaFigure {
                 .label(text)
                 .legend(|(x, y)| Circle::new((x + 12, y), 6, colour::PAPER.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 15))
-            .draw()
-            .map_err(msg)
+        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
     }
 }
