@@ -156,3 +156,18 @@ fn command_line_designs_into_mat_checks_plots_and_exports_it() {
     let first: f64 = dk_line.trim_start_matches("DK = [").split([',', ';', ']']).next().unwrap().trim().parse().unwrap();
     assert_eq!(first.to_bits(), kk.dk[(0, 0)].to_bits());
 }
+
+#[test]
+fn a_campaign_may_name_a_mat_plant_and_gets_the_same_job_ids() {
+    use hinfix::campaign::{expand, Campaign, RunnerTag};
+    let dir = tempfile::tempdir().unwrap();
+    let ids = |plant: &Path| {
+        let f = dir.path().join("c.toml");
+        std::fs::write(&f, format!("name = \"m\"\n[defaults]\nseeds = 2\n[[problem]]\nplant = \"{}\"\norders = [1, 2]\n", plant.display())).unwrap();
+        let c = Campaign::load(&f).unwrap_or_else(|e| panic!("{e}"));
+        expand(&c, RunnerTag::Design).into_iter().map(|j| j.id.0).collect::<Vec<_>>()
+    };
+    let from_mat = ids(&fixture("HE1.mat"));
+    assert_eq!(from_mat.len(), 4);
+    assert_eq!(from_mat, ids(&Path::new(env!("CARGO_MANIFEST_DIR")).join("plants/HE1.json")));
+}
