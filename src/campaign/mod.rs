@@ -10,6 +10,7 @@ pub mod fake;
 pub mod jobs;
 pub mod journal;
 pub mod latex;
+pub mod plot;
 pub mod progress;
 pub mod provenance;
 pub mod record;

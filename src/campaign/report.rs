@@ -196,7 +196,7 @@ pub fn write_reports(
     files.push(p);
 
     let p = out_dir.join("tables.tex");
-    write_atomic(&p, latex::tables_tex(&best, &full).as_bytes())?;
+    write_atomic(&p, latex::tables_tex(&best, &full, reference).as_bytes())?;
     files.push(p);
 
     let p = out_dir.join("compare.csv");

@@ -477,7 +477,7 @@ fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, String> {
     if arg.is_empty() {
         return Err("plant must name a plant (e.g. \"HE1\") or a plant file".into());
     }
-    let is_path = arg.contains('/') || arg.ends_with(".json");
+    let is_path = arg.contains('/') || arg.ends_with(".json") || arg.ends_with(".mat");
     if is_path {
         let p = Path::new(arg);
         let p = if p.is_absolute() { p.to_path_buf() } else { base_dir.join(p) };

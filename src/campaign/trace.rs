@@ -329,10 +329,58 @@ pub struct TraceSummary {
     pub final_gamma: Option<f64>,
 }
 
-/// Reads a trace and summarises it.
-pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
+/// Calls `f(topic, message)` for every message of the trace at `path`, in file order.
+fn each_message(path: &Path, mut f: impl FnMut(&str, Value)) -> Result<(), TraceError> {
     let bytes = std::fs::read(path).map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
     let stream = mcap::MessageStream::new(&bytes).map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
+    for (index, msg) in stream.enumerate() {
+        let msg = msg.map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
+        let topic = msg.channel.topic.clone();
+        let v: Value = serde_json::from_slice(&msg.data).map_err(|source| TraceError::Json {
+            path: path.to_path_buf(),
+            topic: topic.clone(),
+            index,
+            source,
+        })?;
+        f(&topic, v);
+    }
+    Ok(())
+}
+
+/// One [`ITER_TOPIC`] message, as read back (the fields the convergence plot needs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceIteration {
+    /// Phase name (`stabilisation`, `optimisation`, `gradient_sampling`, …).
+    pub phase: String,
+    /// Index of the starting point.
+    pub start: usize,
+    /// Iteration within the start and phase.
+    pub iteration: usize,
+    /// Objective value.
+    pub f: f64,
+    /// CPU seconds since the run started.
+    pub elapsed_cpu_s: f64,
+}
+
+/// Every iteration message of a trace, in order.
+pub fn read_iterations(path: &Path) -> Result<Vec<TraceIteration>, TraceError> {
+    let mut out = Vec::new();
+    each_message(path, |topic, v| {
+        if topic == ITER_TOPIC {
+            out.push(TraceIteration {
+                phase: v["phase"].as_str().unwrap_or("?").to_string(),
+                start: v["start"].as_u64().unwrap_or(0) as usize,
+                iteration: v["iteration"].as_u64().unwrap_or(0) as usize,
+                f: f64_from_json(&v["f"]),
+                elapsed_cpu_s: f64_from_json(&v["elapsed_cpu_s"]),
+            });
+        }
+    })?;
+    Ok(out)
+}
+
+/// Reads a trace and summarises it.
+pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
     let mut s = TraceSummary {
         path: path.to_path_buf(),
         iterations: 0,
@@ -345,15 +393,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
         final_status: None,
         final_gamma: None,
     };
-    for (index, msg) in stream.enumerate() {
-        let msg = msg.map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
-        let topic = msg.channel.topic.clone();
-        let v: Value = serde_json::from_slice(&msg.data).map_err(|source| TraceError::Json {
-            path: path.to_path_buf(),
-            topic: topic.clone(),
-            index,
-            source,
-        })?;
+    each_message(path, |topic, v| {
         if topic == ITER_TOPIC {
             let f = f64_from_json(&v["f"]);
             if s.iterations == 0 {
@@ -382,7 +422,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
             s.final_status = v["status"]["kind"].as_str().map(str::to_string);
             s.final_gamma = Some(f64_from_json(&v["gamma"]));
         }
-    }
+    })?;
     Ok(s)
 }
 

@@ -88,6 +88,13 @@ pub struct ReportArgs {
     pub extra: JournalArgs,
 }
 
+/// Arguments of `campaign plot`.
+#[derive(clap::Args, Debug)]
+pub struct PlotArgs {
+    #[command(flatten)]
+    pub campaign: CampaignFileArgs,
+}
+
 /// Arguments of `campaign trace`.
 #[derive(clap::Args, Debug)]
 pub struct TraceArgs {
@@ -329,6 +336,24 @@ pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("{}: no finished jobs of this campaign in {} journal(s) (run it first)", l.dir.display(), journals.len());
     }
     report_into(&l.dir, &l.campaign, &records)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `campaign plot FILE`: figures of the journaled jobs into `<results>/<name>/plots/`.
+pub fn plot(a: PlotArgs) -> anyhow::Result<ExitCode> {
+    let l = load(&a.campaign)?;
+    let records = journaled(&l)?;
+    if records.is_empty() {
+        anyhow::bail!("{}: no finished jobs of this campaign yet (run it first)", journal_path(&l.dir).display());
+    }
+    let reference = load_default_reference().context("reading the paper's reference table")?;
+    let s = hinfix::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;
+    for f in &s.files {
+        println!("{}", f.display());
+    }
+    for why in &s.skipped {
+        eprintln!("skipped: {why}");
+    }
     Ok(ExitCode::SUCCESS)
 }
 

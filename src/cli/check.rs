@@ -1,5 +1,6 @@
-//! `campaign check --plant NAME|PATH --controller K.json [--json]`: closed-loop and controller
-//! spectral abscissas, ‖Tzw‖∞ with its peak frequency, ‖K‖∞, and both stability decisions.
+//! `campaign check --plant NAME|PATH --controller K.json|K.mat [--json] [--plot OUT.svg|png]`:
+//! closed-loop and controller spectral abscissas, ‖Tzw‖∞ with its peak frequency, ‖K‖∞, and both
+//! stability decisions; `--plot` also draws the σ-plot.
 //!
 //! JSON keys are those of the SLICOT oracle (`closed_loop_spectral_abscissa`,
 //! `controller_spectral_abscissa` (null for nk = 0), `closed_loop_hinf`, `closed_loop_peak_freq`,
@@ -18,15 +19,18 @@ use serde_json::{json, Value};
 /// Arguments of `campaign check`.
 #[derive(clap::Args, Debug)]
 pub struct CheckArgs {
-    /// Plant name (from plants/) or path to a plant JSON file.
+    /// Plant name (from plants/) or path to a plant file (JSON or MATLAB .mat).
     #[arg(long)]
     pub plant: String,
-    /// Controller JSON file {AK, BK, CK, DK}.
+    /// Controller file: JSON {AK, BK, CK, DK} or MATLAB .mat with the variables AK BK CK DK.
     #[arg(long)]
     pub controller: PathBuf,
     /// Print machine-readable JSON.
     #[arg(long)]
     pub json: bool,
+    /// Also draw the σ-plot (σmax of Tzw(iω) and K(iω) vs ω, peak marked) to this .png or .svg file.
+    #[arg(long, value_name = "OUT.svg|OUT.png")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Everything `check` reports.
@@ -53,6 +57,12 @@ pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
     let k = Controller::load(&a.controller)?;
     k.check_fits(&plant).with_context(|| format!("controller {}", a.controller.display()))?;
     let r = evaluate(&plant, &k)?;
+    if let Some(out) = &a.plot {
+        let title = format!("σ-plot: {}, controller {} (order {})", plant.name, a.controller.display(), k.order());
+        let fig = hinfix::campaign::plot::sigma_figure(&plant, &k, title)?;
+        hinfix::campaign::plot::write_by_extension(&fig, out)?;
+        eprintln!("σ-plot written to {}", out.display());
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&to_json(&r))?);
     } else {

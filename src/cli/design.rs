@@ -21,7 +21,7 @@ use super::EXIT_INTERRUPTED;
 /// Arguments of `campaign design`.
 #[derive(clap::Args, Debug)]
 pub struct DesignArgs {
-    /// Plant name (from plants/) or path to a plant JSON file.
+    /// Plant name (from plants/) or path to a plant file (JSON, or MATLAB .mat with A B1 B2 C1 C2 D11 D12 D21 D22).
     #[arg(long)]
     pub plant: String,
     /// Controller order nk ≥ 0.
@@ -39,7 +39,7 @@ pub struct DesignArgs {
     /// Number of random starts (or of perturbations of --init).
     #[arg(long, default_value_t = 3)]
     pub nrand: usize,
-    /// Initial controller JSON (order ≤ --order; a lower order is padded with stable modes).
+    /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
     #[arg(long)]
     pub init: Option<PathBuf>,
     /// Plain fixed-order H∞: do not require a stable controller.
@@ -48,7 +48,8 @@ pub struct DesignArgs {
     /// Print the whole outcome as JSON instead of the summary.
     #[arg(long)]
     pub json: bool,
-    /// Where to write the controller JSON {AK, BK, CK, DK}.
+    /// Where to write the controller: JSON {AK, BK, CK, DK}, or a MATLAB level-5 file with the
+    /// variables AK BK CK DK when the name ends in `.mat`.
     #[arg(long)]
     pub out: PathBuf,
 }
@@ -78,8 +79,13 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, plant.name))?;
-    let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
-    write_atomically(&a.out, &text).with_context(|| format!("writing {}", a.out.display()))?;
+    if hinfix::lti::mat_file::is_mat_path(&a.out) {
+        let k = Controller::from_json_value(&outcome.controller).context("the designed controller")?;
+        k.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+    } else {
+        let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
+        write_atomically(&a.out, &text).with_context(|| format!("writing {}", a.out.display()))?;
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {

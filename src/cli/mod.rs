@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 mod campaign;
 mod check;
 mod design;
+mod export;
 mod plants;
 
 /// hinfix: fixed-order H∞ controller design with strong stabilisation (HIFOO method) and a
@@ -32,6 +33,10 @@ enum Command {
     Report(campaign::ReportArgs),
     /// Summarise one MCAP trace file.
     Trace(campaign::TraceArgs),
+    /// Draw a campaign's figures (γ vs order, convergence, σ-plots) as PNG and SVG.
+    Plot(campaign::PlotArgs),
+    /// Print a controller as MATLAB or python-control code (sign convention u = K y).
+    Export(export::ExportArgs),
     /// List the benchmark plants shipped in plants/.
     Plants(plants::PlantsArgs),
     /// Show one plant in detail.
@@ -55,6 +60,8 @@ pub fn main() -> ExitCode {
         Command::Status(a) => campaign::status(a),
         Command::Report(a) => campaign::report(a),
         Command::Trace(a) => campaign::trace(a),
+        Command::Plot(a) => campaign::plot(a),
+        Command::Export(a) => export::run(a),
         Command::Plants(a) => plants::list(a),
         Command::Plant(a) => plants::show(a),
         Command::Check(a) => check::run(a),

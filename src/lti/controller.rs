@@ -54,6 +54,9 @@ pub enum ControllerErrorKind {
         /// Parser message.
         message: String,
     },
+    /// A `.mat` file that is not a readable level-5 MAT-file of real matrices.
+    #[error("{0}")]
+    Mat(#[from] super::mat_file::MatReadError),
     /// Not an object with AK, BK, CK, DK.
     #[error("the top level must be a JSON object with keys AK, BK, CK, DK")]
     NotObject,
@@ -96,9 +99,14 @@ impl Controller {
         self.dk.ncols()
     }
 
-    /// Reads a controller file.
+    /// Reads a controller file: JSON, or a MATLAB `.mat` file with `AK BK CK DK`.
     pub fn load(path: impl AsRef<Path>) -> Result<Controller, ControllerError> {
         let path = path.as_ref();
+        if super::mat_file::is_mat_path(path) {
+            let err = |kind| ControllerError { file: path.to_path_buf(), kind };
+            let bytes = std::fs::read(path).map_err(|e| err(e.into()))?;
+            return super::mat_file::controller_from_mat(&bytes).map_err(err);
+        }
         let text = std::fs::read_to_string(path)
             .map_err(|e| ControllerError { file: path.to_path_buf(), kind: e.into() })?;
         Self::from_json_str(&text, path)
@@ -137,6 +145,22 @@ impl Controller {
             });
         }
         Ok(Controller { ak: mat("AK", nk, nk)?, bk: mat("BK", nk, p)?, ck: mat("CK", m, nk)?, dk: mat("DK", m, p)? })
+    }
+
+    /// Writes the controller to `path`: a MATLAB `.mat` file (`AK BK CK DK`) when the extension is
+    /// `.mat`, else pretty JSON. Written to `<path>.tmp` and renamed, so no reader sees half a file.
+    pub fn save(&self, path: impl AsRef<Path>) -> std::io::Result<()> {
+        let path = path.as_ref();
+        let bytes = if super::mat_file::is_mat_path(path) {
+            super::mat_file::controller_to_mat(self)
+        } else {
+            (serde_json::to_string_pretty(&self.to_json()).map_err(std::io::Error::other)? + "\n").into_bytes()
+        };
+        let mut tmp = path.as_os_str().to_owned();
+        tmp.push(".tmp");
+        let tmp = PathBuf::from(tmp);
+        std::fs::write(&tmp, bytes)?;
+        std::fs::rename(&tmp, path)
     }
 
     /// The controller as `{AK, BK, CK, DK}`.

@@ -6,10 +6,12 @@
 mod closed_loop;
 mod controller;
 mod error;
-mod freq_response;
+pub mod export;
+pub(crate) mod freq_response;
 mod full_order;
 mod gradient;
 mod hinf;
+pub mod mat_file;
 mod matrix_json;
 mod plant;
 mod plant_library;
@@ -28,6 +30,7 @@ pub use gradient::{
 pub use hinf::{hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
+pub(crate) use spectral::eigenvalues as eigenvalues_of;
 pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};

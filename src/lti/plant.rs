@@ -102,6 +102,9 @@ pub enum PlantErrorKind {
         /// The parser's message.
         message: String,
     },
+    /// A `.mat` file that is not a readable level-5 MAT-file of real matrices.
+    #[error("{0}")]
+    Mat(#[from] super::mat_file::MatReadError),
     /// The document is not a JSON object.
     #[error("the top level must be a JSON object")]
     NotObject,
@@ -140,7 +143,7 @@ pub enum PlantErrorKind {
 }
 
 /// The nine matrices with the dims their shapes come from.
-const MATRICES: [(&str, &str, &str); 9] = [
+pub(crate) const MATRICES: [(&str, &str, &str); 9] = [
     ("A", "n", "n"),
     ("B1", "n", "m1"),
     ("B2", "n", "m2"),
@@ -166,9 +169,15 @@ impl Dims {
 }
 
 impl Plant {
-    /// Reads and validates a plant file.
+    /// Reads and validates a plant file: JSON, or a MATLAB `.mat` file (`lti::mat_file`) that
+    /// goes through the same checks.
     pub fn load(path: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let path = path.as_ref();
+        if super::mat_file::is_mat_path(path) {
+            let err = |kind| PlantError { file: path.to_path_buf(), kind };
+            let bytes = std::fs::read(path).map_err(|e| err(e.into()))?;
+            return super::mat_file::plant_from_mat(&bytes, path).map_err(err);
+        }
         let text = std::fs::read_to_string(path)
             .map_err(|e| PlantError { file: path.to_path_buf(), kind: e.into() })?;
         Self::from_json_str(&text, path)
@@ -183,7 +192,7 @@ impl Plant {
         Self::from_json_value(&doc).map_err(err)
     }
 
-    fn from_json_value(doc: &Value) -> Result<Plant, PlantErrorKind> {
+    pub(crate) fn from_json_value(doc: &Value) -> Result<Plant, PlantErrorKind> {
         let obj = doc.as_object().ok_or(PlantErrorKind::NotObject)?;
         let name = match obj.get("name") {
             None => return Err(PlantErrorKind::MissingField { field: "name" }),

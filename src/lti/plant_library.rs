@@ -1,5 +1,5 @@
 //! Finding plants: a benchmark name such as `HE1` means the file `HE1.json` in the plant library;
-//! anything that names an existing file (or ends in `.json`) is a path.
+//! anything that names an existing file (or ends in `.json` or `.mat`) is a path.
 //!
 //! The library directory is, in order: the environment variable `HINFIX_PLANTS`, `./plants` if it
 //! exists (running from a project checkout), else the `plants/` folder of the source tree the
@@ -24,11 +24,11 @@ pub fn plants_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("plants")
 }
 
-/// Resolves a plant argument: an existing file or a `.json` path as given, else
+/// Resolves a plant argument: an existing file or a `.json`/`.mat` path as given, else
 /// `<plants_dir>/NAME.json`. An unknown name is an error that lists the shipped plants.
 pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
     let as_path = Path::new(name_or_path);
-    if as_path.is_file() || name_or_path.ends_with(".json") || name_or_path.contains('/') {
+    if as_path.is_file() || name_or_path.ends_with(".json") || name_or_path.ends_with(".mat") || name_or_path.contains('/') {
         return Ok(as_path.to_path_buf());
     }
     let file = plants_dir().join(format!("{name_or_path}.json"));

@@ -1,0 +1,118 @@
+//! γ against the controller order for one plant: our best re-verified γ per n_K, the paper's
+//! HIFOO values, and the full-order bound as a horizontal line; a log axis when the values span
+//! more than a decade.
+
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
+
+/// Data of one γ-vs-order figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GammaOrderFigure {
+    /// Plant name.
+    pub plant: String,
+    /// (n_K, our best verified γ), finite values only.
+    pub ours: Vec<(usize, f64)>,
+    /// (n_K, the paper's HIFOO γ).
+    pub paper: Vec<(usize, f64)>,
+    /// The full-order bound γ_opt (None if unknown), and whether it is the paper's value.
+    pub full_order: Option<(f64, bool)>,
+}
+
+impl GammaOrderFigure {
+    /// Every γ shown (ours, paper, bound).
+    fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        self.ours.iter().chain(&self.paper).map(|p| p.1).chain(self.full_order.map(|f| f.0))
+    }
+
+    /// Whether the y axis is logarithmic.
+    pub fn log_axis(&self) -> bool {
+        let (lo, hi) = self.values().fold((f64::INFINITY, 0f64), |(l, h), v| (l.min(v), h.max(v)));
+        spans_decades(lo, hi)
+    }
+
+    fn draw_with<DB: DrawingBackend, Y>(&self, root: &DrawingArea<DB, Shift>, y: Y) -> Result<(), String>
+    where
+        Y: AsRangedCoord<Value = f64>,
+        Y::CoordDescType: ValueFormatter<f64>,
+    {
+        let orders = self.ours.iter().chain(&self.paper).map(|p| p.0);
+        let (kmin, kmax) = orders.fold((usize::MAX, 0), |(l, h), k| (l.min(k), h.max(k)));
+        let (kmin, kmax) = if kmin > kmax { (0, 1) } else { (kmin, kmax) };
+        let x = (kmin as f64 - 0.5)..(kmax as f64 + 0.5);
+        let mut chart = ChartBuilder::on(root)
+            .caption(format!("{}: best γ per controller order", self.plant), (FONT_FAMILY, 26))
+            .margin(16)
+            .x_label_area_size(54)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x, y)
+            .map_err(msg)?;
+        chart
+            .configure_mesh()
+            .x_desc("controller order n_K")
+            .y_desc("γ = ‖T_zw‖∞")
+            .x_labels(kmax - kmin + 3)
+            .x_label_formatter(&|v| if (v - v.round()).abs() < 1e-9 && *v >= 0.0 { format!("{}", v.round()) } else { String::new() })
+            .y_label_formatter(&|v| tick(*v))
+            .max_light_lines(2)
+            .label_style((FONT_FAMILY, 16))
+            .axis_desc_style((FONT_FAMILY, 18))
+            .draw()
+            .map_err(msg)?;
+        if let Some((g, from_paper)) = self.full_order {
+            let label = if from_paper { "full-order bound (paper's value)" } else { "full-order bound γ_opt" };
+            let style = ShapeStyle::from(&colour::BOUND).stroke_width(2);
+            chart
+                .draw_series(DashedLineSeries::new(vec![(kmin as f64 - 0.5, g), (kmax as f64 + 0.5, g)], 10, 6, style))
+                .map_err(msg)?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+        }
+        let line = |pts: &[(usize, f64)]| -> Vec<(f64, f64)> { pts.iter().map(|&(k, g)| (k as f64, g)).collect() };
+        let paper = line(&self.paper);
+        if !paper.is_empty() {
+            let c = colour::PAPER;
+            chart.draw_series(LineSeries::new(paper.clone(), c.stroke_width(2))).map_err(msg)?;
+            chart
+                .draw_series(paper.iter().map(|&p| TriangleMarker::new(p, 9, c.filled())))
+                .map_err(msg)?
+                .label("paper (HIFOO, 2008)")
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x + 12, y))
+                        + PathElement::new(vec![(-12, 0), (12, 0)], c.stroke_width(2))
+                        + TriangleMarker::new((0, 0), 7, c.filled())
+                });
+        }
+        let ours = line(&self.ours);
+        if !ours.is_empty() {
+            let c = colour::OURS;
+            chart.draw_series(LineSeries::new(ours.clone(), c.stroke_width(2))).map_err(msg)?;
+            chart
+                .draw_series(ours.iter().map(|&p| Circle::new(p, 6, c.filled())))
+                .map_err(msg)?
+                .label("ours (best verified)")
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x + 12, y))
+                        + PathElement::new(vec![(-12, 0), (12, 0)], c.stroke_width(2))
+                        + Circle::new((0, 0), 5, c.filled())
+                });
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+impl Figure for GammaOrderFigure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let (lo, hi) = self.values().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+        let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
+        if self.log_axis() {
+            let (a, b) = padded_range(lo, hi, true);
+            self.draw_with(root, (a..b).log_scale())
+        } else {
+            let (a, b) = padded_range(lo, hi, false);
+            self.draw_with(root, a..b)
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! σ-plot of one controller on its plant: σmax(T_zw(iω)) and σmax(K(iω)) against ω (rad/s),
+//! log-log, with the H∞ peak of T_zw marked (the level-set value and frequency from
+//! `lti::hinf_norm`, not the grid's maximum).
+//!
+//! The frequency grid is logarithmic, from a decade below the slowest to a decade above the
+//! fastest closed-loop or controller mode (|λ|, zero modes ignored), widened to contain the
+//! peak, with the peak frequency itself added to the grid.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::render::{colour, draw_legend, msg, tick, Figure, FONT_FAMILY};
+use crate::lti::freq_response::FreqResponse;
+use crate::lti::{closed_loop, hinf_norm, Controller, LtiError, Plant, StateSpace, DEFAULT_HINF_TOL};
+
+/// Points of the frequency grid.
+pub const GRID_POINTS: usize = 600;
+
+/// Data of one σ-plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SigmaFigure {
+    /// Title.
+    pub title: String,
+    /// (ω, σmax(T_zw(iω))).
+    pub closed_loop: Vec<(f64, f64)>,
+    /// (ω, σmax(K(iω))).
+    pub controller: Vec<(f64, f64)>,
+    /// ‖T_zw‖∞ and the frequency where it is attained (may be 0 or +∞).
+    pub peak: (f64, f64),
+}
+
+/// |λ| of the nonzero eigenvalues of `a`.
+fn mode_magnitudes(a: faer::MatRef<'_, f64>) -> Vec<f64> {
+    crate::lti::eigenvalues_of(a).unwrap_or_default().into_iter().map(|l| l.norm()).filter(|m| *m > 0.0 && m.is_finite()).collect()
+}
+
+impl SigmaFigure {
+    /// Computes the curves of `k` on `plant`. Errors if the closed loop cannot be formed; an
+    /// unstable closed loop is drawn all the same (its peak is then +∞ and not marked).
+    pub fn new(plant: &Plant, k: &Controller, title: String) -> Result<Self, LtiError> {
+        let cl = closed_loop(plant, k)?;
+        let ks = StateSpace::new(k.ak.clone(), k.bk.clone(), k.ck.clone(), k.dk.clone())?;
+        let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
+        let mut mags = mode_magnitudes(cl.a.as_ref());
+        mags.extend(mode_magnitudes(k.ak.as_ref()));
+        let (mut lo, mut hi) = mags.iter().fold((f64::INFINITY, 0f64), |(l, h), &m| (l.min(m), h.max(m)));
+        if !(lo <= hi) {
+            (lo, hi) = (1.0, 1.0);
+        }
+        if h.peak_freq.is_finite() && h.peak_freq > 0.0 {
+            lo = lo.min(h.peak_freq);
+            hi = hi.max(h.peak_freq);
+        }
+        let (l0, l1) = ((lo / 10.0).log10().floor(), (hi * 10.0).log10().ceil());
+        let mut grid: Vec<f64> = (0..GRID_POINTS).map(|i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (GRID_POINTS - 1) as f64)).collect();
+        if h.peak_freq.is_finite() && h.peak_freq > 0.0 {
+            grid.push(h.peak_freq);
+            grid.sort_by(f64::total_cmp);
+        }
+        let mut fr_cl = FreqResponse::new(&cl);
+        let mut fr_k = FreqResponse::new(&ks);
+        let closed_loop = grid.iter().map(|&w| (w, fr_cl.sigma_max(w))).collect();
+        let controller = grid.iter().map(|&w| (w, fr_k.sigma_max(w))).collect();
+        Ok(SigmaFigure { title, closed_loop, controller, peak: (h.value, h.peak_freq) })
+    }
+
+    fn positive(v: &[(f64, f64)]) -> impl Iterator<Item = (f64, f64)> + '_ {
+        v.iter().copied().filter(|p| p.1 > 0.0 && p.1.is_finite())
+    }
+
+    /// Where the peak is drawn: its frequency, clamped to the grid when it is 0 or +∞.
+    pub fn peak_point(&self) -> Option<(f64, f64)> {
+        let (g, w) = self.peak;
+        if !g.is_finite() || w.is_nan() {
+            return None;
+        }
+        let (w0, w1) = (self.closed_loop.first()?.0, self.closed_loop.last()?.0);
+        Some((w.clamp(w0, w1), g))
+    }
+}
+
+impl Figure for SigmaFigure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let ys = Self::positive(&self.closed_loop).chain(Self::positive(&self.controller)).map(|p| p.1).chain(self.peak_point().map(|p| p.1));
+        let (lo, hi) = ys.fold((f64::INFINITY, 0f64), |(l, h), v| (l.min(v), h.max(v)));
+        let (lo, hi) = if lo <= hi { (lo / 2.0, hi * 2.0) } else { (0.1, 10.0) };
+        let (w0, w1) = match (self.closed_loop.first(), self.closed_loop.last()) {
+            (Some(a), Some(b)) if a.0 < b.0 => (a.0, b.0),
+            _ => (0.1, 10.0),
+        };
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, (FONT_FAMILY, 24))
+            .margin(16)
+            .x_label_area_size(54)
+            .y_label_area_size(90)
+            .build_cartesian_2d((w0..w1).log_scale(), (lo..hi).log_scale())
+            .map_err(msg)?;
+        chart
+            .configure_mesh()
+            .x_desc("frequency ω (rad/s)")
+            .y_desc("largest singular value σ_max")
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .label_style((FONT_FAMILY, 15))
+            .axis_desc_style((FONT_FAMILY, 17))
+            .draw()
+            .map_err(msg)?;
+        let cl_style = colour::OURS.stroke_width(3);
+        chart
+            .draw_series(LineSeries::new(Self::positive(&self.closed_loop), cl_style))
+            .map_err(msg)?
+            .label("σ_max(T_zw(iω)), closed loop")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], cl_style));
+        let k_style = colour::CONTROLLER.stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(Self::positive(&self.controller), k_style))
+            .map_err(msg)?
+            .label("σ_max(K(iω)), controller")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], k_style));
+        if let Some(p) = self.peak_point() {
+            let (g, w) = self.peak;
+            let at = if w.is_infinite() { "ω → ∞".to_string() } else if w == 0.0 { "ω = 0".to_string() } else { format!("ω = {} rad/s", tick(w)) };
+            let text = format!("peak ‖T_zw‖∞ = {} at {at}", tick(g));
+            chart
+                .draw_series(std::iter::once(Circle::new(p, 7, colour::PAPER.filled())))
+                .map_err(msg)?
+                .label(text)
+                .legend(|(x, y)| Circle::new((x + 12, y), 6, colour::PAPER.filled()));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
+    }
+}

@@ -1,0 +1,107 @@
+//! A controller as ready-to-paste MATLAB or python-control code.
+//!
+//! Sign convention (algorithm.md §1): the controller is **positive feedback**, u = K y:
+//!
+//! ```text
+//! xk' = AK xk + BK y,   u = CK xk + DK y
+//! ```
+//!
+//! and the closed loop is the lower LFT F_l(P, K) = P11 + P12 K (I − P22 K)⁻¹ P21, which is what
+//! MATLAB's `lft(P, K)` and python-control's `P.lft(K)` compute. `feedback(G, K)` assumes
+//! *negative* feedback in both; keep u = K y with `feedback(G, K, +1)` (MATLAB) or
+//! `control.feedback(G, K, sign=1)` (python), or pass `-K`.
+//!
+//! Numbers are printed with Rust's shortest round-trip representation, so the pasted matrices
+//! are bit-for-bit the controller's.
+
+use faer::MatRef;
+
+use super::Controller;
+
+/// Target language of [`export_code`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportTarget {
+    /// MATLAB (Control System Toolbox `ss`).
+    Matlab,
+    /// Python with numpy and python-control.
+    Python,
+}
+
+/// Shortest representation that reads back to the same f64.
+fn number(x: f64) -> String {
+    let s = format!("{x:?}");
+    s.strip_suffix(".0").map_or(s.clone(), str::to_string)
+}
+
+fn matlab_matrix(m: MatRef<'_, f64>) -> String {
+    if m.nrows() == 0 || m.ncols() == 0 {
+        return format!("zeros({}, {})", m.nrows(), m.ncols());
+    }
+    let rows: Vec<String> =
+        (0..m.nrows()).map(|i| (0..m.ncols()).map(|j| number(m[(i, j)])).collect::<Vec<_>>().join(", ")).collect();
+    format!("[{}]", rows.join(";\n      "))
+}
+
+fn python_matrix(m: MatRef<'_, f64>) -> String {
+    if m.nrows() == 0 || m.ncols() == 0 {
+        return format!("np.zeros(({}, {}))", m.nrows(), m.ncols());
+    }
+    let rows: Vec<String> = (0..m.nrows())
+        .map(|i| format!("[{}]", (0..m.ncols()).map(|j| number(m[(i, j)])).collect::<Vec<_>>().join(", ")))
+        .collect();
+    format!("np.array([{}])", rows.join(",\n               "))
+}
+
+/// The code that builds `k` as a state-space object in `target`, with the sign convention in
+/// comments. `source` names where the controller came from (printed in the first comment).
+pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String {
+    let (nk, m, p) = (k.order(), k.m(), k.p());
+    let mats = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
+    let mut s = String::new();
+    match target {
+        ExportTarget::Matlab => {
+            s += &format!("% hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n");
+            s += "% Sign convention: POSITIVE feedback u = K y (xk' = AK xk + BK y, u = CK xk + DK y).\n";
+            s += "% Closed loop with the plant P = ss(A, [B1 B2], [C1; C2], [D11 D12; D21 D22]):\n";
+            s += "%   Tzw = lft(P, K);                 % lft keeps u = K y\n";
+            s += "%   L = feedback(P22, K, +1);        % feedback() is negative by default: use +1 (or -K)\n";
+            for (name, mat) in mats {
+                s += &format!("{name} = {};\n", matlab_matrix(mat));
+            }
+            s += "K = ss(AK, BK, CK, DK);\n";
+        }
+        ExportTarget::Python => {
+            s += &format!("# hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n");
+            s += "# Sign convention: POSITIVE feedback u = K y (xk' = AK xk + BK y, u = CK xk + DK y).\n";
+            s += "# Closed loop with P = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]), np.block([[D11, D12], [D21, D22]])):\n";
+            s += "#   Tzw = P.lft(K)                          # lower LFT, keeps u = K y\n";
+            s += "#   L = control.feedback(P22, K, sign=1)    # feedback() is negative by default: use sign=1 (or -K)\n";
+            s += "import numpy as np\nimport control\n\n";
+            for (name, mat) in mats {
+                s += &format!("{name} = {}\n", python_matrix(mat));
+            }
+            s += "K = control.ss(AK, BK, CK, DK)\n";
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+
+    #[test]
+    fn numbers_round_trip_and_empty_blocks_have_shapes() {
+        for x in [0.1, -1.0 / 3.0, 1e-300, 123456789.0, -0.0] {
+            assert_eq!(number(x).parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x}");
+        }
+        let k = Controller { ak: Mat::zeros(0, 0), bk: Mat::zeros(0, 2), ck: Mat::zeros(1, 0), dk: Mat::from_fn(1, 2, |_, j| j as f64 + 0.5) };
+        let m = export_code(&k, ExportTarget::Matlab, "k.json");
+        assert!(m.contains("BK = zeros(0, 2);") && m.contains("CK = zeros(1, 0);") && m.contains("DK = [0.5, 1.5];"), "{m}");
+        assert!(m.contains("K = ss(AK, BK, CK, DK);") && m.contains("u = K y"));
+        let p = export_code(&k, ExportTarget::Python, "k.json");
+        assert!(p.contains("BK = np.zeros((0, 2))") && p.contains("DK = np.array([[0.5, 1.5]])"), "{p}");
+        assert!(p.contains("K = control.ss(AK, BK, CK, DK)") && p.contains("sign=1"));
+    }
+}

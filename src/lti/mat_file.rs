@@ -1,0 +1,393 @@
+//! MATLAB level-5 MAT-files: plants (`A B1 B2 C1 C2 D11 D12 D21 D22`) and controllers
+//! (`AK BK CK DK`) in and out, so a model can come from MATLAB (or `scipy.io.savemat`) and a
+//! designed controller go back.
+//!
+//! Reading uses the `matfile` crate (pure Rust; uncompressed and zlib-compressed variables; it
+//! returns numeric arrays and skips character, cell, struct and sparse variables). No maintained
+//! Rust crate writes MAT-files, so [`write_mat`] is a minimal level-5 writer: a 128-byte header
+//! and one uncompressed `miMATRIX` element per variable (class `mxDOUBLE_CLASS`, 2-D, real),
+//! little-endian, following MathWorks' "MAT-File Format" (level 5) document. MATLAB, Octave and
+//! `scipy.io.loadmat` read it.
+//!
+//! A plant file is turned into the same JSON document a plant JSON file holds and validated by
+//! the same code, so the checks and the error messages are the same; `dims` is inferred from the
+//! blocks' sizes: n = rows of A, m1 = columns of B1 (else of D11 or D21), m2 = columns of B2 (else
+//! D12, D22), p1 = rows of C1 (else D11, D12), p2 = rows of C2 (else D21, D22). A variable with no
+//! entries (`[]`, or a 0-wide block) stands for a zero block of the size the others imply. The
+//! plant's name is the file's stem, or the character variable `name` when the file has one
+//! (read by this module, since `matfile` skips character arrays).
+//!
+//! Values are copied bit for bit: the same plant as `.mat` and as JSON is the same plant (same
+//! fingerprint, same job ids, same designs).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use faer::{Mat, MatRef};
+use serde_json::{Map, Value};
+
+use super::controller::{Controller, ControllerErrorKind};
+use super::matrix_json::MatrixJsonError;
+// The plant variables in file order, with the dims their rows and columns give.
+use super::plant::{Plant, PlantErrorKind, MATRICES as PLANT_VARS};
+
+/// A real 2-D variable of a MAT-file, column-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatVar {
+    /// Rows.
+    pub rows: usize,
+    /// Columns.
+    pub cols: usize,
+    /// Entries, column-major (MATLAB's order).
+    pub data: Vec<f64>,
+}
+
+impl MatVar {
+    /// The variable as a dense matrix.
+    pub fn to_mat(&self) -> Mat<f64> {
+        Mat::from_fn(self.rows, self.cols, |i, j| self.data[i + j * self.rows])
+    }
+
+    /// A matrix as a variable.
+    pub fn from_mat(m: MatRef<'_, f64>) -> Self {
+        let mut data = Vec::with_capacity(m.nrows() * m.ncols());
+        for j in 0..m.ncols() {
+            for i in 0..m.nrows() {
+                data.push(m[(i, j)]);
+            }
+        }
+        MatVar { rows: m.nrows(), cols: m.ncols(), data }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.rows == 0 || self.cols == 0
+    }
+}
+
+/// Why a MAT-file could not be read as plain real matrices.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MatReadError {
+    /// Not a level-5 MAT-file, or a damaged one.
+    #[error("not a readable MATLAB level-5 .mat file ({0}); save it with `save(..., '-v7')` or scipy.io.savemat")]
+    Format(String),
+    /// A variable this program needs is not a real 2-D array.
+    #[error("variable `{name}` {problem}")]
+    Variable {
+        /// Variable name.
+        name: String,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+/// Reads every numeric variable of a level-5 MAT-file (`bytes`) as a real 2-D matrix, by name.
+/// Complex or N-d (N > 2) variables are errors; integer and single classes are converted to f64
+/// exactly.
+pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadError> {
+    if bytes.len() < 128 {
+        return Err(MatReadError::Format(format!("{} bytes, shorter than the 128-byte header", bytes.len())));
+    }
+    if bytes.get(512..).is_some_and(|b| b.starts_with(b"\x89HDF")) {
+        return Err(MatReadError::Format("an HDF5-based v7.3 file".into()));
+    }
+    let file = matfile::MatFile::parse(bytes).map_err(|e| MatReadError::Format(e.to_string()))?;
+    let mut out = BTreeMap::new();
+    for a in file.arrays() {
+        let bad = |problem: String| MatReadError::Variable { name: a.name().to_string(), problem };
+        if a.ndims() != 2 {
+            return Err(bad(format!("has {} dimensions {:?}; a matrix has 2", a.ndims(), a.size())));
+        }
+        let data = real_f64(a.data()).ok_or_else(|| bad("is complex; a matrix here must be real".into()))?;
+        let (rows, cols) = (a.size()[0], a.size()[1]);
+        if data.len() != rows * cols {
+            return Err(bad(format!("holds {} entries for a {rows}×{cols} array", data.len())));
+        }
+        out.insert(a.name().to_string(), MatVar { rows, cols, data });
+    }
+    Ok(out)
+}
+
+/// The real part as f64, or None when the data are complex.
+fn real_f64(d: &matfile::NumericData) -> Option<Vec<f64>> {
+    use matfile::NumericData as N;
+    fn conv<T: Copy + Into<f64>, U>(real: &[T], imag: &Option<Vec<U>>) -> Option<Vec<f64>> {
+        imag.is_none().then(|| real.iter().map(|&x| x.into()).collect())
+    }
+    match d {
+        N::Double { real, imag } => conv(real, imag),
+        N::Single { real, imag } => conv(real, imag),
+        N::Int8 { real, imag } => conv(real, imag),
+        N::UInt8 { real, imag } => conv(real, imag),
+        N::Int16 { real, imag } => conv(real, imag),
+        N::UInt16 { real, imag } => conv(real, imag),
+        N::Int32 { real, imag } => conv(real, imag),
+        N::UInt32 { real, imag } => conv(real, imag),
+        // 64-bit integers above 2^53 would not be exact; MATLAB users have no reason for them here.
+        N::Int64 { real, imag } => imag.is_none().then(|| real.iter().map(|&x| x as f64).collect()),
+        N::UInt64 { real, imag } => imag.is_none().then(|| real.iter().map(|&x| x as f64).collect()),
+    }
+}
+
+/// The first character variable called `name` (uncompressed `mxCHAR_CLASS`, as MATLAB's `save`
+/// without compression and `scipy.io.savemat` write it), if any. Best effort: anything unexpected
+/// gives None and the caller falls back to the file stem.
+fn read_char_var(bytes: &[u8], wanted: &str) -> Option<String> {
+    let u32_at = |i: usize| bytes.get(i..i + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    if bytes.get(126..128) != Some(b"IM") {
+        return None; // big-endian or not level 5: not worth supporting for an optional name
+    }
+    let mut pos = 128;
+    while pos + 8 <= bytes.len() {
+        let (ty, len) = (u32_at(pos)?, u32_at(pos + 4)? as usize);
+        let body = bytes.get(pos + 8..pos + 8 + len)?;
+        if ty == MI_MATRIX {
+            if let Some(s) = char_matrix(body, wanted) {
+                return Some(s);
+            }
+        }
+        pos += 8 + len.div_ceil(8) * 8;
+    }
+    None
+}
+
+/// Parses one uncompressed miMATRIX body as a 1-row char array named `wanted`.
+fn char_matrix(body: &[u8], wanted: &str) -> Option<String> {
+    let mut sub = SubElements { b: body, pos: 0 };
+    let (_, flags) = sub.next()?;
+    if flags.first().copied()? != MX_CHAR_CLASS {
+        return None;
+    }
+    let (_, dims) = sub.next()?;
+    if dims.len() != 8 || u32::from_le_bytes(dims[..4].try_into().ok()?) != 1 {
+        return None;
+    }
+    let (_, name) = sub.next()?;
+    if name != wanted.as_bytes() {
+        return None;
+    }
+    let (ty, text) = sub.next()?;
+    match ty {
+        MI_UTF8 | MI_UINT8 => String::from_utf8(text.to_vec()).ok(),
+        MI_UINT16 | MI_UTF16 => {
+            let units: Vec<u16> = text.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+            String::from_utf16(&units).ok()
+        }
+        MI_INT32 | MI_UINT32 | MI_UTF32 => {
+            text.chunks_exact(4).map(|c| char::from_u32(u32::from_le_bytes([c[0], c[1], c[2], c[3]]))).collect()
+        }
+        _ => None,
+    }
+}
+
+/// Sub-elements of a miMATRIX, in the long or the small (≤ 4 bytes) tag form.
+struct SubElements<'a> {
+    b: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> SubElements<'a> {
+    fn next(&mut self) -> Option<(u32, &'a [u8])> {
+        let tag = u32::from_le_bytes(self.b.get(self.pos..self.pos + 4)?.try_into().ok()?);
+        if tag >> 16 != 0 {
+            // small data element: size in the upper half, data in the next 4 bytes
+            let (ty, len) = (tag & 0xffff, (tag >> 16) as usize);
+            let data = self.b.get(self.pos + 4..self.pos + 4 + len)?;
+            self.pos += 8;
+            return Some((ty, data));
+        }
+        let len = u32::from_le_bytes(self.b.get(self.pos + 4..self.pos + 8)?.try_into().ok()?) as usize;
+        let data = self.b.get(self.pos + 8..self.pos + 8 + len)?;
+        self.pos += 8 + len.div_ceil(8) * 8;
+        Some((tag, data))
+    }
+}
+
+// Level-5 data types and array classes used here (MAT-File Format, tables 1-2 and 1-3).
+const MI_INT8: u32 = 1;
+const MI_UINT8: u32 = 2;
+const MI_UINT16: u32 = 4;
+const MI_INT32: u32 = 5;
+const MI_UINT32: u32 = 6;
+const MI_DOUBLE: u32 = 9;
+const MI_MATRIX: u32 = 14;
+const MI_UTF8: u32 = 16;
+const MI_UTF16: u32 = 17;
+const MI_UTF32: u32 = 18;
+const MX_CHAR_CLASS: u8 = 4;
+const MX_DOUBLE_CLASS: u8 = 6;
+
+/// Writes `vars` (name, matrix) as a level-5 MAT-file (see the module docs). Names must be valid
+/// MATLAB identifiers (the callers' names are fixed ones such as `AK`).
+pub fn write_mat(vars: &[(&str, MatRef<'_, f64>)], description: &str) -> Vec<u8> {
+    let mut out = Vec::new();
+    // Header: 116 bytes of text, 8 bytes of subsystem offset, version 0x0100, endian "IM".
+    let mut text = format!("MATLAB 5.0 MAT-file, {description}").into_bytes();
+    text.truncate(116);
+    text.resize(116, b' ');
+    out.extend_from_slice(&text);
+    out.extend_from_slice(&[0u8; 8]);
+    out.extend_from_slice(&0x0100u16.to_le_bytes());
+    out.extend_from_slice(b"IM");
+    for (name, m) in vars {
+        let mut body = Vec::new();
+        // Array flags: class double, no complex/global/logical bits.
+        element(&mut body, MI_UINT32, &[MX_DOUBLE_CLASS as u32, 0].map(u32::to_le_bytes).concat());
+        let dims = [m.nrows() as i32, m.ncols() as i32].map(i32::to_le_bytes).concat();
+        element(&mut body, MI_INT32, &dims);
+        element(&mut body, MI_INT8, name.as_bytes());
+        let v = MatVar::from_mat(*m);
+        let re: Vec<u8> = v.data.iter().flat_map(|x| x.to_le_bytes()).collect();
+        element(&mut body, MI_DOUBLE, &re);
+        element(&mut out, MI_MATRIX, &body);
+    }
+    out
+}
+
+/// Appends one data element (8-byte tag, data, padding to a multiple of 8).
+fn element(out: &mut Vec<u8>, ty: u32, data: &[u8]) {
+    out.extend_from_slice(&ty.to_le_bytes());
+    out.extend_from_slice(&(data.len() as u32).to_le_bytes());
+    out.extend_from_slice(data);
+    out.resize(out.len() + (8 - data.len() % 8) % 8, 0);
+}
+
+const PLANT_HINT: &str =
+    " (a plant .mat file holds A B1 B2 C1 C2 D11 D12 D21 D22 as real full numeric arrays; character, cell, struct and sparse variables are not read)";
+
+/// Infers one dimension from the first non-empty variable that carries it.
+fn infer(vars: &BTreeMap<String, MatVar>, dim: &str) -> usize {
+    for (key, r, c) in PLANT_VARS {
+        let Some(v) = vars.get(key).filter(|v| !v.is_empty()) else { continue };
+        if r == dim {
+            return v.rows;
+        }
+        if c == dim {
+            return v.cols;
+        }
+    }
+    0
+}
+
+/// A variable as a JSON array of rows.
+fn var_to_json(v: &MatVar) -> Value {
+    Value::Array((0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect())).collect())
+}
+
+fn json_number(x: f64) -> Value {
+    serde_json::Number::from_f64(x).map(Value::Number).expect("finite values were checked")
+}
+
+fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind> {
+    let bad = |i: usize| {
+        let (row, col) = (i % v.rows + 1, i / v.rows + 1);
+        PlantErrorKind::Matrix { matrix: name, problem: MatrixJsonError::NotFinite { row, col, value: v.data[i] }, hint: String::new() }
+    };
+    match v.data.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(bad(i)),
+        None => Ok(()),
+    }
+}
+
+/// The JSON plant document a plant MAT-file stands for (validated by the caller with the JSON
+/// plant checks). `stem` names the plant when the file has no `name` variable.
+fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
+    let vars = read_mat_vars(bytes)?;
+    for (key, _, _) in PLANT_VARS {
+        match vars.get(key) {
+            None => {
+                return Err(PlantErrorKind::Matrix { matrix: key, problem: MatrixJsonError::Missing, hint: PLANT_HINT.into() })
+            }
+            Some(v) => first_non_finite(key, v)?,
+        }
+    }
+    let dims: BTreeMap<&str, usize> = ["n", "m1", "m2", "p1", "p2"].into_iter().map(|d| (d, infer(&vars, d))).collect();
+    let name = read_char_var(bytes, "name").filter(|s| !s.trim().is_empty()).unwrap_or_else(|| stem.to_string());
+    let mut doc = Map::new();
+    doc.insert("name".into(), name.into());
+    doc.insert("description".into(), format!("read from the MATLAB file {stem}.mat").into());
+    doc.insert("dims".into(), serde_json::to_value(&dims).expect("dims serialise"));
+    for (key, r, c) in PLANT_VARS {
+        let v = &vars[key];
+        let value = if v.is_empty() {
+            // an empty variable is a zero block of the inferred size
+            let (rows, cols) = (dims[r], dims[c]);
+            Value::Array((0..rows).map(|_| Value::Array(vec![json_number(0.0); cols])).collect())
+        } else {
+            var_to_json(v)
+        };
+        doc.insert(key.into(), value);
+    }
+    Ok(Value::Object(doc))
+}
+
+/// Reads a plant from the bytes of a MAT-file (see the module docs).
+pub(crate) fn plant_from_mat(bytes: &[u8], path: &Path) -> Result<Plant, PlantErrorKind> {
+    let stem = path.file_stem().map_or_else(|| "plant".to_string(), |s| s.to_string_lossy().into_owned());
+    Plant::from_json_value(&plant_document(bytes, &stem)?)
+}
+
+/// The plant as a MAT-file (the nine matrices; `name` is not written, the file stem names it).
+pub fn plant_to_mat(p: &Plant) -> Vec<u8> {
+    let names = PLANT_VARS.map(|(k, _, _)| k);
+    let vars: Vec<(&str, MatRef<'_, f64>)> = names.into_iter().zip(p.matrices()).collect();
+    write_mat(&vars, &format!("hinfix plant {}", p.name))
+}
+
+/// Reads a controller from the bytes of a MAT-file holding `AK BK CK DK` (AK, BK, CK may be
+/// empty for a static gain). Shapes are checked as for a controller JSON file.
+pub(crate) fn controller_from_mat(bytes: &[u8]) -> Result<Controller, ControllerErrorKind> {
+    let vars = read_mat_vars(bytes)?;
+    let mut doc = Map::new();
+    for key in ["AK", "BK", "CK", "DK"] {
+        let Some(v) = vars.get(key) else { continue };
+        if let Some(i) = v.data.iter().position(|x| !x.is_finite()) {
+            let (row, col) = (i % v.rows + 1, i / v.rows + 1);
+            let problem = MatrixJsonError::NotFinite { row, col, value: v.data[i] };
+            return Err(ControllerErrorKind::Matrix { matrix: key, problem });
+        }
+        doc.insert(key.into(), var_to_json(v));
+    }
+    // `[]` (a 0×0 AK, BK, CK of a static gain) is accepted for any block without entries.
+    Controller::from_json_value(&Value::Object(doc))
+}
+
+/// The controller as a MAT-file `AK BK CK DK`.
+pub fn controller_to_mat(k: &Controller) -> Vec<u8> {
+    let vars = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
+    write_mat(&vars, "hinfix controller (u = K y: xk' = AK xk + BK y, u = CK xk + DK y)")
+}
+
+/// Whether a path names a MAT-file (extension `.mat`, any case).
+pub fn is_mat_path(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("mat"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writer_output_reads_back_bit_for_bit() {
+        let a = Mat::from_fn(3, 2, |i, j| (i as f64 + 1.0) / (j as f64 + 3.0) - 1e-300);
+        let e = Mat::<f64>::zeros(2, 0);
+        let bytes = write_mat(&[("A", a.as_ref()), ("E", e.as_ref())], "test");
+        assert_eq!(&bytes[126..128], b"IM");
+        let vars = read_mat_vars(&bytes).unwrap();
+        let back = vars["A"].to_mat();
+        assert_eq!((back.nrows(), back.ncols()), (3, 2));
+        for i in 0..3 {
+            for j in 0..2 {
+                assert_eq!(back[(i, j)].to_bits(), a[(i, j)].to_bits());
+            }
+        }
+        assert_eq!((vars["E"].rows, vars["E"].cols), (2, 0));
+    }
+
+    #[test]
+    fn garbage_is_a_format_error() {
+        let e = read_mat_vars(&[7u8; 300]).unwrap_err();
+        assert!(matches!(e, MatReadError::Format(_)), "{e}");
+        assert!(matches!(read_mat_vars(b"short").unwrap_err(), MatReadError::Format(_)));
+    }
+}

@@ -1,0 +1,69 @@
+//! `tables.tex` in the paper's layout: 4 significant figures, captions and labels, † only when
+//! used, a literature column only for plants with literature values; it and `compare.tex`
+//! compile with pdflatex.
+
+use std::path::Path;
+
+use hinfix::campaign::latex::{compare_tex, sig4, sig_figs, tables_tex};
+use hinfix::campaign::reduce::BestRow;
+use hinfix::campaign::report::{compare_rows, FullOrderRow};
+use hinfix::campaign::{load_reference, REFERENCE_CSV};
+
+mod common;
+
+fn row(plant: &str, order: usize, gamma: f64) -> BestRow {
+    BestRow { plant: plant.into(), order, gamma, job_id: Some("j".into()), eps: Some(1e-3), seed: Some(0), runs: 2, verified: 1, failed: 1 }
+}
+
+#[test]
+fn four_significant_figures_not_four_decimals() {
+    assert_eq!(sig_figs(0.00035, 4), "0.0003500");
+    assert_eq!(sig_figs(34.81, 4), "34.81");
+    assert_eq!(sig_figs(1.36957, 4), "1.370");
+    assert_eq!(sig_figs(9.99996, 4), "10.00");
+    assert_eq!(sig_figs(12345.6, 4), "12346");
+    assert_eq!(sig_figs(-0.123449, 4), "-0.1234");
+    assert_eq!(sig4(1e-6), "$1.000\\times10^{-6}$");
+    assert_eq!(sig4(f64::NAN), "--");
+    assert_eq!(sig4(0.07362), "0.07362");
+}
+
+#[test]
+fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_used() {
+    let reference = load_reference(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE_CSV)).unwrap();
+    let best = vec![row("PA", 1, 0.000351), row("PA", 2, 0.0003498), row("ZerenOzbay", 3, 35.0), row("ZerenOzbay", 5, 34.9), row("My_Plant", 1, 2.5)];
+    let full = vec![
+        FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: false },
+        FullOrderRow { plant: "ZerenOzbay".into(), gamma: 34.24, from_paper: false },
+    ];
+    let tex = tables_tex(&best, &full, &reference);
+    let block = |p: &str| {
+        let start = tex.find(&format!("\\label{{tab:hinfix-{p}}}")).unwrap_or_else(|| panic!("no label for {p}:\n{tex}"));
+        let end = start + tex[start..].find("\\end{table}").unwrap();
+        tex[start..end].to_string()
+    };
+    let pa = block("PA");
+    assert!(pa.contains("2 & 0.0003498 & 0.0003500 & 0.9994"), "{pa}");
+    assert!(!pa.contains("literature"), "PA has no literature values:\n{pa}");
+    assert!(pa.contains("full order ($n_K = 5$, stable $K$) & $1.000\\times10^{-6}$"), "{pa}");
+    let zo = block("ZerenOzbay");
+    assert!(zo.contains("& literature"), "{zo}");
+    assert!(zo.contains("unstable $K$"), "the paper's full-order controller of ZerenOzbay is unstable:\n{zo}");
+    assert!(zo.contains("10 & -- & -- & -- & 42.51 (Zeren-Ozbay 2000); 35.29 (Gumussoy-Ozbay 2005)"), "{zo}");
+    let (i5, i3) = (zo.find("\n5 & ").unwrap(), zo.find("\n3 & ").unwrap());
+    assert!(i5 < i3, "orders from the highest down, as in the paper");
+    assert!(block("My-Plant").contains("\\end{tabular}"), "labels keep only letters, digits and -");
+    assert!(tex.contains("\\caption{My\\_Plant: "), "names escaped in captions");
+    assert_eq!(tex.matches("\\caption{").count(), 3);
+    assert!(!tex.contains("dagger"), "no † when no value is the paper's");
+
+    let with_paper = vec![FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: true }];
+    let tex2 = tables_tex(&best[..2], &with_paper, &reference);
+    assert_eq!(tex2.matches("$^\\dagger$").count(), 2, "one mark and its note:\n{tex2}");
+
+    // Both files compile.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tables.tex"), tables_tex(&best, &with_paper, &reference)).unwrap();
+    std::fs::write(dir.path().join("compare.tex"), compare_tex(&compare_rows(&best, &full, &reference))).unwrap();
+    common::latex_compiles(dir.path());
+}
