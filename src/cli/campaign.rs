@@ -93,6 +93,8 @@ pub struct ReportArgs {
 pub struct PlotArgs {
     #[command(flatten)]
     pub campaign: CampaignFileArgs,
+    #[command(flatten)]
+    pub extra: JournalArgs,
 }
 
 /// Arguments of `campaign trace`.
@@ -342,9 +344,9 @@ pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
 /// `campaign plot FILE`: figures of the journaled jobs into `<results>/<name>/plots/`.
 pub fn plot(a: PlotArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
-    let records = journaled(&l)?;
+    let (records, journals) = journaled(&l, &a.extra)?;
     if records.is_empty() {
-        anyhow::bail!("{}: no finished jobs of this campaign yet (run it first)", journal_path(&l.dir).display());
+        anyhow::bail!("{}: no finished jobs of this campaign in {} journal(s) (run it first)", l.dir.display(), journals.len());
     }
     let reference = load_default_reference().context("reading the paper's reference table")?;
     let s = hinfix::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;
