@@ -8,6 +8,12 @@
 //! - [`lti`]: plants, controllers, closed loops, spectral abscissa, H∞ norm and their gradients;
 //! - [`design`]: the HIFOO method, joining `lti` and `optim`;
 //! - [`campaign`]: campaign files, job scheduling, journal/resume, traces and reports.
+//!
+//! Below all of them, [`numeric`] (a few shared numeric helpers) and [`fs_atomic`] (atomic file
+//! writes). The layers, a job's path through them and the journal's guarantees are described in
+//! docs/ARCHITECTURE.md; the methods, with their references, in docs/ALGORITHMS.md.
+pub mod fs_atomic;
+pub(crate) mod numeric;
 pub mod optim;
 pub mod lti;
 pub mod design;

@@ -8,7 +8,6 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::latex;
@@ -134,15 +133,10 @@ pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[Refere
         .collect()
 }
 
-/// Writes `bytes` to `path` atomically: `<path>.tmp` in the same directory, fsync, rename.
+/// Writes `bytes` to `path` atomically and durably ([`crate::fs_atomic::write_atomic`]), with
+/// the path in the error.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
-    let tmp = path.with_extension(format!("{}.tmp", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
-    let io = |source| ReportError::Io { path: path.to_path_buf(), source };
-    let mut f = std::fs::File::create(&tmp).map_err(io)?;
-    f.write_all(bytes).map_err(io)?;
-    f.sync_all().map_err(io)?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(io)
+    crate::fs_atomic::write_atomic(path, bytes).map_err(|source| ReportError::Io { path: path.to_path_buf(), source })
 }
 
 fn csv_bytes<R: serde::Serialize>(path: &Path, rows: impl IntoIterator<Item = R>) -> Result<Vec<u8>, ReportError> {

@@ -3,7 +3,7 @@
 //! ```text
 //! xk' = Ak xk + Bk y,   u = Ck xk + Dk y        (positive feedback u = K y)
 //! ```
-//! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (algorithm.md §1). The file is a JSON object with
+//! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (docs/ALGORITHMS.md §1). The file is a JSON object with
 //! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`).
 
 use std::path::{Path, PathBuf};
@@ -84,6 +84,11 @@ impl Controller {
     /// Order nk (number of controller states).
     pub fn order(&self) -> usize {
         self.ak.nrows()
+    }
+
+    /// Whether every entry of Ak, Bk, Ck, Dk is finite.
+    pub fn is_finite(&self) -> bool {
+        [&self.ak, &self.bk, &self.ck, &self.dk].iter().all(|m| crate::numeric::all_finite(m.as_ref()))
     }
 
     /// Number of control inputs m (rows of Dk).
