@@ -35,4 +35,12 @@ mod tests {
         m[(1, 2)] = f64::NEG_INFINITY;
         assert!(!all_finite(m.as_ref()));
     }
+
+    /// The tests run in the release profile (`cargo test --release`), where Cargo.toml turns
+    /// overflow checks on for this crate: integer overflow must panic, not wrap.
+    #[test]
+    fn integer_overflow_panics() {
+        let zero = std::hint::black_box(0usize);
+        assert!(std::panic::catch_unwind(|| zero - 1).is_err(), "overflow checks are off (see Cargo.toml)");
+    }
 }
