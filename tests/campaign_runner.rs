@@ -150,3 +150,22 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("c.toml:3:"), "{stderr}");
 }
+
+#[test]
+fn latex_structure_catches_what_would_not_compile() {
+    let ok = "% c\n\\begin{tabular}{l@{}rr}\n\\toprule\n\\multicolumn{3}{c}{A\\_1 γ} \\\\\n\\midrule\n$n_K$ & x & 50\\% \\\\\n\\bottomrule\n\\end{tabular}\n";
+    assert_eq!(common::latex_structure(ok), Ok(()));
+    for (bad, why) in [
+        (ok.replace("A\\_1", "A_1"), "outside math"),
+        (ok.replace("& x &", "& x & y &"), "has 4 cells"),
+        (ok.replace("\\end{tabular}", "\\end{table}"), "closes"),
+        (ok.replace("{c}{A", "{c}A"), "unmatched }"),
+        (ok.replace("\\bottomrule", ""), "booktabs"),
+        (ok.replace("$n_K$", "$n_K"), "math not closed"),
+        (ok.replace("\\end{tabular}\n", ""), "never closed"),
+        (ok.replace("x &", "\\# #1 &"), "unescaped #"),
+    ] {
+        let e = common::latex_structure(&bad).unwrap_err();
+        assert!(e.contains(why), "{e} (wanted: {why})");
+    }
+}

@@ -2,7 +2,7 @@
 //!
 //! [`expand`] turns a [`Campaign`] into jobs in a deterministic, order-stable sequence: problems
 //! in file order, then orders ascending, then ε and seeds in file order. The same file always
-//! gives the same jobs in the same order, which a future `--shard i/N` needs (design.md).
+//! gives the same jobs in the same order, which a future `--shard i/N` needs (docs/ARCHITECTURE.md §2).
 //!
 //! A [`JobId`] is the SHA-256 (hex) of a canonical JSON document holding the plant fingerprint,
 //! every [`DesignOptions`] field (order, ε, seed, cpumax, nrand, objective, tolerances …) and, for

@@ -1,7 +1,7 @@
 //! Benchmark campaigns: campaign files, job expansion, scheduling, journal/resume, traces and
 //! reports — plus the paper's reference numbers they are compared with.
 //!
-//! The pieces are separate, nextest style (style.md §4): [`scheduler::execute`] runs jobs and
+//! The pieces are separate, nextest style (docs/ARCHITECTURE.md §2): [`scheduler::execute`] runs jobs and
 //! emits [`scheduler::CampaignEvent`]s without printing or writing anything; the journal
 //! ([`run`]), the trace writer ([`trace`]), the progress reporter ([`progress`]) and the report
 //! writers ([`report`]) each consume what they need.

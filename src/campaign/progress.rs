@@ -1,5 +1,5 @@
 //! The progress reporter: a consumer of [`CampaignEvent`]s, never called by the scheduler itself
-//! (nextest's runner/reporter split, style.md §4).
+//! (nextest's runner/reporter split; docs/ARCHITECTURE.md §2).
 //!
 //! Two displays:
 //! * [`Display::Bars`] (stderr is a terminal): an indicatif bar over all jobs with ETA, and one

@@ -42,17 +42,7 @@ impl Provenance {
 
 /// This machine's host name (`"unknown"` if it cannot be read).
 pub fn host_name() -> String {
-    let mut buf = [0u8; 256];
-    // SAFETY: gethostname writes at most buf.len() bytes into the buffer we own.
-    let rc = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) };
-    if rc != 0 {
-        return "unknown".into();
-    }
-    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
-    match String::from_utf8_lossy(&buf[..end]).trim() {
-        "" => "unknown".into(),
-        s => s.to_string(),
-    }
+    crate::fs_atomic::host_name()
 }
 
 /// The CPU model from `/proc/cpuinfo` (`model name`, else `Model`/`Hardware`), else the

@@ -8,7 +8,6 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::latex;
@@ -133,24 +132,10 @@ pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[Refere
         .collect()
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file unique to this process and call in the
-/// same directory, fsync, rename (several processes may write the same report at once; each
-/// rename installs one complete file).
+/// Writes `bytes` to `path` atomically and durably ([`crate::fs_atomic::write_atomic`]), with
+/// the path in the error.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
-    static SEQ: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let seq = SEQ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-    let host = super::provenance::host_name();
-    let tmp = path.with_file_name(format!(".{name}.{host}.{}.{seq}.tmp", std::process::id()));
-    let io = |source| ReportError::Io { path: path.to_path_buf(), source };
-    let mut f = std::fs::File::create(&tmp).map_err(io)?;
-    f.write_all(bytes).map_err(io)?;
-    f.sync_all().map_err(io)?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
-    })
+    crate::fs_atomic::write_atomic(path, bytes).map_err(|source| ReportError::Io { path: path.to_path_buf(), source })
 }
 
 fn csv_bytes<R: serde::Serialize>(path: &Path, rows: impl IntoIterator<Item = R>) -> Result<Vec<u8>, ReportError> {

@@ -1,5 +1,5 @@
 //! The scheduler: runs jobs on a local rayon pool and reports [`CampaignEvent`]s to one
-//! callback on the calling thread. It never prints or writes (nextest's split, style.md §4); the
+//! callback on the calling thread. It never prints or writes (nextest's split; docs/ARCHITECTURE.md §2); the
 //! journal, traces and progress display are consumers.
 //!
 //! * The job runner is injected ([`JobRunner`]): production passes [`DesignRunner`]
@@ -33,6 +33,7 @@ use super::provenance::Provenance;
 use super::record::JobRecord;
 use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, Phase};
 use crate::lti::Controller;
+use crate::optim::thread_cpu_time;
 
 /// Runs one job. Production: [`DesignRunner`]; tests: closures.
 pub trait JobRunner: Sync {
@@ -270,17 +271,6 @@ pub enum ExecuteError<E> {
     /// The event callback failed (the first error; in-flight jobs were cancelled).
     #[error("{0}")]
     Callback(E),
-}
-
-/// CPU time of the calling thread (s).
-pub fn thread_cpu_time() -> f64 {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: clock_gettime writes into the timespec we own.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    if rc != 0 {
-        return f64::NAN;
-    }
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
 enum WorkerMsg {

@@ -1,7 +1,7 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
 //! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
-//! `campaign check` reads, atomically (temporary file + rename).
+//! `campaign check` reads, atomically and durably (`hinfix::fs_atomic`).
 //!
 //! Every outcome (including "not stabilised") writes the returned controller and exits 0, except
 //! an interrupt (Ctrl-C cancels the run; the best controller so far is still written), which
@@ -13,6 +13,7 @@ use std::sync::Arc;
 
 use anyhow::Context;
 use hinfix::design::{run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind};
+use hinfix::fs_atomic::write_atomic;
 use hinfix::lti::{resolve_plant, Controller, Plant};
 use hinfix::optim::RunControl;
 
@@ -84,7 +85,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         k.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
     } else {
         let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
-        write_atomically(&a.out, &text).with_context(|| format!("writing {}", a.out.display()))?;
+        write_atomic(&a.out, text.as_bytes()).with_context(|| format!("writing {}", a.out.display()))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&outcome)?);
@@ -92,15 +93,6 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         print!("{}", summary(&plant, &opts, &outcome, &a.out));
     }
     Ok(if outcome.status == DesignStatus::Interrupted { ExitCode::from(EXIT_INTERRUPTED) } else { ExitCode::SUCCESS })
-}
-
-/// Writes `text` to `path` via `path.tmp` + rename, so a reader never sees a partial file.
-fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, text)?;
-    std::fs::rename(&tmp, path)
 }
 
 fn status_text(s: &DesignStatus) -> String {

@@ -1,4 +1,4 @@
-//! The HIFOO method: fixed-order H∞ design with strong stabilisation (algorithm.md §3, §3.1, §7;
+//! The HIFOO method: fixed-order H∞ design with strong stabilisation (docs/ALGORITHMS.md §3, §8;
 //! Gumussoy, Millstone & Overton, CDC 2008).
 //!
 //! * [`params`]: x = [vec Ak; vec Bk; vec Ck; vec Dk] ↔ controller;

@@ -1,5 +1,5 @@
 //! The two design objectives as [`optim::Objective`](crate::optim::Objective)s
-//! (algorithm.md §3, §3.1), and the observer adapter that reports their components.
+//! (docs/ALGORITHMS.md §3), and the observer adapter that reports their components.
 //!
 //! With weights (1, ε) on the plant and on the controller "plant" `'K'` (HIFOO 3.5's strong
 //! stabilisation, Gumussoy–Millstone–Overton 2008):
@@ -16,7 +16,7 @@
 //! not finite the gradient is NaN, which the optimiser's line search treats as a failed trial.
 //!
 //! For order 0 the controller term is dropped from f_s (a static gain has no dynamics) but kept
-//! in f_h as ε·σmax(Dk) (algorithm.md §3.1).
+//! in f_h as ε·σmax(Dk) (docs/ALGORITHMS.md §3.2).
 //!
 //! Cost: ε·‖K‖∞ (an nk-state system) is evaluated before ‖Tzw‖∞ (n + nk states), so an unstable
 //! controller costs almost nothing. Each evaluation stores its components (‖Tzw‖∞, ‖K‖∞, α's) in

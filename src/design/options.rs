@@ -14,7 +14,7 @@ pub enum ObjectiveKind {
     Plain,
 }
 
-/// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (algorithm.md §7).
+/// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (docs/ALGORITHMS.md §8).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DesignOptions {

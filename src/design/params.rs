@@ -1,4 +1,4 @@
-//! The controller parameterisation (algorithm.md §1):
+//! The controller parameterisation (docs/ALGORITHMS.md §1):
 //!
 //! ```text
 //! x = [ vec(Ak) ; vec(Bk) ; vec(Ck) ; vec(Dk) ]     (column-major vec)

@@ -1,4 +1,4 @@
-//! The two phases of a HIFOO run (algorithm.md §7.4, §7.5).
+//! The two phases of a HIFOO run (docs/ALGORITHMS.md §8.3, §8.4).
 //!
 //! **Stabilisation.** BFGS on f_s = max(α(Acl), ε·α(Ak)) from each start separately, with
 //! fvalquit = 0 (stop as soon as f_s < 0, i.e. Acl and Ak both Hurwitz). If no start was
@@ -62,7 +62,7 @@ pub(crate) struct Stabilisation {
     pub stopped: Option<Termination>,
 }
 
-/// Runs the stabilisation phase from `starts` (algorithm.md §7.4).
+/// Runs the stabilisation phase from `starts` (docs/ALGORITHMS.md §8.3).
 pub(crate) fn stabilise(
     obj: &mut DesignObjective<'_>,
     starts: &[Vec<f64>],
@@ -159,7 +159,7 @@ pub(crate) struct Optimisation {
     pub stopped: Option<Termination>,
 }
 
-/// Runs the optimisation phase (HANSO) from the stable points (algorithm.md §7.5).
+/// Runs the optimisation phase (HANSO) from the stable points (docs/ALGORITHMS.md §8.4).
 pub(crate) fn optimise(
     obj: &mut DesignObjective<'_>,
     starts: &[Vec<f64>],

@@ -1,4 +1,4 @@
-//! [`run`]: one HIFOO design (algorithm.md §7): validate, build the starting points, stabilise,
+//! [`run`]: one HIFOO design (docs/ALGORITHMS.md §8): validate, build the starting points, stabilise,
 //! optimise, and report figures recomputed from the returned controller.
 
 use std::cell::RefCell;
@@ -23,7 +23,7 @@ use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_s
 /// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds.
 ///
 /// `init` (optional) is a starting controller of order ≤ `opts.order`; a lower order is padded
-/// with decoupled stable modes (algorithm.md §7.3), and it is used together with `opts.nrand`
+/// with decoupled stable modes (docs/ALGORITHMS.md §8.2), and it is used together with `opts.nrand`
 /// relative perturbations of itself. Without `init`, `opts.nrand` standard-normal starts are drawn
 /// from a ChaCha8 generator seeded with `opts.seed`.
 ///
@@ -96,10 +96,7 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
                 opts.order
             )));
         }
-        let finite = [&k.ak, &k.bk, &k.ck, &k.dk]
-            .iter()
-            .all(|m| (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite())));
-        if !finite {
+        if !k.is_finite() {
             return Err(DesignError::Init("has a non-finite entry".into()));
         }
     }

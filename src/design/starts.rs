@@ -1,4 +1,4 @@
-//! Starting points of a design run (algorithm.md §7.2–§7.3).
+//! Starting points of a design run (docs/ALGORITHMS.md §8.1–§8.2).
 //!
 //! * No initial controller: `nrand` standard-normal vectors x ~ N(0, I) in ℝ^nvar
 //!   (HIFOO `randn(nvar, nrand)`).

@@ -1,4 +1,4 @@
-//! The closed loop of a generalised plant with a dynamic controller u = K y (algorithm.md §2).
+//! The closed loop of a generalised plant with a dynamic controller u = K y (docs/ALGORITHMS.md §2).
 //!
 //! The loop is written as a linear-fractional transformation of the controller's realisation
 //! X = [Ak Bk; Ck Dk] ((nk+m)×(nk+p)) around the augmented plant
@@ -15,11 +15,11 @@
 //! ```
 //!
 //! Written out, W = [Ak + Bk D22 F⁻¹ Ck, Bk N; F⁻¹ Ck, F⁻¹ Dk] with F = I − Dk D22 and
-//! N = (I − D22 Dk)⁻¹ = I + D22 F⁻¹ Dk, which is exactly §2 (and the SLICOT oracle's formula).
+//! N = (I − D22 Dk)⁻¹ = I + D22 F⁻¹ Dk, which is the usual block form (the SLICOT oracle's formula, tests/fixtures/oracle/README.md).
 //! The loop is well posed iff F is invertible; we require cond₂(F) ≤ [`MAX_LOOP_CONDITION`]
-//! and report [`LtiError::IllPosed`] otherwise (HIFOO itself does not test this, §2 notes).
+//! and report [`LtiError::IllPosed`] otherwise (HIFOO itself does not test this; docs/ALGORITHMS.md §2).
 //!
-//! The same form gives the chain rule of §4.3/§4.4 in one line: dW = P dX Q with
+//! The same form gives the chain rule (docs/ALGORITHMS.md §6.2) in one line: dW = P dX Q with
 //! P = (I − X D̄22)⁻¹ and Q = (I − D̄22 X)⁻¹, so for any f of (Acl, Bcl, Ccl, Dcl) with real
 //! matrix gradients G_A, G_B, G_C, G_D,
 //!
@@ -27,7 +27,7 @@
 //! ∂f/∂X = Pᵀ Γ Qᵀ,   Γ = [B̄ᵀ D̄12ᵀ] [G_A G_B; G_C G_D] [C̄ᵀ; D̄21ᵀ],
 //! ```
 //!
-//! whose blocks for D22 = 0 (P = Q = I) are the four formulas of §4.3. Every gradient this
+//! whose blocks for D22 = 0 (P = Q = I) are HIFOO's four formulas. Every gradient this
 //! crate needs is a rank-one complex outer product (α: ū vᵀ/(uᴴv); ‖·‖∞: ā bᵀ etc.), so Γ is
 //! assembled from two short vectors instead of (n+nk)² matrices ([`ClosedLoop::chain_rule`]).
 
@@ -157,7 +157,7 @@ fn check_shape(what: &'static str, m: MatRef<'_, f64>, expected: (usize, usize))
 
 /// 2-norm condition number σmax/σmin of a square matrix (+∞ if singular, NaN if not finite).
 pub(crate) fn condition_number(f: MatRef<'_, f64>) -> f64 {
-    if !super::state_space::all_finite(f) {
+    if !crate::numeric::all_finite(f) {
         return f64::NAN;
     }
     match f.singular_values() {

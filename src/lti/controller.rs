@@ -3,7 +3,7 @@
 //! ```text
 //! xk' = Ak xk + Bk y,   u = Ck xk + Dk y        (positive feedback u = K y)
 //! ```
-//! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (algorithm.md §1). The file is a JSON object with
+//! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (docs/ALGORITHMS.md §1). The file is a JSON object with
 //! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`).
 
 use std::path::{Path, PathBuf};
@@ -89,6 +89,11 @@ impl Controller {
         self.ak.nrows()
     }
 
+    /// Whether every entry of Ak, Bk, Ck, Dk is finite.
+    pub fn is_finite(&self) -> bool {
+        [&self.ak, &self.bk, &self.ck, &self.dk].iter().all(|m| crate::numeric::all_finite(m.as_ref()))
+    }
+
     /// Number of control inputs m (rows of Dk).
     pub fn m(&self) -> usize {
         self.dk.nrows()
@@ -156,11 +161,7 @@ impl Controller {
         } else {
             (serde_json::to_string_pretty(&self.to_json()).map_err(std::io::Error::other)? + "\n").into_bytes()
         };
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        let tmp = PathBuf::from(tmp);
-        std::fs::write(&tmp, bytes)?;
-        std::fs::rename(&tmp, path)
+        crate::fs_atomic::write_atomic(path, &bytes)
     }
 
     /// The controller as `{AK, BK, CK, DK}`.

@@ -1,7 +1,7 @@
 //! Errors of the LTI numerics.
 //!
 //! Most numerical outcomes are values, not errors: an unstable loop has H∞ norm +∞ and a failed
-//! eigenvalue computation gives spectral abscissa +∞ (algorithm.md §3). What remains are inputs
+//! eigenvalue computation gives spectral abscissa +∞ (docs/ALGORITHMS.md §3.1). What remains are inputs
 //! that do not fit together and an ill-posed feedback loop.
 
 /// Why an LTI computation could not produce a value.

@@ -52,7 +52,8 @@ use std::fmt;
 use faer::{Mat, MatRef, Side};
 
 use super::plant::Plant;
-use super::riccati::{all_finite, solve_care};
+use super::riccati::solve_care;
+use crate::numeric::all_finite;
 
 /// Relative width of the final γ bracket.
 pub const GAMMA_RTOL: f64 = 1e-8;

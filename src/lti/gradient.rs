@@ -1,7 +1,7 @@
 //! The four quantities of the design objectives with their exact gradients with respect to the
-//! controller (Ak, Bk, Ck, Dk): α(Acl), α(Ak), ‖Tzw‖∞ and ‖K‖∞ (algorithm.md §3.1, §4).
+//! controller (Ak, Bk, Ck, Dk): α(Acl), α(Ak), ‖Tzw‖∞ and ‖K‖∞ (docs/ALGORITHMS.md §3.2, §6).
 //!
-//! Written by hand because no crate offers H∞ norms or their gradients (rust-numerics.md §6).
+//! Written by hand because no crate offers H∞ norms or their gradients.
 //! Method as in HIFOO (Burke, Henrion, Lewis & Overton 2006; Gumussoy, Millstone & Overton 2008):
 //!
 //! * α: ∇_A α = Re(ū vᵀ)/(uᴴv) from the rightmost eigen-triple (`spectral.rs`).
@@ -10,7 +10,7 @@
 //!   ```text
 //!   G_A = Re(ā bᵀ),  G_B = Re(ā vᵀ),  G_C = Re(ū bᵀ),  G_D = Re(ū vᵀ)
 //!   ```
-//!   (§4.2 in vector form; at ω = ∞ only G_D survives). One complex LU of Z gives both b and a.
+//!   (docs/ALGORITHMS.md §6.1, in vector form; at ω = ∞ only G_D survives). One complex LU of Z gives both b and a.
 //! * Chain rule through the closed loop, D22 ≠ 0 included: `closed_loop.rs`
 //!   ([`ClosedLoop::chain_rule`]). For the controller's own quantities the matrix gradients are the
 //!   gradient (no chain rule).

@@ -1,7 +1,7 @@
 //! The H∞ norm ‖G‖∞ = sup_ω σmax(G(iω)) of a stable continuous-time system, with its peak
-//! frequency (algorithm.md §5).
+//! frequency (docs/ALGORITHMS.md §5).
 //!
-//! Written by hand because no Rust crate offers it (rust-numerics.md §6: the only one,
+//! Written by hand because no Rust crate offers it (the only one found,
 //! control_systems_torbox, links SLICOT Fortran and a GUI stack).
 //!
 //! # Method: Bruinsma–Steinbuch level set with AB13DD's refinements

@@ -5,7 +5,7 @@
 //! z  = C1 x + D11 w + D12 u
 //! y  = C2 x + D21 w + D22 u
 //! ```
-//! with n = dim x, m1 = dim w, m2 = dim u, p1 = dim z, p2 = dim y (algorithm.md §1).
+//! with n = dim x, m1 = dim w, m2 = dim u, p1 = dim z, p2 = dim y (docs/ALGORITHMS.md §1).
 //!
 //! A plant file is a JSON object with `name`, optional `description`, `source` (a citation string
 //! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices

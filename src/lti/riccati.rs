@@ -12,7 +12,7 @@
 //! `span [I; X]` then `X` is the (unique, symmetric) stabilising solution, `X = Ric(H)` in the
 //! notation of Doyle–Glover–Khargonekar–Francis (IEEE TAC 34(8), 1989).
 //!
-//! # Method (rust-numerics.md §4)
+//! # Method (docs/ALGORITHMS.md §9.2)
 //!
 //! No Rust crate offers an ordered real Schur form, so the stable subspace is obtained from the
 //! matrix sign function `S = sign(H)` (Roberts 1971; Byers 1987; Kenney–Laub 1995), computed by the
@@ -52,6 +52,8 @@
 
 use faer::linalg::solvers::{DenseSolveCore, SolveLstsq};
 use faer::{Mat, MatRef};
+
+use crate::numeric::all_finite;
 
 /// Relative change ‖Z_{k+1} − Z_k‖_F / ‖Z_{k+1}‖_F below which the sign iteration has converged.
 pub const SIGN_TOL: f64 = 1e-12;
@@ -326,10 +328,6 @@ fn symmetrise(m: MatRef<'_, f64>) -> Mat<f64> {
 
 fn trace(m: MatRef<'_, f64>) -> f64 {
     (0..m.nrows()).map(|i| m[(i, i)]).sum()
-}
-
-pub(crate) fn all_finite(m: MatRef<'_, f64>) -> bool {
-    (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()))
 }
 
 #[cfg(test)]

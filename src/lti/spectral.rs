@@ -1,4 +1,4 @@
-//! Spectral abscissa α(M) = max Re λ(M) and its gradient (algorithm.md §4.1).
+//! Spectral abscissa α(M) = max Re λ(M) and its gradient (docs/ALGORITHMS.md §4).
 //!
 //! For a simple eigenvalue λ with right eigenvector v (M v = λ v) and left eigenvector u
 //! (uᴴ M = λ uᴴ), first-order perturbation theory gives dλ = uᴴ dM v / (uᴴ v), hence
@@ -9,7 +9,7 @@
 //!
 //! (Burke, Henrion, Lewis & Overton, "HIFOO — a MATLAB package for fixed-order controller design
 //! and H∞ optimization", IFAC ROCOND 2006.) Left and right eigenvectors come from one call to faer's
-//! `evd_real` (LAPACK `dgeev`-style packing, rust-numerics.md §1.1).
+//! `evd_real` (LAPACK `dgeev`-style packing).
 //!
 //! * **Complex pairs.** Both members of a conjugate pair give the same real gradient; we always
 //!   use the member with Im λ > 0.
@@ -48,7 +48,7 @@ pub(crate) fn eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
     if n == 0 {
         return Some(Vec::new());
     }
-    if !super::state_space::all_finite(a) {
+    if !crate::numeric::all_finite(a) {
         return None;
     }
     let mut wr = faer::diag::Diag::<f64>::zeros(n);
@@ -92,7 +92,7 @@ pub(crate) struct RightmostEigen {
 /// Rightmost eigen-triple of A (n ≥ 1); `None` for non-finite input or eigensolver failure.
 pub(crate) fn rightmost_eigen(a: MatRef<'_, f64>) -> Option<RightmostEigen> {
     let n = a.nrows();
-    if n == 0 || !super::state_space::all_finite(a) {
+    if n == 0 || !crate::numeric::all_finite(a) {
         return None;
     }
     let par = Par::Seq;

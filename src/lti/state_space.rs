@@ -3,6 +3,7 @@
 use faer::Mat;
 
 use super::LtiError;
+use crate::numeric::all_finite;
 
 /// Real state-space realisation (A, B, C, D): A n×n, B n×m, C p×n, D p×m.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,9 +55,4 @@ impl StateSpace {
     pub fn is_finite(&self) -> bool {
         [&self.a, &self.b, &self.c, &self.d].iter().all(|m| all_finite(m.as_ref()))
     }
-}
-
-/// Whether every entry of a matrix is finite.
-pub(crate) fn all_finite(m: faer::MatRef<'_, f64>) -> bool {
-    (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()))
 }

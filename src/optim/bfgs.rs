@@ -1,5 +1,5 @@
 //! BFGS for nonsmooth functions (Lewis & Overton 2013, "Nonsmooth optimization via quasi-Newton
-//! methods", Math. Program. 141; HANSO 2.x `bfgs1run`, algorithm.md §6.2).
+//! methods", Math. Program. 141; HANSO 2.x `bfgs1run`, docs/ALGORITHMS.md §7.1).
 //!
 //! Iteration k, with H ≈ (∇²f)⁻¹ the inverse-Hessian approximation (H₀ = I):
 //!
@@ -11,7 +11,7 @@
 //!    H⁺ = H − ρ(H y sᵀ + s yᵀ H) + (ρ² yᵀHy + ρ) s sᵀ, ρ = 1/sᵀy (the explicitly symmetric form of
 //!    (I − ρsyᵀ)H(I − ρysᵀ) + ρssᵀ). If sᵀy ≤ 0 the update is **skipped** (only happens after a
 //!    failed line search; HANSO); so is an update that would produce a non-finite H (GRANSO).
-//!    Optional GRANSO-style damping (algorithm.md §8), off by default; optional relative
+//!    Optional GRANSO-style damping (Curtis, Mitchell & Overton 2017), off by default; optional relative
 //!    eigenvalue floor H ← H + δ·maxᵢHᵢᵢ·I (`h_floor`), off by default.
 //!
 //! Termination tests, in HANSO's order: f < fvalquit, ‖x‖ > xnormquit, line search bracketed but
@@ -32,6 +32,7 @@ use super::observer::{Observer, SolverKind};
 use super::options::BfgsOptions;
 use super::solver::{run, Limits, OptimResult, Solver, SolverState};
 use super::termination::Termination;
+use crate::numeric::dot;
 
 
 /// The state of a BFGS run.
@@ -72,10 +73,6 @@ impl SolverState for BfgsState {
 
 pub(crate) struct Bfgs<'o> {
     pub(crate) opts: &'o BfgsOptions,
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn symv(h: &[f64], v: &[f64]) -> Vec<f64> {

@@ -1,4 +1,4 @@
-//! The gradient bundle and the local optimality certificate (HANSO 2.x; algorithm.md §6.2, §6.5).
+//! The gradient bundle and the local optimality certificate (HANSO 2.x; docs/ALGORITHMS.md §7.3).
 //!
 //! BFGS keeps the gradients of consecutive iterates as long as each step is ≤ `evaldist`
 //! (a longer step resets the bundle to the new point), at most `ngrad` of them, newest first.

@@ -1,6 +1,6 @@
 //! Gradient sampling: "Algorithm GS" of Burke, Curtis, Lewis, Overton and Simões (2020),
 //! "Gradient sampling methods for nonsmooth optimization" (in Numerical Nonsmooth Optimization,
-//! Springer), the variant of HANSO 3.0 (algorithm.md §6.6).
+//! Springer), the variant of HANSO 3.0 (docs/ALGORITHMS.md §7.4).
 //!
 //! At iteration k, with sampling radius ε and stationarity target ν:
 //!
@@ -33,6 +33,7 @@ use super::options::GradSampOptions;
 use super::qp::min_norm_in_hull;
 use super::solver::{run, Limits, OptimResult, Solver, SolverState};
 use super::termination::Termination;
+use crate::numeric::dot;
 use rand::{Rng, RngCore};
 use rand_distr::{Distribution, StandardNormal};
 
@@ -76,10 +77,6 @@ impl SolverState for GradSampState {
 pub(crate) struct GradSamp<'a> {
     pub(crate) opts: &'a GradSampOptions,
     pub(crate) rng: &'a mut dyn RngCore,
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 impl GradSamp<'_> {

@@ -1,5 +1,5 @@
 //! HANSO-style driver (Hybrid Algorithm for Non-Smooth Optimization; Lewis & Overton 2013;
-//! algorithm.md §6.2 "multiple starts", §6.6): BFGS from every starting point with one shared
+//! docs/ALGORITHMS.md §7.5): BFGS from every starting point with one shared
 //! budget, then optionally gradient sampling from the best BFGS point.
 //!
 //! * The budget ([`RunControl`]: CPU seconds, cancel flag) is shared by all starts. A start that

@@ -1,5 +1,5 @@
 //! Weak-Wolfe bracketing line search (Lewis & Overton 2013, §4.2; HANSO `linesch_ww`,
-//! algorithm.md §6.3).
+//! docs/ALGORITHMS.md §7.2).
 //!
 //! Along a descent direction d from x₀ (g₀ᵀd < 0) find t > 0 with
 //!

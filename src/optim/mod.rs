@@ -12,11 +12,11 @@
 //! * [`hanso`]: BFGS from several starts with a shared budget, then gradient sampling.
 //! * [`min_norm_in_hull`]: the simplex QP behind both certificates.
 //!
-//! Structure (style.md): each solver has a state and a `step` (mathematics only); one driver
+//! Structure (docs/ALGORITHMS.md §7.5): each solver has a state and a `step` (mathematics only); one driver
 //! loop applies the termination tests in HANSO's order, the [`RunControl`] budget and cancel
 //! flag, and calls the [`Observer`], which can stop a run but never change it. All randomness
 //! comes from the `rng` passed in, so the same seed gives a bitwise-identical path.
-//! See algorithm.md §6 for the method and its defaults.
+//! See docs/ALGORITHMS.md §7 for the method and its defaults.
 
 mod bfgs;
 mod bundle;

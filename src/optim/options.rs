@@ -1,8 +1,8 @@
 //! Options of the solvers, with documented defaults and validation.
 //!
-//! Defaults: [`BfgsOptions`] follows HANSO 2.x `bfgs` (algorithm.md §6.1) with `wolfe1 = 1e-4`
+//! Defaults: [`BfgsOptions`] follows HANSO 2.x `bfgs` (docs/ALGORITHMS.md §7.1) with `wolfe1 = 1e-4`
 //! (HANSO 2.2/3.0; HANSO 2.0 had 0); [`GradSampOptions`] follows Algorithm GS of Burke, Curtis,
-//! Lewis, Overton and Simões (2020) as used by HANSO 3.0 (algorithm.md §6.6).
+//! Lewis, Overton and Simões (2020) as used by HANSO 3.0 (docs/ALGORITHMS.md §7.4).
 //! Override with struct-update syntax: `BfgsOptions { normtol: 1e-3, ..Default::default() }`.
 
 use super::error::OptimError;
@@ -37,7 +37,7 @@ pub struct BfgsOptions {
     pub quit_ls_fail: bool,
     /// Scale H₀ = I by sᵀy/yᵀy before the first update (HANSO `scale`). Default true.
     pub scale: bool,
-    /// Powell-type damping of the update as in GRANSO (algorithm.md §8): with B = H⁻¹ (here
+    /// Powell-type damping of the update as in GRANSO (Curtis, Mitchell & Overton 2017): with B = H⁻¹ (here
     /// Bs = −t·g_prev exactly, since s = −t·H·g_prev), if sᵀy < damping·sᵀBs replace y by
     /// θy + (1−θ)Bs, θ = (1−damping)·sᵀBs/(sᵀBs − sᵀy) (GRANSO: damping 1e-4, factor 0.9999).
     /// `None` (HANSO: no damping, skip the update when sᵀy ≤ 0). Default `None`.

@@ -7,14 +7,14 @@
 //! wᵀQw − minᵢ (Qw)ᵢ is 0 (this gap also bounds the suboptimality of ½wᵀQw).
 //!
 //! **Production path:** a small dense Mehrotra predictor–corrector interior-point method, the
-//! approach of HANSO's `qpspecial` (algorithm.md §6.4), written from the mathematics above: each
+//! approach of HANSO's `qpspecial` (docs/ALGORITHMS.md §7.3), written from the mathematics above: each
 //! iteration factors M = Q + diag(z/w) (+ a tiny regularisation) by Cholesky (faer) and eliminates
 //! the single equality multiplier with one extra solve M⁻¹e. Q is scaled by 1/maxᵢ Qᵢᵢ first
 //! (w is scale invariant). The answer is accepted only if the Frank–Wolfe gap passes
 //! [`KKT_GAP_REL`]/[`KKT_GAP_ABS`]; otherwise clarabel 0.11 (the project's QP solver) solves the
 //! same problem and the better feasible answer wins. The best single column is always a
 //! candidate as well, so the result is never worse than min ‖gᵢ‖.
-//! rust-numerics.md §7 measured the dense solver 10–100× faster than clarabel at 30–100 columns;
+//! The dense solver is 10–100× faster than clarabel at 30–100 columns (`cargo bench --bench optim`);
 //! it is called at every BFGS iteration, hence the special path. The module test checks that both
 //! solvers agree.
 
@@ -24,6 +24,8 @@ use clarabel::solver::{
 };
 use faer::{Mat, Side};
 use faer::linalg::solvers::Solve;
+
+use crate::numeric::dot;
 
 /// Maximum interior-point iterations.
 pub const QP_MAXIT: usize = 100;
@@ -76,10 +78,6 @@ pub struct MinNormResult {
     pub method: QpMethod,
     /// Frank–Wolfe gap wᵀQw − minᵢ(Qw)ᵢ of the returned w (unscaled; 0 = exactly optimal).
     pub kkt_gap: f64,
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// Scaled Gram matrix Q = GᵀG / s with s = max diag (s returned; s = 0 if all columns are 0).

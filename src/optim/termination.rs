@@ -1,5 +1,5 @@
 //! Why a solver stopped: a typed reason, `Copy` and serde, in the order of HANSO's tests
-//! (algorithm.md §6.2; HANSO `bfgs1run` `info` codes are available via [`Termination::hanso_info`]).
+//! (docs/ALGORITHMS.md §7.1; HANSO `bfgs1run` `info` codes are available via [`Termination::hanso_info`]).
 
 use serde::{Deserialize, Serialize};
 

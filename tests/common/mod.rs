@@ -4,21 +4,26 @@
 use std::path::Path;
 use std::process::Command;
 
-/// The LaTeX tables compile with a real `pdflatex` (CI installs it from Debian's packages). Where
-/// none can be installed, `HINFIX_NO_PDFLATEX=1` downgrades this to a structural check.
+/// The LaTeX tables are always checked structurally ([`latex_structure`]); where `pdflatex` is
+/// installed they are also compiled for real. Without `pdflatex` the structural check is all,
+/// unless CI asks for the real compile: with `CI` set (as `.ci/run` sets it) a missing `pdflatex`
+/// fails the test, except where `HINFIX_NO_PDFLATEX=1` says that none could be installed.
 pub fn latex_compiles(dir: &Path) {
+    for f in ["tables.tex", "compare.tex"] {
+        let tex = std::fs::read_to_string(dir.join(f)).unwrap();
+        if let Err(e) = latex_structure(&tex) {
+            panic!("{f}: {e}\n{tex}");
+        }
+    }
     let have = Command::new("pdflatex").arg("--version").output().is_ok_and(|o| o.status.success());
     if !have {
-        assert_eq!(
-            std::env::var("HINFIX_NO_PDFLATEX").as_deref(),
-            Ok("1"),
-            "pdflatex is not on PATH: install it (texlive-latex-base, texlive-latex-recommended) or set HINFIX_NO_PDFLATEX=1"
+        let opted_out = std::env::var("HINFIX_NO_PDFLATEX").as_deref() == Ok("1");
+        let ci = std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && v != "false");
+        assert!(
+            opted_out || !ci,
+            "CI is set but pdflatex is not on PATH: install it (texlive-latex-base, texlive-latex-recommended) or set HINFIX_NO_PDFLATEX=1"
         );
-        for f in ["tables.tex", "compare.tex"] {
-            let tex = std::fs::read_to_string(dir.join(f)).unwrap();
-            assert_eq!(tex.matches("\\begin{").count(), tex.matches("\\end{").count(), "{f}: unbalanced environments");
-            assert!(tex.contains("\\toprule") && tex.contains("\\bottomrule"), "{f}: not booktabs");
-        }
+        eprintln!("note: pdflatex not found; the LaTeX tables were checked structurally only");
         return;
     }
     std::fs::write(
@@ -34,3 +39,134 @@ pub fn latex_compiles(dir: &Path) {
     assert!(out.status.success(), "pdflatex failed:\n{}", String::from_utf8_lossy(&out.stdout));
     assert!(dir.join("wrap.pdf").is_file());
 }
+
+/// What makes a table fragment fail to compile, checked without LaTeX: environments nest and
+/// close (`\begin{x}` … `\end{x}`); braces balance; `#` never appears and `_`, `^` only in math
+/// (both unescaped); `$` math closes on its line; every `tabular` has booktabs rules, and each of
+/// its rows has as many cells (`\multicolumn{k}` counting k) as its column specification has
+/// columns. `%` starts a comment, as in LaTeX.
+pub fn latex_structure(tex: &str) -> Result<(), String> {
+    let mut envs: Vec<(String, usize, Vec<String>)> = Vec::new(); // (name, columns, rows)
+    let mut depth = 0i64;
+    for (no, raw) in tex.lines().enumerate() {
+        let at = |what: String| format!("line {}: {what}", no + 1);
+        let line = strip_comment(raw);
+        // Characters: braces, math, specials.
+        let mut math = false;
+        let mut chars = line.chars().peekable();
+        while let Some(c) = chars.next() {
+            match c {
+                '\\' => {
+                    chars.next(); // an escaped character or the first letter of a command
+                }
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if depth < 0 {
+                        return Err(at("unmatched }".into()));
+                    }
+                }
+                '$' => math = !math,
+                '#' => return Err(at("unescaped #".into())),
+                '_' | '^' if !math => return Err(at(format!("unescaped {c} outside math"))),
+                _ => {}
+            }
+        }
+        if math {
+            return Err(at("$ math not closed on its line".into()));
+        }
+        // Environments and table rows.
+        let mut rest = line;
+        while !rest.is_empty() {
+            if let Some(r) = rest.strip_prefix("\\begin{") {
+                let (name, r) = r.split_once('}').ok_or_else(|| at("\\begin without }".into()))?;
+                let (cols, r) = if name == "tabular" { column_spec(r).map_err(&at)? } else { (0, r) };
+                envs.push((name.to_string(), cols, Vec::new()));
+                rest = r;
+            } else if let Some(r) = rest.strip_prefix("\\end{") {
+                let (name, r) = r.split_once('}').ok_or_else(|| at("\\end without }".into()))?;
+                let (open, cols, rows) = envs.pop().ok_or_else(|| at(format!("\\end{{{name}}} without \\begin")))?;
+                if open != name {
+                    return Err(at(format!("\\end{{{name}}} closes \\begin{{{open}}}")));
+                }
+                if name == "tabular" {
+                    check_tabular(cols, &rows).map_err(&at)?;
+                }
+                rest = r;
+            } else {
+                let skip = rest.chars().next().map_or(1, char::len_utf8);
+                let tail = &rest[skip..];
+                let next = tail.find("\\begin{").into_iter().chain(tail.find("\\end{")).min().map_or(rest.len(), |i| i + skip);
+                if let Some((name, _, rows)) = envs.last_mut() {
+                    if name == "tabular" {
+                        rows.push(rest[..next].to_string());
+                    }
+                }
+                rest = &rest[next..];
+            }
+        }
+    }
+    if let Some((name, ..)) = envs.last() {
+        return Err(format!("\\begin{{{name}}} never closed"));
+    }
+    if depth != 0 {
+        return Err(format!("{depth} unclosed {{"));
+    }
+    Ok(())
+}
+
+fn strip_comment(line: &str) -> &str {
+    let b = line.as_bytes();
+    (0..b.len()).find(|&i| b[i] == b'%' && (i == 0 || b[i - 1] != b'\\')).map_or(line, |i| &line[..i])
+}
+
+/// The number of columns of a `{spec}` at the start of `s` (l, c, r, S, X; p/m/b{width};
+/// `|` and @/!/>/<{…} take none), and the text after it. A `*{n}{…}` repeat is not supported.
+fn column_spec(s: &str) -> Result<(usize, &str), String> {
+    let s = s.strip_prefix('{').ok_or("tabular without a column specification")?;
+    let (mut cols, mut level, mut end) = (0, 0, None);
+    let b = s.as_bytes();
+    let mut i = 0;
+    while i < b.len() {
+        match b[i] {
+            b'{' => level += 1,
+            b'}' if level == 0 => {
+                end = Some(i);
+                break;
+            }
+            b'}' => level -= 1,
+            b'*' => return Err("tabular column repeat *{n}{…} is not checked: write the columns out".into()),
+            b'l' | b'c' | b'r' | b'S' | b'X' | b'p' | b'm' | b'b' if level == 0 => cols += 1,
+            _ => {}
+        }
+        i += 1;
+    }
+    let end = end.ok_or("unterminated column specification")?;
+    Ok((cols, &s[end + 1..]))
+}
+
+/// Every row of a tabular (text up to each `\\`) has `cols` cells; booktabs rules are present.
+fn check_tabular(cols: usize, rows: &[String]) -> Result<(), String> {
+    let body = rows.join("\n");
+    if !(body.contains("\\toprule") && body.contains("\\bottomrule")) {
+        return Err("tabular without booktabs \\toprule/\\bottomrule".into());
+    }
+    for row in body.split("\\\\").map(str::trim) {
+        let row = ["\\toprule", "\\midrule", "\\bottomrule"].iter().fold(row.to_string(), |r, rule| r.replace(rule, ""));
+        if row.trim().is_empty() {
+            continue;
+        }
+        let b = row.as_bytes();
+        let amps = (0..b.len()).filter(|&i| b[i] == b'&' && (i == 0 || b[i - 1] != b'\\')).count();
+        let spans: usize = row
+            .split("\\multicolumn{")
+            .skip(1)
+            .map(|m| m.split('}').next().and_then(|k| k.trim().parse::<usize>().ok()).map_or(0, |k| k.saturating_sub(1)))
+            .sum();
+        if amps + 1 + spans != cols {
+            return Err(format!("row `{}` has {} cells, the tabular has {cols} columns", row.trim(), amps + 1 + spans));
+        }
+    }
+    Ok(())
+}
+

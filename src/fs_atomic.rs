@@ -1,0 +1,117 @@
+//! Writing a whole file atomically and durably: the one function every output file goes through
+//! (the campaign reports, the controller file of `campaign design`).
+//!
+//! A reader sees either the old file or the complete new one, never a part, and after the
+//! function returns the new content survives a crash or power cut (docs/ARCHITECTURE.md §3):
+//!
+//! 1. write `.<name>.<host>.<pid>.<seq>.tmp` in the same directory (so the rename below stays
+//!    within one file system; host, process id and a per-process sequence number keep two
+//!    writers of the same file — threads, processes, or machines sharing the folder — from
+//!    sharing a tmp file);
+//! 2. `fsync` it (its data is on disk before its name is);
+//! 3. `rename` it over `<name>` (atomic on POSIX file systems);
+//! 4. `fsync` the directory (the rename itself is on disk).
+//!
+//! On an error the tmp file is removed (best effort) and the target is left as it was.
+//! The MCAP traces are written incrementally by their own writer and use the same
+//! tmp-then-rename scheme (`campaign::trace`); the journal is append-only (`campaign::journal`).
+
+use std::fs::File;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Replaces `path` by a file holding exactly `bytes`, atomically and durably (see the module
+/// docs). The error is the underlying I/O error; the caller adds the path.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let tmp = tmp_path(path)?;
+    let result = write_synced(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    sync_dir(path)
+}
+
+/// `<dir>/.<name>.<host>.<pid>.<seq>.tmp` next to `path`.
+fn tmp_path(path: &Path) -> io::Result<PathBuf> {
+    static SEQ: AtomicUsize = AtomicUsize::new(0);
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path does not name a file"))?;
+    let seq = SEQ.fetch_add(1, Ordering::Relaxed);
+    let mut tmp = std::ffi::OsString::from(".");
+    tmp.push(name);
+    tmp.push(format!(".{}.{}.{seq}.tmp", host_name(), std::process::id()));
+    Ok(path.with_file_name(tmp))
+}
+
+/// This machine's host name (`gethostname`), or `"unknown"`.
+pub fn host_name() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: gethostname writes at most buf.len() bytes into the buffer we own.
+    let rc = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) };
+    if rc != 0 {
+        return "unknown".into();
+    }
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
+    match String::from_utf8_lossy(&buf[..end]).trim() {
+        "" => "unknown".into(),
+        s => s.to_string(),
+    }
+}
+
+fn write_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut f = File::create(path)?;
+    f.write_all(bytes)?;
+    f.sync_all()
+}
+
+/// `fsync` of the directory holding `path`, so that a rename into it is durable.
+fn sync_dir(path: &Path) -> io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    File::open(dir)?.sync_all()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("hinfix-fs-atomic-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn writes_replaces_and_leaves_no_tmp_file() {
+        let d = scratch("ok");
+        let p = d.join("best.csv");
+        write_atomic(&p, b"first\n").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"first\n");
+        write_atomic(&p, b"second, longer\n").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"second, longer\n");
+        let names: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("best.csv")]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn failure_keeps_the_old_file_and_removes_the_tmp_file() {
+        let d = scratch("fail");
+        // The target is a non-empty directory: the rename fails after the tmp file was written.
+        let p = d.join("out");
+        std::fs::create_dir_all(p.join("inside")).unwrap();
+        assert!(write_atomic(&p, b"x").is_err());
+        assert!(p.join("inside").is_dir());
+        let names: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("out")]);
+        // A path that names no file at all.
+        assert_eq!(write_atomic(Path::new("/"), b"x").unwrap_err().kind(), io::ErrorKind::InvalidInput);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}

@@ -1,0 +1,46 @@
+//! Small numeric helpers shared by [`crate::lti`] and [`crate::optim`].
+//!
+//! They live here, below both layers, so that `lti` and `optim` stay independent of each other
+//! (docs/ARCHITECTURE.md §1) while keeping one copy of each helper.
+
+use faer::MatRef;
+
+/// Σᵢ aᵢbᵢ, summed left to right (over the shorter length if the lengths differ).
+///
+/// The summation order is part of the result's rounding, and the optimiser's iterates depend on
+/// it bit for bit (same seed ⇒ same path), so it must not be changed casually. The H∞ level-set
+/// code keeps its own four-lane reduction (`lti::square_reduced`), where vectorisation matters.
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Whether every entry of a matrix is finite (no NaN, no ±∞).
+pub(crate) fn all_finite(m: MatRef<'_, f64>) -> bool {
+    (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dot_and_all_finite() {
+        assert_eq!(dot(&[1.0, 2.0, 3.0], &[4.0, -5.0, 6.0]), 12.0);
+        assert_eq!(dot(&[], &[]), 0.0);
+        let mut m = faer::Mat::<f64>::zeros(2, 3);
+        assert!(all_finite(m.as_ref()));
+        assert!(all_finite(faer::Mat::<f64>::zeros(0, 4).as_ref()));
+        m[(1, 2)] = f64::NAN;
+        assert!(!all_finite(m.as_ref()));
+        m[(1, 2)] = f64::NEG_INFINITY;
+        assert!(!all_finite(m.as_ref()));
+    }
+
+    /// The tests run in the release profile (`cargo test --release`), where Cargo.toml turns
+    /// overflow checks on for this crate: integer overflow must panic, not wrap.
+    #[test]
+    fn integer_overflow_panics() {
+        let zero = std::hint::black_box(0usize);
+        assert!(std::panic::catch_unwind(|| zero - 1).is_err(), "overflow checks are off (see Cargo.toml)");
+    }
+}
