@@ -7,7 +7,9 @@
 //!   sampling) that knows nothing about control;
 //! - [`lti`]: plants, controllers, closed loops, spectral abscissa, H∞ norm and their gradients;
 //! - [`design`]: the HIFOO method, joining `lti` and `optim`;
-//! - [`campaign`]: campaign files, job scheduling, journal/resume, traces and reports.
+//! - [`campaign`]: campaign files, job scheduling, journal/resume, traces and reports;
+//! - [`input`]: bounded reading of every input file (documented size limits).
+pub mod input;
 pub mod optim;
 pub mod lti;
 pub mod design;

@@ -4,7 +4,6 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::Ordering;
 
 use anyhow::Context;
 use hinfix::campaign::fake::FakeRunner;
@@ -17,7 +16,9 @@ use hinfix::campaign::{
     expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
 };
 
-use super::{EXIT_INTERRUPTED, EXIT_JOBS_FAILED};
+use hinfix::campaign::sanitise::for_terminal;
+
+use super::{signals, EXIT_JOBS_FAILED};
 
 /// Where campaign results go unless `--results` says otherwise.
 const DEFAULT_RESULTS: &str = "results";
@@ -37,9 +38,9 @@ pub struct CampaignFileArgs {
 pub struct RunArgs {
     #[command(flatten)]
     pub campaign: CampaignFileArgs,
-    /// Worker threads (one job per thread; faer is single-threaded inside a job). Default: the
-    /// file's `defaults.threads`, else 2.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    /// Worker threads (one job per thread; faer is single-threaded inside a job), 1..=256.
+    /// Default: the file's `defaults.threads`, else 2.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=hinfix::campaign::MAX_THREADS as i64))]
     pub threads: Option<u32>,
     /// Plain log lines instead of live progress bars (automatic when stderr is not a terminal).
     #[arg(long)]
@@ -108,7 +109,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let threads = l.campaign.threads(a.threads.map(|t| t as usize));
     let opts = ExecuteOptions::new(&l.campaign.name, threads);
     let cancel = opts.cancel.clone();
-    ctrlc::set_handler(move || cancel.store(true, Ordering::SeqCst)).context("installing the Ctrl-C handler")?;
+    signals::install_into(&cancel).context("installing the signal handlers")?;
 
     let runner: &dyn JobRunner = match &l.fake {
         Some(f) => f,
@@ -116,7 +117,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     };
     let observers = trace_observers(&l.dir.join("traces"));
     let mut reporter = Reporter::new(&l.jobs, Display::choose(a.no_progress));
-    eprintln!("campaign {} → {}", l.campaign.name, l.dir.display());
+    eprintln!("campaign {} → {}", for_terminal(&l.campaign.name), for_terminal(&l.dir.display().to_string()));
     let outcome = run_jobs(&l.jobs, &l.dir, runner, &observers, &opts, |ev| reporter.on_event(ev))?;
     if let Some(t) = &outcome.torn {
         eprintln!(
@@ -134,7 +135,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     report_into(&l.dir, &l.campaign, &outcome.records)?;
     if outcome.interrupted() {
         eprintln!("interrupted: rerun the same command to resume");
-        return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        return Ok(ExitCode::from(signals::exit_code()));
     }
     if outcome.failed() > 0 {
         eprintln!("{} job(s) failed: see `status` in {}", outcome.failed(), outcome.journal.display());
@@ -174,10 +175,10 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             rows[i].3 += r.failed() as usize;
         }
     }
-    println!("campaign {} ({})", l.campaign.name, journal_path(&l.dir).display());
+    println!("campaign {} ({})", for_terminal(&l.campaign.name), for_terminal(&journal_path(&l.dir).display().to_string()));
     println!("{:<16} {:>6} {:>6} {:>9} {:>7}", "plant", "jobs", "done", "remaining", "failed");
     for (p, n, d, f) in &rows {
-        println!("{p:<16} {n:>6} {d:>6} {:>9} {f:>7}", n - d);
+        println!("{:<16} {n:>6} {d:>6} {:>9} {f:>7}", for_terminal(p), n - d);
     }
     let (n, d, f) = rows.iter().fold((0, 0, 0), |acc, r| (acc.0 + r.1, acc.1 + r.2, acc.2 + r.3));
     println!("{:<16} {n:>6} {d:>6} {:>9} {f:>7}", "total", n - d);

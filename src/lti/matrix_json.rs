@@ -58,6 +58,14 @@ pub enum MatrixJsonError {
         /// The JSON text found.
         found: String,
     },
+    /// A matrix that must have entries has none.
+    #[error("must have at least one row and one column, found {rows}×{cols}")]
+    Empty {
+        /// Rows found.
+        rows: usize,
+        /// Columns found.
+        cols: usize,
+    },
     /// A number that is not finite.
     #[error("entry ({row}, {col}) is not finite ({value})")]
     NotFinite {
@@ -70,7 +78,7 @@ pub enum MatrixJsonError {
     },
 }
 
-fn json_type(v: &Value) -> &'static str {
+pub(crate) fn json_type(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",
         Value::Bool(_) => "a boolean",

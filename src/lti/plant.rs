@@ -80,8 +80,8 @@ pub struct Plant {
 pub struct PlantError {
     /// The file (or a label such as `<inline>`).
     pub file: PathBuf,
-    /// What is wrong.
-    #[source]
+    /// What is wrong (part of the message, so not also a `source`: a chain printer would repeat
+    /// it).
     pub kind: PlantErrorKind,
 }
 
@@ -91,7 +91,7 @@ pub struct PlantError {
 pub enum PlantErrorKind {
     /// The file could not be read.
     #[error("cannot read: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// Not valid JSON.
     #[error("invalid JSON at line {line}, column {column}: {message}")]
     Json {
@@ -120,10 +120,12 @@ pub enum PlantErrorKind {
         problem: String,
     },
     /// No plant of that name in the plant library.
-    #[error("no plant named `{name}` in the library (known: {known}); give a path to use another file")]
+    #[error("no plant named `{name}` in the library ({hint}known: {known}); give a path to use another file")]
     UnknownName {
         /// The name asked for.
         name: String,
+        /// `did you mean `HE1`? ` when a library name differs only in case, else empty.
+        hint: String,
         /// The library's plant names, comma-separated.
         known: String,
     },
@@ -169,8 +171,8 @@ impl Plant {
     /// Reads and validates a plant file.
     pub fn load(path: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| PlantError { file: path.to_path_buf(), kind: e.into() })?;
+        let text = crate::input::read_capped_string(path, crate::input::MAX_PLANT_BYTES, "plant file")
+            .map_err(|e| PlantError { file: path.to_path_buf(), kind: PlantErrorKind::Io(e) })?;
         Self::from_json_str(&text, path)
     }
 
