@@ -329,6 +329,15 @@ fn signal(child: &std::process::Child, sig: i32) {
     assert_eq!(unsafe { libc::kill(child.id() as i32, sig) }, 0);
 }
 
+/// Waits until the run has started jobs (its signal handlers are installed before that).
+fn wait_started(dir: &Path) {
+    let t = Instant::now();
+    while tmp_traces(dir).is_empty() {
+        assert!(t.elapsed() < Duration::from_secs(60), "the campaign did not start");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
 fn tmp_traces(dir: &Path) -> Vec<PathBuf> {
     match std::fs::read_dir(dir.join("r/t/traces")) {
         Ok(rd) => rd.map(|e| e.unwrap().path()).filter(|p| p.to_string_lossy().ends_with(".tmp")).collect(),
@@ -341,7 +350,8 @@ fn item5_sigterm_and_sighup_stop_like_ctrl_c() {
     for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGHUP, 129), (libc::SIGINT, 130)] {
         let dir = scratch(&format!("sig{sig}"));
         let child = spawn_slow(&dir);
-        std::thread::sleep(Duration::from_millis(1500));
+        wait_started(&dir);
+        std::thread::sleep(Duration::from_millis(300));
         signal(&child, sig);
         let out = child.wait_with_output().unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
@@ -363,7 +373,7 @@ fn item5_second_ctrl_c_stops_at_once() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(800));
+    wait_started(&dir);
     signal(&child, libc::SIGINT);
     std::thread::sleep(Duration::from_millis(100));
     let t = Instant::now();
