@@ -345,6 +345,8 @@ fn validate_target(cases: u32) -> Counts {
             evaldist,
             gradient_sampling: gs,
             gradsamp_maxit: gsm,
+            // (options other issues add keep their defaults)
+            #[allow(clippy::needless_update)]
             ..DesignOptions::default()
         });
     let init = prop::option::weighted(0.3, (0usize..4, 0usize..3, 0usize..3, float.clone()).prop_map(|(nk, m, p, x)| {
