@@ -10,13 +10,16 @@
 //! - [`campaign`]: campaign files, job scheduling, journal/resume, traces and reports.
 //!
 //! Under all of them, used by any and using none: `numeric` (a few shared numeric helpers,
-//! crate-private) and [`fs_atomic`] (atomic, durable file writes). The layers, a job's path through them and the journal's guarantees are described in
-//! docs/ARCHITECTURE.md; the methods, with their references, in docs/ALGORITHMS.md.
+//! crate-private), [`fs_atomic`] (atomic, durable file writes) and [`input`] (bounded reading of
+//! every input file, with documented size limits). The layers, a job's path through them and the
+//! journal's guarantees are described in docs/ARCHITECTURE.md; the methods, with their
+//! references, in docs/ALGORITHMS.md.
 // `!(x > 0.0)` is this crate's NaN-aware comparison (true when x is NaN, which must count as a
 // failure); clippy's suggested `partial_cmp` form would hide that intent.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod fs_atomic;
+pub mod input;
 pub(crate) mod numeric;
 pub mod optim;
 pub mod lti;

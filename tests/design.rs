@@ -35,7 +35,7 @@ fn rea2_order1_reaches_the_published_gamma() {
     let p = plant("REA2");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, cpumax: 30.0, ..Default::default() };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
-    assert_eq!(o.status, DesignStatus::Optimised);
+    assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
     assert!(o.gamma <= 1.134 * 1.01, "γ = {}", o.gamma);
     check_recomputed(&p, &o);
     assert!(o.objective >= o.gamma && o.objective >= opts.eps * o.k_hinf);
@@ -46,7 +46,7 @@ fn he1_order1_reaches_the_published_gamma() {
     let p = plant("HE1");
     let opts = DesignOptions { order: 1, eps: 1e-4, seed: 1, cpumax: 30.0, ..Default::default() };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
-    assert_eq!(o.status, DesignStatus::Optimised);
+    assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
     assert!(o.gamma <= 0.1235 * 1.01, "γ = {}", o.gamma);
     check_recomputed(&p, &o);
     let cpu: f64 = o.phases.iter().map(|s| s.cpu_s).sum();

@@ -12,7 +12,7 @@ use hinfix::campaign::{load_reference, REFERENCE_CSV};
 mod common;
 
 fn row(plant: &str, order: usize, gamma: f64) -> BestRow {
-    BestRow { plant: plant.into(), plant_fingerprint: format!("fp-{plant}"), order, gamma, job_id: Some("j".into()), eps: Some(1e-3), seed: Some(0), runs: 2, verified: 1, failed: 1 }
+    BestRow { plant: plant.into(), plant_fingerprint: format!("fp-{plant}"), order, gamma, job_id: Some("j".into()), eps: Some(1e-3), seed: Some(0), runs: 2, verified: 1, failed: 1, unverified: 0 }
 }
 
 #[test]

@@ -75,7 +75,7 @@ impl JobRunner for FakeRunner {
         for i in 0..job.options.order {
             k.ak[(i, i)] = -1.0 - seed - i as f64;
         }
-        let mut status = DesignStatus::Optimised;
+        let mut status = DesignStatus::Converged;
         let mut iters = 0;
         for iter in 0..FAKE_ITERS {
             std::thread::sleep(self.pause);
@@ -84,7 +84,7 @@ impl JobRunner for FakeRunner {
             let rec = DesignIterRecord {
                 phase: Phase::Optimisation,
                 start: 0,
-                iter,
+                iter: iter + 1,
                 f,
                 hinf_cl: f,
                 hinf_k: 1.0,
@@ -108,6 +108,7 @@ impl JobRunner for FakeRunner {
             alpha_cl: -1.0,
             alpha_k: (job.options.order > 0).then_some(-1.0),
             objective: gamma,
+            controller_norm_active: false,
             dnorm: Some(1e-4),
             evaldist: Some(job.options.evaldist),
             phases: vec![PhaseStats { phase: Phase::Optimisation, iters, evals: iters, cpu_s: 0.0 }],

@@ -3,10 +3,11 @@
 //! * Writing ([`JournalWriter::append`]): the whole line plus its newline goes out in a single
 //!   `write` on a file opened with `O_APPEND`, then the file is flushed and `fsync`ed, so a line
 //!   is either entirely there or (after a kill -9 or a power cut in the middle) a torn tail.
-//! * Reading ([`read_journal`]): every complete line must parse; a corrupt line in the middle is
-//!   an error naming the file and line (something other than a crash damaged the file). The last
-//!   line is allowed to be torn — no trailing newline, or not parsable — and is reported in
-//!   [`JournalRead::torn`] and ignored: that job simply runs again.
+//! * Reading ([`read_journal`]): every complete (newline-terminated) line must parse; a corrupt
+//!   complete line is an error naming the file and line (something other than a crash damaged
+//!   the file) and is never deleted, wherever it is. Only a last line without its newline — what
+//!   a cut-off append leaves — is torn: it is reported in [`JournalRead::torn`] and ignored, and
+//!   that job simply runs again.
 //! * Repair ([`JournalWriter::open`]): before appending, a torn tail is truncated away so the file
 //!   stays valid JSONL.
 //!
@@ -120,7 +121,7 @@ fn parse_line(text: &str) -> Result<JobRecord, Result<String, u32>> {
 
 /// Reads a journal. A missing file is an empty journal.
 pub fn read_journal(path: &Path) -> Result<JournalRead, JournalError> {
-    let bytes = match std::fs::read(path) {
+    let bytes = match crate::input::read_capped(path, crate::input::MAX_JOURNAL_BYTES, "journal") {
         Ok(b) => b,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(JournalRead::default()),
         Err(e) => return Err(io_err(path)(e)),
@@ -139,7 +140,6 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
             Some(i) => (offset + i, true),
             None => (bytes.len(), false),
         };
-        let is_last = !complete || end + 1 == bytes.len();
         let raw = &bytes[offset..end];
         let torn = |reason: String| TornTail { line: line_no, offset: offset as u64, len: bytes.len() - offset, reason };
         if !complete {
@@ -148,20 +148,12 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
         }
         let text = match std::str::from_utf8(raw) {
             Ok(t) => t.trim(),
-            Err(e) if is_last => {
-                out.torn = Some(torn(format!("not UTF-8: {e}")));
-                break;
-            }
             Err(e) => return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, message: format!("not UTF-8: {e}") }),
         };
         if !text.is_empty() {
             match parse_line(text) {
                 Ok(r) => out.records.push(r),
                 Err(Err(found)) => return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found }),
-                Err(Ok(message)) if is_last => {
-                    out.torn = Some(torn(format!("unparsable: {message}")));
-                    break;
-                }
                 Err(Ok(message)) => return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, message }),
             }
         }

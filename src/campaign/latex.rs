@@ -7,11 +7,13 @@ use super::reduce::BestRow;
 use super::reference::{RefMethod, ReferenceRow};
 use super::report::{CompareRow, FullOrderRow};
 
-/// Escapes LaTeX specials (`\ & % $ # _ { } ~ ^`).
+/// Escapes LaTeX specials (`\ & % $ # _ { } ~ ^`) and drops control characters (a newline or
+/// NUL in a name must not end a table row or break the file).
 pub fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
+            c if c.is_control() => {}
             '\\' => out.push_str("\\textbackslash{}"),
             '&' | '%' | '$' | '#' | '_' | '{' | '}' => {
                 out.push('\\');

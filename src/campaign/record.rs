@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::jobs::{Job, JobId, RunnerTag};
 use super::provenance::Provenance;
-use crate::design::{serde_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats};
+use crate::design::{serde_f64_or_string, serde_opt_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats};
 
 /// Version of the journal line format. Readers refuse newer versions.
 pub const SCHEMA_VERSION: u32 = 1;
@@ -14,8 +14,14 @@ pub const SCHEMA_VERSION: u32 = 1;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum JobStatus {
-    /// Both phases ran; stable and stabilising controller.
-    Optimised,
+    /// Both phases ran and the optimality certificate was met (see
+    /// [`DesignStatus::Converged`]).
+    Converged,
+    /// Both phases ran, but a limit ended the search before the certificate was met (see
+    /// [`DesignStatus::Stopped`]); journal lines of older builds with kind "optimised" read as
+    /// this.
+    #[serde(alias = "optimised")]
+    Stopped,
     /// Stabilised, but the optimisation phase made no progress.
     StabilisedOnly,
     /// No (strongly) stabilising controller found.
@@ -37,7 +43,8 @@ impl JobStatus {
     /// Short name as in the journal's `kind`.
     pub fn kind(&self) -> &'static str {
         match self {
-            JobStatus::Optimised => "optimised",
+            JobStatus::Converged => "converged",
+            JobStatus::Stopped => "stopped",
             JobStatus::StabilisedOnly => "stabilised_only",
             JobStatus::NotStabilised { .. } => "not_stabilised",
             JobStatus::BudgetExhausted => "budget_exhausted",
@@ -50,8 +57,10 @@ impl JobStatus {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Certificate {
     /// Norm of the min-norm element of the gradient bundle.
+    #[serde(with = "serde_f64_or_string")]
     pub dnorm: f64,
     /// Bundle radius.
+    #[serde(with = "serde_f64_or_string")]
     pub evaldist: f64,
 }
 
@@ -71,10 +80,12 @@ pub struct JobRecord {
     /// Controller order.
     pub order: usize,
     /// Weight ε.
+    #[serde(with = "serde_f64_or_string")]
     pub eps: f64,
     /// Seed.
     pub seed: u64,
     /// CPU budget (s).
+    #[serde(with = "serde_f64_or_string")]
     pub cpumax: f64,
     /// Every design option (repeats order, eps, seed, cpumax).
     pub options: DesignOptions,
@@ -97,10 +108,14 @@ pub struct JobRecord {
     #[serde(with = "serde_f64_or_string")]
     pub alpha_cl: f64,
     /// α(Ak) (None for order 0 or failed jobs).
+    #[serde(default, with = "serde_opt_f64_or_string")]
     pub alpha_k: Option<f64>,
     /// Final objective value.
     #[serde(with = "serde_f64_or_string")]
     pub objective: f64,
+    /// ε‖K‖∞ is the active term of the objective (γ is held up by the controller-norm penalty).
+    #[serde(default)]
+    pub controller_norm_active: bool,
     /// Certificate of the final point, if the optimisation ran.
     pub certificate: Option<Certificate>,
     /// Total iterations.
@@ -110,12 +125,16 @@ pub struct JobRecord {
     /// Per-phase counters.
     pub phases: Vec<PhaseStats>,
     /// CPU seconds as counted by the design run.
+    #[serde(with = "serde_f64_or_string")]
     pub design_cpu_s: f64,
     /// CPU seconds of the worker thread for the whole job.
+    #[serde(with = "serde_f64_or_string")]
     pub cpu_s: f64,
     /// Wall seconds of the whole job.
+    #[serde(with = "serde_f64_or_string")]
     pub wall_s: f64,
     /// When it finished (Unix seconds).
+    #[serde(with = "serde_f64_or_string")]
     pub finished_unix_s: f64,
     /// The controller `{AK, BK, CK, DK}` (None for failed jobs).
     pub controller: Option<serde_json::Value>,
@@ -160,6 +179,7 @@ impl JobRecord {
             alpha_cl: f64::NAN,
             alpha_k: None,
             objective: f64::NAN,
+            controller_norm_active: false,
             certificate: None,
             iterations: 0,
             evaluations: 0,
@@ -178,7 +198,8 @@ impl JobRecord {
             Ok(out) => {
                 r.status = match out.status {
                     DesignStatus::Interrupted => return None,
-                    DesignStatus::Optimised => JobStatus::Optimised,
+                    DesignStatus::Converged => JobStatus::Converged,
+                    DesignStatus::Stopped => JobStatus::Stopped,
                     DesignStatus::StabilisedOnly => JobStatus::StabilisedOnly,
                     DesignStatus::NotStabilised { best_alpha } => JobStatus::NotStabilised { best_alpha },
                     DesignStatus::BudgetExhausted => JobStatus::BudgetExhausted,
@@ -188,6 +209,7 @@ impl JobRecord {
                 r.alpha_cl = out.alpha_cl;
                 r.alpha_k = out.alpha_k;
                 r.objective = out.objective;
+                r.controller_norm_active = out.controller_norm_active;
                 r.certificate = match (out.dnorm, out.evaldist) {
                     (Some(dnorm), Some(evaldist)) => Some(Certificate { dnorm, evaldist }),
                     _ => None,

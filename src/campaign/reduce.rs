@@ -103,6 +103,7 @@ pub struct BestRow {
     /// Job that gave it.
     pub job_id: Option<String>,
     /// Its ε.
+    #[serde(default, with = "crate::design::serde_opt_f64_or_string")]
     pub eps: Option<f64>,
     /// Its seed.
     pub seed: Option<u64>,
@@ -110,8 +111,12 @@ pub struct BestRow {
     pub runs: usize,
     /// Jobs whose controller re-verified stable and stabilising.
     pub verified: usize,
-    /// Jobs that failed or did not verify.
+    /// Jobs that failed (status `failed`: no trustworthy result), the same count as `campaign
+    /// status` and the run's exit code use.
     pub failed: usize,
+    /// Jobs that did not fail but whose controller did not re-verify (e.g. not stabilised).
+    #[serde(default)]
+    pub unverified: usize,
 }
 
 /// Best γ per (plant, order), sorted by plant label then order. Records of plants missing
@@ -157,6 +162,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
             runs: 0,
             verified: 0,
             failed: 0,
+            unverified: 0,
         });
         row.runs += 1;
         match gamma {
@@ -169,7 +175,8 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
                     row.seed = Some(r.seed);
                 }
             }
-            None => row.failed += 1,
+            None if r.failed() => row.failed += 1,
+            None => row.unverified += 1,
         }
     }
     rows.into_values().collect()

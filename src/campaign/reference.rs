@@ -84,11 +84,20 @@ mod stable_word {
     }
 }
 
+/// The paper's table, built into the program (a plant library chosen with `HINFIX_PLANTS` need
+/// not, and usually does not, hold a copy).
+pub const REFERENCE_TEXT: &str = include_str!("../../plants/reference/gumussoy-millstone-overton-2008.csv");
+
 /// Reads the reference table at `path`; every row is checked (γ finite and positive).
 pub fn load_reference(path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> {
     let file = std::fs::File::open(path).map_err(|source| ReferenceError::Io { path: path.to_path_buf(), source })?;
+    parse_reference(file, path)
+}
+
+/// Reads reference rows from CSV text (`path` names it in errors).
+pub fn parse_reference(input: impl std::io::Read, path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> {
     let mut rows = Vec::new();
-    let mut reader = csv::Reader::from_reader(file);
+    let mut reader = csv::Reader::from_reader(input);
     for rec in reader.deserialize::<ReferenceRow>() {
         let row_err = |line: u64, message: String| ReferenceError::Row { path: path.to_path_buf(), line, message };
         let row = rec.map_err(|e| {
@@ -103,9 +112,10 @@ pub fn load_reference(path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> 
     Ok(rows)
 }
 
-/// The project's reference table (from the plant library's `reference/` folder).
+/// The paper's reference table as built into the program ([`REFERENCE_TEXT`]); it does not
+/// depend on the plant library folder or the working directory.
 pub fn load_default_reference() -> Result<Vec<ReferenceRow>, ReferenceError> {
-    load_reference(&crate::lti::plants_dir().join("reference/gumussoy-millstone-overton-2008.csv"))
+    parse_reference(REFERENCE_TEXT.as_bytes(), Path::new(REFERENCE_CSV))
 }
 
 #[cfg(test)]
@@ -121,6 +131,12 @@ mod tests {
         assert!(he1.iter().any(|r| r.order == 1 && r.gamma == 0.1235 && r.controller_stable));
         assert!(rows.iter().any(|r| r.method == RefMethod::FullOrder && !r.controller_stable));
         assert!(rows.iter().any(|r| r.method == RefMethod::Literature));
+    }
+
+    #[test]
+    fn built_in_table_equals_the_file() {
+        let from_file = load_reference(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE_CSV)).unwrap();
+        assert_eq!(load_default_reference().unwrap(), from_file);
     }
 
     #[test]

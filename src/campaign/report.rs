@@ -11,6 +11,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::latex;
+use super::sanitise::{for_csv, for_terminal};
 use super::record::JobRecord;
 use super::reduce::{best_per_order, BestRow, PlantMap};
 use super::reference::{RefMethod, ReferenceRow};
@@ -90,7 +91,7 @@ impl fmt::Display for ReportSummary {
         for r in &self.compare {
             let b = self.best.iter().find(|b| b.plant == r.plant && b.order == r.order);
             let v = b.map(|b| format!("{}/{}", b.verified, b.runs)).unwrap_or_default();
-            writeln!(f, "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}", r.plant, r.order, latex::num(r.ours), latex::num(r.paper), latex::num(r.ratio), v)?;
+            writeln!(f, "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}", for_terminal(&r.plant), r.order, latex::num(r.ours), latex::num(r.paper), latex::num(r.ratio), v)?;
         }
         Ok(())
     }
@@ -148,8 +149,8 @@ fn csv_bytes<R: serde::Serialize>(path: &Path, rows: impl IntoIterator<Item = R>
 }
 
 #[derive(serde::Serialize)]
-struct CompareCsv<'a> {
-    plant: &'a str,
+struct CompareCsv {
+    plant: String,
     order: usize,
     ours: String,
     paper: String,
@@ -177,7 +178,8 @@ pub fn write_reports(
     let mut files = Vec::new();
 
     let p = out_dir.join("best.csv");
-    write_atomic(&p, &csv_bytes(&p, &best)?)?;
+    let best_csv = best.iter().map(|b| BestRow { plant: for_csv(&b.plant), ..b.clone() });
+    write_atomic(&p, &csv_bytes(&p, best_csv)?)?;
     files.push(p);
 
     let p = out_dir.join("tables.tex");
@@ -186,11 +188,11 @@ pub fn write_reports(
 
     let p = out_dir.join("compare.csv");
     let rows = compare.iter().map(|r| CompareCsv {
-        plant: &r.plant,
+        plant: for_csv(&r.plant),
         order: r.order,
         ours: csv_num(r.ours),
         paper: csv_num(r.paper),
-        literature: r.literature.iter().map(|(s, g)| format!("{s}={g}")).collect::<Vec<_>>().join("; "),
+        literature: for_csv(&r.literature.iter().map(|(s, g)| format!("{s}={g}")).collect::<Vec<_>>().join("; ")),
         full_order: csv_num(r.full_order),
         ratio: csv_num(r.ratio),
     });

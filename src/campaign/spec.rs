@@ -26,6 +26,14 @@ use crate::lti::Plant;
 pub const DEFAULT_THREADS: usize = 2;
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
 pub const MAX_ORDER: usize = 200;
+/// Largest number of seeds of one problem (`seeds = N` or a list).
+pub const MAX_SEEDS: usize = 10_000;
+/// Largest number of jobs a campaign file may expand to.
+pub const MAX_JOBS: usize = 100_000;
+/// Largest `threads` (as on the command line).
+pub const MAX_THREADS: usize = 256;
+/// Longest campaign name, in characters (it names the results folder).
+pub const MAX_NAME_CHARS: usize = 100;
 
 /// A position in a campaign file (1-based line and column, columns counted in characters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -48,6 +56,10 @@ impl Location {
     }
 }
 
+fn location_suffix(l: &Location) -> String {
+    if l.line == 0 { String::new() } else { format!(":{}:{}", l.line, l.column) }
+}
+
 fn floor_char_boundary(s: &str, mut i: usize) -> usize {
     while i > 0 && !s.is_char_boundary(i) {
         i -= 1;
@@ -56,8 +68,10 @@ fn floor_char_boundary(s: &str, mut i: usize) -> usize {
 }
 
 /// A campaign file that cannot be used: where and why.
+/// Displayed as `file:line:column: message`, or `file: message` when the error has no position
+/// in the file (it could not be read: line 0).
 #[derive(Debug, thiserror::Error)]
-#[error("{}:{}:{}: {message}", file.display(), location.line, location.column)]
+#[error("{}{}: {message}", file.display(), location_suffix(location))]
 pub struct SpecError {
     /// The campaign file.
     pub file: PathBuf,
@@ -198,8 +212,10 @@ impl<'de> Deserialize<'de> for Orders {
                 if to < from {
                     return Err(de::Error::custom(format!("empty order range: from = {from} > to = {to}")));
                 }
-                if to - from > MAX_ORDER as i64 {
-                    return Err(de::Error::custom(format!("order range {from}..={to} is too long")));
+                if from < 0 || to > MAX_ORDER as i64 {
+                    return Err(de::Error::custom(format!(
+                        "order range {from}..={to} leaves 0..={MAX_ORDER} (controller orders are integers in that range)"
+                    )));
                 }
                 Ok(Orders((from..=to).collect()))
             }
@@ -221,8 +237,8 @@ impl<'de> Deserialize<'de> for Seeds {
                 f.write_str("a number of seeds (integer) or a list of seeds")
             }
             fn visit_i64<E: de::Error>(self, n: i64) -> Result<Seeds, E> {
-                if n < 1 {
-                    return Err(E::custom(format!("the number of seeds must be at least 1, found {n}")));
+                if n < 1 || n > MAX_SEEDS as i64 {
+                    return Err(E::custom(format!("the number of seeds must be in 1..={MAX_SEEDS}, found {n}")));
                 }
                 Ok(Seeds((0..n).collect(), true))
             }
@@ -232,6 +248,9 @@ impl<'de> Deserialize<'de> for Seeds {
             fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Seeds, A::Error> {
                 let mut v = Vec::new();
                 while let Some(x) = seq.next_element::<i64>()? {
+                    if v.len() == MAX_SEEDS {
+                        return Err(de::Error::custom(format!("more than {MAX_SEEDS} seeds")));
+                    }
                     v.push(x);
                 }
                 Ok(Seeds(v, false))
@@ -289,7 +308,7 @@ impl<'de> Deserialize<'de> for EpsList {
 impl Campaign {
     /// Reads and validates a campaign file.
     pub fn load(path: &Path) -> Result<Campaign, SpecError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SpecError {
+        let text = crate::input::read_capped_string(path, crate::input::MAX_CAMPAIGN_BYTES, "campaign file").map_err(|e| SpecError {
             file: path.to_path_buf(),
             location: Location { line: 0, column: 0 },
             message: format!("cannot read the campaign file: {e}"),
@@ -308,6 +327,9 @@ impl Campaign {
         let raw: RawCampaign = toml::from_str(text).map_err(|e| at(e.span().unwrap_or(0..0), e.message().trim().to_string()))?;
 
         let name = raw.name.get_ref().clone();
+        if name.chars().count() > MAX_NAME_CHARS {
+            return Err(at(raw.name.span(), format!("campaign name is longer than {MAX_NAME_CHARS} characters")));
+        }
         if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) || name.starts_with('.') {
             return Err(at(
                 raw.name.span(),
@@ -316,7 +338,9 @@ impl Campaign {
         }
         let d = &raw.defaults;
         let threads = match &d.threads {
-            Some(t) if *t.get_ref() == 0 => return Err(at(t.span(), "threads must be at least 1".into())),
+            Some(t) if !(1..=MAX_THREADS).contains(t.get_ref()) => {
+                return Err(at(t.span(), format!("threads must be in 1..={MAX_THREADS}, found {}", t.get_ref())))
+            }
             Some(t) => Some(*t.get_ref()),
             None => None,
         };
@@ -333,9 +357,6 @@ impl Campaign {
                     let v = s.get_ref().0.clone();
                     if v.is_empty() {
                         return Err(at(s.span(), "eps must list at least one weight".into()));
-                    }
-                    if let Some(bad) = v.iter().find(|e| !(e.is_finite() && **e > 0.0)) {
-                        return Err(at(s.span(), format!("every ε must be a finite positive number, found {bad}")));
                     }
                     if has_duplicates(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()) {
                         return Err(at(s.span(), "eps lists the same weight twice".into()));
@@ -375,40 +396,25 @@ impl Campaign {
             orders.sort_unstable();
 
             let mut base = DesignOptions::default();
-            let pos_f64 = |v: &Option<Spanned<f64>>, dv: &Option<Spanned<f64>>, name: &str, max: f64| -> Result<Option<f64>, SpecError> {
-                match v.as_ref().or(dv.as_ref()) {
-                    None => Ok(None),
-                    Some(s) => {
-                        let x = *s.get_ref();
-                        if !(x.is_finite() && x > 0.0 && x < max) {
-                            let range = if max.is_finite() { format!("in (0, {max})") } else { "finite and positive".to_string() };
-                            Err(at(s.span(), format!("{name} must be {range}, found {x}")))
-                        } else {
-                            Ok(Some(x))
-                        }
-                    }
+            // Values are only collected here; `design::validate` below judges them (one rule
+            // for `campaign design` and campaign files).
+            let pick = |v: &Option<Spanned<f64>>, dv: &Option<Spanned<f64>>| v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()));
+            let pick_n = |v: &Option<Spanned<usize>>, dv: &Option<Spanned<usize>>| v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()));
+            let cpumax = pick(&p.cpumax, &d.cpumax);
+            let normtol = pick(&p.normtol, &d.normtol);
+            let evaldist = pick(&p.evaldist, &d.evaldist);
+            let hinf_tol = pick(&p.hinf_tol, &d.hinf_tol);
+            let nrand = pick_n(&p.nrand, &d.nrand);
+            let maxit = pick_n(&p.maxit, &d.maxit);
+            for (slot, v) in [(&mut base.cpumax, &cpumax), (&mut base.normtol, &normtol), (&mut base.evaldist, &evaldist), (&mut base.hinf_tol, &hinf_tol)] {
+                if let Some((x, _)) = v {
+                    *slot = *x;
                 }
-            };
-            if let Some(x) = pos_f64(&p.cpumax, &d.cpumax, "cpumax", f64::INFINITY)? {
-                base.cpumax = x;
             }
-            if let Some(x) = pos_f64(&p.normtol, &d.normtol, "normtol", f64::INFINITY)? {
-                base.normtol = x;
-            }
-            if let Some(x) = pos_f64(&p.evaldist, &d.evaldist, "evaldist", f64::INFINITY)? {
-                base.evaldist = x;
-            }
-            if let Some(x) = pos_f64(&p.hinf_tol, &d.hinf_tol, "hinf_tol", 1.0)? {
-                base.hinf_tol = x;
-            }
-            if let Some(s) = p.nrand.as_ref().or(d.nrand.as_ref()) {
-                base.nrand = *s.get_ref();
-            }
-            if let Some(s) = p.maxit.as_ref().or(d.maxit.as_ref()) {
-                if *s.get_ref() == 0 {
-                    return Err(at(s.span(), "maxit must be at least 1".into()));
+            for (slot, v) in [(&mut base.nrand, &nrand), (&mut base.maxit, &maxit)] {
+                if let Some((x, _)) = v {
+                    *slot = *x;
                 }
-                base.maxit = *s.get_ref();
             }
             if let Some(o) = p.objective.or(d.objective) {
                 base.objective = o;
@@ -416,16 +422,36 @@ impl Campaign {
             if let Some(g) = p.gradient_sampling.or(d.gradient_sampling) {
                 base.gradient_sampling = g;
             }
-            if let Some(s) = p.nrand.as_ref().or(d.nrand.as_ref()) {
-                if *s.get_ref() == 0 {
-                    return Err(at(s.span(), "nrand must be at least 1 (the first order of a chain has no other start)".into()));
-                }
-            }
 
             let plant_arg = p.plant.get_ref().clone();
             let pspan = p.plant.span();
             let plant_path = resolve_plant_arg(&plant_arg, base_dir).map_err(|m| at(pspan.clone(), m))?;
             let plant = Plant::load(&plant_path).map_err(|e| at(pspan.clone(), e.to_string()))?;
+
+            // The very check `design` makes, for the largest order (the only option that depends
+            // on the order is order ≤ n) and every ε, before any job starts.
+            let max_order = *orders.last().expect("orders is not empty");
+            for &e in &eps {
+                let opts = DesignOptions { order: max_order, eps: e, ..base.clone() };
+                if let Err(err) = crate::design::validate(&plant, &opts, None) {
+                    let field = match &err {
+                        crate::design::DesignError::Options { field, .. } => *field,
+                        _ => "",
+                    };
+                    let span = match field {
+                        "order" => Some(ospan.clone()),
+                        "eps" => eps_s.as_ref().map(|s| s.span()),
+                        "cpumax" => cpumax.as_ref().map(|c| c.1.clone()),
+                        "normtol" => normtol.as_ref().map(|c| c.1.clone()),
+                        "evaldist" => evaldist.as_ref().map(|c| c.1.clone()),
+                        "hinf_tol" => hinf_tol.as_ref().map(|c| c.1.clone()),
+                        "nrand" => nrand.as_ref().map(|c| c.1.clone()),
+                        "maxit" => maxit.as_ref().map(|c| c.1.clone()),
+                        _ => None,
+                    };
+                    return Err(at(span.unwrap_or(pspan.clone()), err.to_string()));
+                }
+            }
             problems.push(Problem {
                 plant_arg,
                 plant_path,
@@ -440,6 +466,17 @@ impl Campaign {
             });
         }
 
+        let mut total: usize = 0;
+        for (p, raw_p) in problems.iter().zip(&raw.problems) {
+            let n = p.orders.len().saturating_mul(p.eps.len()).saturating_mul(p.seeds.len());
+            total = total.saturating_add(n);
+            if total > MAX_JOBS {
+                return Err(at(
+                    raw_p.plant.span(),
+                    format!("the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)"),
+                ));
+            }
+        }
         let campaign = Campaign { name, description: raw.description, file: file.to_path_buf(), threads, problems };
         // Two problems that produce the same job would run it twice under one id.
         let jobs = super::jobs::expand(&campaign, super::jobs::RunnerTag::Design);
@@ -583,7 +620,7 @@ objective = "plain"
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, -2]\n", 4, 10, "orders"),
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, 1]\n", 4, 10, "twice"),
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = { from = 3, to = 1 }\n", 4, 10, "empty"),
-            ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nseeds = 0\n", 5, 9, "at least 1"),
+            ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nseeds = 0\n", 5, 9, "1..=10000"),
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nseeds = [1, -1]\n", 5, 9, "non-negative"),
             ("name = \"t\"\n[[problem]]\nplant = \"NOPE\"\norders = [1]\n", 3, 9, "NOPE"),
             ("name = \"t\"\n[[problem]]\nplant = \"nope/x.json\"\norders = [1]\n", 3, 9, "does not exist"),

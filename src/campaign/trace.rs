@@ -309,7 +309,10 @@ pub struct PhaseSummary {
 pub struct TraceSummary {
     /// The file.
     pub path: PathBuf,
-    /// Iteration messages.
+    /// Iteration messages (one per optimiser step plus one for the starting point of every
+    /// optimiser run, which has `iteration` 0).
+    pub messages: usize,
+    /// Optimiser steps: messages with `iteration` ≥ 1. Equals the journal's `iterations`.
     pub iterations: usize,
     /// Per phase (by name, in first-seen order).
     pub phases: Vec<(String, PhaseSummary)>,
@@ -331,7 +334,7 @@ pub struct TraceSummary {
 
 /// Calls `f(topic, message)` for every message of the trace at `path`, in file order.
 fn each_message(path: &Path, mut f: impl FnMut(&str, Value)) -> Result<(), TraceError> {
-    let bytes = std::fs::read(path).map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
+    let bytes = crate::input::read_capped(path, crate::input::MAX_TRACE_BYTES, "trace file").map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
     let stream = mcap::MessageStream::new(&bytes).map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
     for (index, msg) in stream.enumerate() {
         let msg = msg.map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
@@ -383,6 +386,7 @@ pub fn read_iterations(path: &Path) -> Result<Vec<TraceIteration>, TraceError> {
 pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
     let mut s = TraceSummary {
         path: path.to_path_buf(),
+        messages: 0,
         iterations: 0,
         phases: Vec::new(),
         first_f: f64::NAN,
@@ -396,10 +400,13 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
     each_message(path, |topic, v| {
         if topic == ITER_TOPIC {
             let f = f64_from_json(&v["f"]);
-            if s.iterations == 0 {
+            if s.messages == 0 {
                 s.first_f = f;
             }
-            s.iterations += 1;
+            s.messages += 1;
+            if v["iteration"].as_u64().is_some_and(|i| i >= 1) {
+                s.iterations += 1;
+            }
             s.last_f = f;
             let h = f64_from_json(&v["hinf_cl"]);
             if h.is_finite() && !(h >= s.best_hinf_cl) {
@@ -429,7 +436,11 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
 impl fmt::Display for TraceSummary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "trace {}", self.path.display())?;
-        writeln!(f, "  iterations {}  evaluations {}  cpu {:.2} s", self.iterations, self.evaluations, self.elapsed_cpu_s)?;
+        writeln!(
+            f,
+            "  iterations {} ({} messages with the starting points)  evaluations {}  cpu {:.2} s",
+            self.iterations, self.messages, self.evaluations, self.elapsed_cpu_s
+        )?;
         writeln!(f, "  f: first {:.6e}  last {:.6e}  best ‖Tzw‖∞ {:.6}", self.first_f, self.last_f, self.best_hinf_cl)?;
         for (name, p) in &self.phases {
             writeln!(f, "  {name:<16} {:>6} msgs  f {:.6e} → {:.6e}", p.messages, p.first_f, p.last_f)?;

@@ -4,7 +4,6 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::Ordering;
 
 use anyhow::Context;
 use hinfix::campaign::claims::{unix_now, ClaimDir};
@@ -20,7 +19,9 @@ use hinfix::campaign::{
     expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
 };
 
-use super::{EXIT_INTERRUPTED, EXIT_JOBS_FAILED};
+use hinfix::campaign::sanitise::for_terminal;
+
+use super::{signals, EXIT_JOBS_FAILED};
 
 /// Where campaign results go unless `--results` says otherwise.
 const DEFAULT_RESULTS: &str = "results";
@@ -40,9 +41,9 @@ pub struct CampaignFileArgs {
 pub struct RunArgs {
     #[command(flatten)]
     pub campaign: CampaignFileArgs,
-    /// Worker threads (one job per thread; faer is single-threaded inside a job). Default: the
-    /// file's `defaults.threads`, else 2.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    /// Worker threads (one job per thread; faer is single-threaded inside a job), 1..=256.
+    /// Default: the file's `defaults.threads`, else 2.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=hinfix::campaign::MAX_THREADS as i64))]
     pub threads: Option<u32>,
     /// Plain log lines instead of live progress bars (automatic when stderr is not a terminal).
     #[arg(long)]
@@ -159,7 +160,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let threads = l.campaign.threads(a.threads.map(|t| t as usize));
     let opts = ExecuteOptions::new(&l.campaign.name, threads);
     let cancel = opts.cancel.clone();
-    ctrlc::set_handler(move || cancel.store(true, Ordering::SeqCst)).context("installing the Ctrl-C handler")?;
+    signals::install_into(&cancel).context("installing the signal handlers")?;
 
     let runner: &dyn JobRunner = match &l.fake {
         Some(f) => f,
@@ -167,9 +168,10 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     };
     let observers = trace_observers(&l.dir.join("traces"));
     let mut reporter = Reporter::new(&jobs, Display::choose(a.no_progress));
+    let (name, dir) = (for_terminal(&l.campaign.name), for_terminal(&l.dir.display().to_string()));
     match a.shard {
-        Some(s) => eprintln!("campaign {} shard {s}: {} of {} jobs → {}", l.campaign.name, jobs.len(), l.jobs.len(), l.dir.display()),
-        None => eprintln!("campaign {} → {}", l.campaign.name, l.dir.display()),
+        Some(s) => eprintln!("campaign {name} shard {s}: {} of {} jobs → {dir}", jobs.len(), l.jobs.len()),
+        None => eprintln!("campaign {name} → {dir}"),
     }
     let outcome = run_jobs(&jobs, &l.dir, runner, &observers, &opts, |ev| reporter.on_event(ev))?;
     if let Some(t) = &outcome.torn {
@@ -195,7 +197,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     report_into(&l.dir, &l.campaign, &records_for(&l.jobs, &outcome.records))?;
     if outcome.interrupted() {
         eprintln!("interrupted: rerun the same command to resume");
-        return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        return Ok(ExitCode::from(signals::exit_code()));
     }
     if outcome.failed() > 0 {
         eprintln!("{} job(s) failed: see `campaign status` and the journals in {}", outcome.failed(), l.dir.display());
@@ -267,10 +269,10 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         }
     }
     let names: Vec<String> = journals.iter().map(|p| p.display().to_string()).collect();
-    println!("campaign {} ({} journal(s): {})", l.campaign.name, names.len(), names.join(", "));
+    println!("campaign {} ({} journal(s): {})", for_terminal(&l.campaign.name), names.len(), for_terminal(&names.join(", ")));
     println!("{:<16} {:>6} {:>6} {:>8} {:>9} {:>7}", "plant", "jobs", "done", "running", "remaining", "failed");
     for (p, n, d, r, f) in &rows {
-        println!("{p:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", n - d - r);
+        println!("{:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", for_terminal(p), n - d - r);
     }
     let (n, d, r, f) = rows.iter().fold((0, 0, 0, 0), |acc, x| (acc.0 + x.1, acc.1 + x.2, acc.2 + x.3, acc.3 + x.4));
     println!("{:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", "total", n - d - r);
@@ -281,7 +283,7 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
                 Some(o) => format!("{}:{} for {:.0} s", o.host, o.pid, (unix_now() - o.since_unix_s).max(0.0)),
                 None => "(owner not written yet)".into(),
             };
-            println!("  {}  {}  {who}", j.id.short(), j.label());
+            println!("  {}  {}  {}", j.id.short(), for_terminal(&j.label()), for_terminal(&who));
         }
     }
     let stale = claims.iter().filter(|c| !c.held && !done.contains_key(&c.job)).count();
@@ -293,7 +295,7 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         println!("{} job(s) have more than one record; reports count each once, by its best verified record:", dups.len());
         for (id, n) in &dups {
             let label = index.get(id).map_or_else(String::new, |j| j.label());
-            println!("  {}  {label}  {n} records", id.short());
+            println!("  {}  {}  {n} records", id.short(), for_terminal(&label));
         }
     }
     if let Some(n) = a.shards {

@@ -7,6 +7,9 @@
 //! `controller_hinf`, `closed_loop_stable`, `controller_stable`); non-finite numbers are written
 //! as the strings "inf" / "-inf" / "nan" (as `design::float_serde`), a frequency that does not
 //! exist (unstable loop) as null.
+//!
+//! Exit codes: 0 when the closed loop is stable, 4 ([`super::EXIT_NOT_STABILISED`]) when it is
+//! not (the report is printed either way), 1 on an error.
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -68,7 +71,7 @@ pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
     } else {
         print!("{}", human(&plant, &k, &r));
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(if r.closed_loop_stable() { ExitCode::SUCCESS } else { ExitCode::from(super::EXIT_NOT_STABILISED) })
 }
 
 fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
@@ -103,14 +106,19 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     } else {
         format!("ω = {:.6} rad/s", r.peak_freq)
     };
-    let mut s = format!("plant {} (n = {}), controller of order {}\n", plant.name, plant.dims.n, k.order());
+    let mut s = format!(
+        "plant {} (n = {}), controller of order {}\n",
+        hinfix::campaign::sanitise::for_terminal(&plant.name),
+        plant.dims.n,
+        k.order()
+    );
     s += &format!("closed loop: α(A_cl) = {:+.6e}   {}\n", r.alpha_cl, yes_no(r.closed_loop_stable()));
-    s += &format!("             ‖Tzw‖∞  = {:.10}   at {}\n", r.hinf_cl, freq);
+    s += &format!("             ‖Tzw‖∞  = {}   at {}\n", super::fmt_num(r.hinf_cl, 10), freq);
     match r.alpha_k {
         Some(a) => s += &format!("controller:  α(Ak)    = {:+.6e}   {}\n", a, yes_no(r.controller_stable())),
         None => s += "controller:  static gain (order 0), trivially stable\n",
     }
-    s += &format!("             ‖K‖∞    = {:.10}\n", r.hinf_k);
+    s += &format!("             ‖K‖∞    = {}\n", super::fmt_num(r.hinf_k, 10));
     s
 }
 

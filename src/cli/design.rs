@@ -3,12 +3,13 @@
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`hinfix::fs_atomic`).
 //!
-//! Every outcome (including "not stabilised") writes the returned controller and exits 0, except
-//! an interrupt (Ctrl-C cancels the run; the best controller so far is still written), which
-//! exits 130.
+//! Every outcome writes the returned controller. Exit codes: 0 for a stabilising controller
+//! (converged, stopped by a limit, budget exhausted, stabilised only), 4 when it is NOT
+//! STABILISED, 130/143/129 after Ctrl-C/SIGTERM/SIGHUP (the run is cancelled; the best
+//! controller so far is still written). `--out` is checked (not a directory, writable) before
+//! the design starts.
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use anyhow::Context;
@@ -17,7 +18,8 @@ use hinfix::fs_atomic::write_atomic;
 use hinfix::lti::{resolve_plant, Controller, Plant};
 use hinfix::optim::RunControl;
 
-use super::EXIT_INTERRUPTED;
+use super::{fmt_num, signals, EXIT_NOT_STABILISED};
+use hinfix::campaign::sanitise::for_terminal;
 
 /// Arguments of `campaign design`.
 #[derive(clap::Args, Debug)]
@@ -28,16 +30,16 @@ pub struct DesignArgs {
     /// Controller order nk ≥ 0.
     #[arg(long)]
     pub order: usize,
-    /// Weight ε of ‖K‖∞ and α(Ak) (strong stabilisation).
-    #[arg(long, default_value_t = 1e-3)]
+    /// Weight ε of ‖K‖∞ and α(Ak) (strong stabilisation), > 0.
+    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
     pub eps: f64,
     /// Seed of the random starting points.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// CPU-second budget of the whole design.
-    #[arg(long, default_value_t = 60.0)]
+    /// CPU-second budget of the whole design, > 0.
+    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub cpumax: f64,
-    /// Number of random starts (or of perturbations of --init).
+    /// Number of random starts (or of perturbations of --init), 1..=10000.
     #[arg(long, default_value_t = 3)]
     pub nrand: usize,
     /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
@@ -71,15 +73,14 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         objective: if a.no_strong { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
         ..Default::default()
     };
-    let cancel = Arc::new(AtomicBool::new(false));
-    {
-        let cancel = Arc::clone(&cancel);
-        // Not fatal if a handler is already installed (e.g. in tests).
-        let _ = ctrlc::set_handler(move || cancel.store(true, Ordering::Relaxed));
-    }
+    // Bad options and an unusable --out are errors before any work (and before any file is made).
+    hinfix::design::validate(&plant, &opts, init.as_ref())
+        .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
+    check_writable(&a.out).with_context(|| format!("--out {}", a.out.display()))?;
+    let cancel = signals::install();
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
-        .with_context(|| format!("designing an order-{} controller for {}", a.order, plant.name))?;
+        .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
     if hinfix::lti::mat_file::is_mat_path(&a.out) {
         let k = Controller::from_json_value(&outcome.controller).context("the designed controller")?;
         k.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
@@ -92,12 +93,35 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     } else {
         print!("{}", summary(&plant, &opts, &outcome, &a.out));
     }
-    Ok(if outcome.status == DesignStatus::Interrupted { ExitCode::from(EXIT_INTERRUPTED) } else { ExitCode::SUCCESS })
+    Ok(match outcome.status {
+        DesignStatus::Interrupted => ExitCode::from(signals::exit_code()),
+        DesignStatus::NotStabilised { .. } => ExitCode::from(EXIT_NOT_STABILISED),
+        _ => ExitCode::SUCCESS,
+    })
+}
+
+/// `path` can receive the controller: not a directory, and its `.tmp` sibling can be created
+/// (it is removed again).
+fn check_writable(path: &Path) -> anyhow::Result<()> {
+    if path.is_dir() {
+        anyhow::bail!("is a directory; give a file name such as {}", path.join("K.json").display());
+    }
+    let tmp = tmp_path(path);
+    std::fs::OpenOptions::new().write(true).create(true).truncate(true).open(&tmp)?;
+    std::fs::remove_file(&tmp)?;
+    Ok(())
+}
+
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    PathBuf::from(tmp)
 }
 
 fn status_text(s: &DesignStatus) -> String {
     match s {
-        DesignStatus::Optimised => "optimised".into(),
+        DesignStatus::Converged => "converged (optimality certificate met)".into(),
+        DesignStatus::Stopped => "stopped by a limit before the optimality certificate was met".into(),
         DesignStatus::StabilisedOnly => "stabilised only (the optimisation made no progress)".into(),
         DesignStatus::NotStabilised { best_alpha } => {
             format!("NOT STABILISED (best max(α(A_cl), ε·α(Ak)) = {best_alpha:+.6e})")
@@ -112,9 +136,15 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
         ObjectiveKind::Plain => "plain H∞".to_string(),
     };
-    let mut s = format!("{} (n = {}), order {}, {}, seed {}\n", plant.name, plant.dims.n, opts.order, mode, opts.seed);
+    let mut s = format!("{} (n = {}), order {}, {}, seed {}\n", for_terminal(&plant.name), plant.dims.n, opts.order, mode, opts.seed);
     s += &format!("status:   {}\n", status_text(&o.status));
-    s += &format!("‖Tzw‖∞ = {:.6}   ‖K‖∞ = {:.6}   objective = {:.6}\n", o.gamma, o.k_hinf, o.objective);
+    s += &format!("‖Tzw‖∞ = {}   ‖K‖∞ = {}   objective = {}\n", fmt_num(o.gamma, 6), fmt_num(o.k_hinf, 6), fmt_num(o.objective, 6));
+    if o.controller_norm_active {
+        s += &format!(
+            "note:     ε‖K‖∞ = {} ≥ ‖Tzw‖∞: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets γ go lower)\n",
+            fmt_num(opts.eps * o.k_hinf, 6)
+        );
+    }
     s += &format!("α(A_cl) = {:+.4e}", o.alpha_cl);
     match o.alpha_k {
         Some(a) => s += &format!("   α(Ak) = {a:+.4e}\n"),

@@ -2,7 +2,8 @@
 //! `anyhow` only here, at the edge, and map to documented exit codes.
 //!
 //! Exit codes: 0 success, 1 error, 2 usage error (clap), 3 some campaign jobs failed,
-//! 130 interrupted.
+//! 4 not stabilised (`design` found no (strongly) stabilising controller; `check`: the closed
+//! loop is unstable), 130 interrupted by Ctrl-C (SIGINT), 143 by SIGTERM, 129 by SIGHUP.
 
 use std::process::ExitCode;
 
@@ -13,6 +14,7 @@ mod check;
 mod design;
 mod export;
 mod plants;
+mod signals;
 
 /// hinfix: fixed-order H∞ controller design with strong stabilisation (HIFOO method) and a
 /// benchmark-campaign runner.
@@ -51,6 +53,19 @@ enum Command {
 pub const EXIT_JOBS_FAILED: u8 = 3;
 /// Exit code after an interrupt.
 pub const EXIT_INTERRUPTED: u8 = 130;
+/// Exit code of `design` when no (strongly) stabilising controller was found, and of `check`
+/// when the closed loop is unstable.
+pub const EXIT_NOT_STABILISED: u8 = 4;
+
+/// A number for people: fixed-point with `prec` decimals in [1e-3, 1e6), scientific outside
+/// (ε = 1e308 must not print a 309-digit objective).
+pub(crate) fn fmt_num(x: f64, prec: usize) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.prec$e}")
+    } else {
+        format!("{x:.prec$}")
+    }
+}
 
 /// Parses the command line and runs it.
 pub fn main() -> ExitCode {
@@ -70,8 +85,23 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", hinfix::campaign::sanitise::for_terminal(&format!("{e:#}")));
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_num;
+
+    #[test]
+    fn numbers_stay_short() {
+        assert_eq!(fmt_num(0.123456789, 6), "0.123457");
+        assert_eq!(fmt_num(1e308, 6), "1.000000e308");
+        assert_eq!(fmt_num(2.5e-9, 3), "2.500e-9");
+        assert_eq!(fmt_num(0.0, 2), "0.00");
+        assert_eq!(fmt_num(f64::INFINITY, 6), "inf");
+        assert!(fmt_num(-1.7e300, 6).len() < 20);
     }
 }

@@ -2,6 +2,8 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
+use hinfix::campaign::report::FULL_ORDER_MAX_N;
+use hinfix::campaign::sanitise::for_terminal as term;
 use hinfix::campaign::{load_default_reference, RefMethod};
 use hinfix::lti::{self, Plant};
 use serde_json::{json, Value};
@@ -44,7 +46,7 @@ impl Summary {
         json!({
             "name": self.name, "n": d.n, "m1": d.m1, "m2": d.m2, "p1": d.p1, "p2": d.p2,
             "open_loop_stable": self.stable(),
-            "open_loop_spectral_abscissa": self.alpha,
+            "open_loop_spectral_abscissa": hinfix::design::f64_to_json(self.alpha),
             "source": self.plant.citation,
         })
     }
@@ -67,7 +69,7 @@ pub fn list(a: PlantsArgs) -> anyhow::Result<ExitCode> {
     for r in &rows {
         let d = r.plant.dims;
         let stab = if r.stable() { "stable" } else { "unstable" };
-        println!("{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} {}", r.name, d.n, d.m1, d.m2, d.p1, d.p2, stab, short(&r.plant.citation, 70));
+        println!("{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} {}", term(&r.name), d.n, d.m1, d.m2, d.p1, d.p2, stab, term(&short(&r.plant.citation, 70)));
     }
     println!("\n{} plants in {}; problems without public data: {}", rows.len(), dir.display(), dir.join("MISSING.md").display());
     Ok(ExitCode::SUCCESS)
@@ -81,17 +83,22 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
         .ok()
         .and_then(|rows| rows.into_iter().find(|r| r.plant == s.name && r.method == RefMethod::FullOrder))
         .map(|r| r.gamma);
-    let full = lti::full_order_gamma(&s.plant);
+    // Above FULL_ORDER_MAX_N the full-order γ takes minutes (and cannot be interrupted): skipped.
+    let full = if s.plant.dims.n <= FULL_ORDER_MAX_N {
+        lti::full_order_gamma(&s.plant).map_err(|e| e.to_string())
+    } else {
+        Err(format!("skipped: n = {} > {FULL_ORDER_MAX_N} (the limit for computing it here)", s.plant.dims.n))
+    };
     if a.json {
         let mut doc = s.plant.to_json();
         let o = doc.as_object_mut().expect("plant JSON is an object");
         o.insert("file".into(), path.display().to_string().into());
         o.insert("open_loop_stable".into(), s.stable().into());
-        o.insert("open_loop_spectral_abscissa".into(), s.alpha.into());
+        o.insert("open_loop_spectral_abscissa".into(), hinfix::design::f64_to_json(s.alpha));
         o.insert("d22_zero".into(), s.plant.d22_is_zero().into());
         o.insert("full_order_gamma".into(), match &full {
             Ok(f) => json!({"gamma": f.gamma, "regularisation": f.regularisation, "method": f.describe()}),
-            Err(e) => json!({"error": e.to_string()}),
+            Err(e) => json!({"error": e}),
         });
         o.insert("paper_full_order_gamma".into(), paper_full.into());
         println!("{}", serde_json::to_string_pretty(&doc)?);
@@ -99,9 +106,9 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
     }
     let p = &s.plant;
     let d = p.dims;
-    println!("{} — {}", p.name, p.description);
-    println!("  file:        {}", path.display());
-    println!("  source:      {}", p.citation);
+    println!("{} — {}", term(&p.name), term(&p.description));
+    println!("  file:        {}", term(&path.display().to_string()));
+    println!("  source:      {}", term(&p.citation));
     println!("  sizes:       n = {}, w: m1 = {}, u: m2 = {}, z: p1 = {}, y: p2 = {}", d.n, d.m1, d.m2, d.p1, d.p2);
     println!("  open loop:   {} (spectral abscissa {:.6e})", if s.stable() { "stable" } else { "unstable" }, s.alpha);
     println!("  D22:         {}", if p.d22_is_zero() { "zero" } else { "non-zero" });
@@ -116,7 +123,7 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
         println!("  file's check block:   {check}");
     }
     if !p.notes.is_empty() {
-        println!("  notes:       {}", p.notes);
+        println!("  notes:       {}", term(&p.notes));
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -2,6 +2,14 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::float_serde::serde_f64_or_string;
+
+/// Largest accepted number of random starts `nrand` (each start is a BFGS run of its own).
+pub const MAX_NRAND: usize = 10_000;
+/// Largest accepted iteration limit `maxit` and `gradsamp_maxit` (the CPU budget stops a run
+/// long before; the bound only turns a typo into an error).
+pub const MAX_ITERATIONS: usize = 100_000_000;
+
 /// Which problem to solve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -21,22 +29,27 @@ pub struct DesignOptions {
     /// Controller order nk ≥ 0.
     pub order: usize,
     /// Weight ε of the controller's own term (strong stabilisation only), ε > 0.
+    #[serde(with = "serde_f64_or_string")]
     pub eps: f64,
     /// Seed of the run's random number generator.
     pub seed: u64,
     /// CPU-second budget of the whole run (both phases and gradient sampling).
+    #[serde(with = "serde_f64_or_string")]
     pub cpumax: f64,
     /// Number of random starting points (HIFOO `nrand`, default 3).
     pub nrand: usize,
     /// Strong stabilisation or plain H∞.
     pub objective: ObjectiveKind,
     /// Relative tolerance of the H∞ norm computation.
+    #[serde(with = "serde_f64_or_string")]
     pub hinf_tol: f64,
     /// BFGS iteration limit per start and phase (HIFOO `maxit`, 1000).
     pub maxit: usize,
     /// Stop BFGS when the certificate dnorm ≤ normtol (HIFOO passes 1e-3).
+    #[serde(with = "serde_f64_or_string")]
     pub normtol: f64,
     /// Gradient-bundle radius (HIFOO passes 1e-3).
+    #[serde(with = "serde_f64_or_string")]
     pub evaldist: f64,
     /// Run gradient sampling after BFGS (HIFOO `fast = 0`).
     pub gradient_sampling: bool,

@@ -4,7 +4,7 @@ use std::ops::ControlFlow;
 
 use serde::{Deserialize, Serialize};
 
-use super::float_serde::serde_f64_or_string;
+use super::float_serde::{serde_f64_or_string, serde_opt_f64_or_string};
 
 /// Phase of a design run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -22,8 +22,14 @@ pub enum Phase {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum DesignStatus {
-    /// Both phases ran; the controller is stable and stabilising.
-    Optimised,
+    /// Both phases ran and the final point meets the optimality certificate (dnorm ≤ normtol
+    /// on a bundle of radius evaldist); the controller is stable and stabilising.
+    Converged,
+    /// Both phases ran and made progress, but a limit (iterations, stall, evaluations) ended the
+    /// search before the certificate was met; the controller is stable and stabilising.
+    /// Journals of older builds, which called both cases "optimised", read as this.
+    #[serde(alias = "optimised")]
+    Stopped,
     /// Stabilised, but the optimisation phase made no progress (or could not run).
     StabilisedOnly,
     /// No stabilising (strongly stabilising) controller found; the best abscissa reached.
@@ -48,6 +54,7 @@ pub struct PhaseStats {
     /// Objective evaluations.
     pub evals: usize,
     /// CPU seconds.
+    #[serde(with = "serde_f64_or_string")]
     pub cpu_s: f64,
 }
 
@@ -68,14 +75,22 @@ pub struct DesignOutcome {
     #[serde(with = "serde_f64_or_string")]
     pub alpha_cl: f64,
     /// Spectral abscissa of Ak (None for order 0).
+    #[serde(default, with = "serde_opt_f64_or_string")]
     pub alpha_k: Option<f64>,
     /// Final objective: max(γ, ε‖K‖∞) (strong) or γ (plain).
     #[serde(with = "serde_f64_or_string")]
     pub objective: f64,
     /// Optimality certificate (dnorm, evaldist) of the final point, if the optimisation ran.
+    #[serde(default, with = "serde_opt_f64_or_string")]
     pub dnorm: Option<f64>,
     /// See `dnorm`.
+    #[serde(default, with = "serde_opt_f64_or_string")]
     pub evaldist: Option<f64>,
+    /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞): the
+    /// controller-norm penalty, not the closed loop, sets the objective (strong stabilisation
+    /// only; a smaller ε would let γ go lower).
+    #[serde(default)]
+    pub controller_norm_active: bool,
     /// Per-phase counters.
     pub phases: Vec<PhaseStats>,
     /// Total iterations.
@@ -83,6 +98,7 @@ pub struct DesignOutcome {
     /// Total objective evaluations.
     pub evals: usize,
     /// Total CPU seconds of the run.
+    #[serde(with = "serde_f64_or_string")]
     pub cpu_s: f64,
 }
 

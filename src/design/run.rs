@@ -13,7 +13,7 @@ use crate::lti::{
 use crate::optim::{RunControl, Termination};
 
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
-use super::options::{DesignOptions, ObjectiveKind};
+use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase};
 use super::params::{controller_to_x, ControllerShape};
 use super::phases::{optimise, stabilise};
@@ -59,16 +59,18 @@ fn opt_err(field: &'static str, problem: impl Into<String>) -> DesignError {
     DesignError::Options { field, problem: problem.into() }
 }
 
-/// Checks the options and the initial controller against the plant.
+/// Checks the options and the initial controller against the plant. This is the one validation
+/// of design options: `campaign design` calls it through [`run`], and a campaign file calls it
+/// for every problem before any job starts.
 pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) -> Result<(), DesignError> {
     if !(opts.eps.is_finite() && opts.eps > 0.0) {
-        return Err(opt_err("eps", format!("must be finite and > 0, got {}", opts.eps)));
+        return Err(opt_err("eps", format!("ε must be finite and positive (> 0), got {}", opts.eps)));
     }
     if !(opts.cpumax > 0.0) {
         return Err(opt_err("cpumax", format!("must be > 0 CPU seconds (may be infinite), got {}", opts.cpumax)));
     }
-    if opts.nrand < 1 {
-        return Err(opt_err("nrand", "must be at least 1"));
+    if !(1..=MAX_NRAND).contains(&opts.nrand) {
+        return Err(opt_err("nrand", format!("must be in 1..={MAX_NRAND}, got {}", opts.nrand)));
     }
     if opts.order > plant.dims.n {
         return Err(opt_err(
@@ -79,8 +81,11 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     if !(opts.hinf_tol.is_finite() && opts.hinf_tol >= MIN_HINF_TOL && opts.hinf_tol < 1.0) {
         return Err(opt_err("hinf_tol", format!("must be in [{MIN_HINF_TOL:e}, 1), got {}", opts.hinf_tol)));
     }
-    if opts.maxit < 1 {
-        return Err(opt_err("maxit", "must be at least 1"));
+    if !(1..=MAX_ITERATIONS).contains(&opts.maxit) {
+        return Err(opt_err("maxit", format!("must be in 1..={MAX_ITERATIONS}, got {}", opts.maxit)));
+    }
+    if opts.gradsamp_maxit > MAX_ITERATIONS {
+        return Err(opt_err("gradsamp_maxit", format!("must be at most {MAX_ITERATIONS}, got {}", opts.gradsamp_maxit)));
     }
     for (field, v) in [("normtol", opts.normtol), ("evaldist", opts.evaldist)] {
         if !(v.is_finite() && v >= 0.0) {
@@ -151,6 +156,11 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
     Figures { gamma, k_hinf, alpha_cl, alpha_k, objective }
 }
 
+/// Whether ε‖K‖∞ ≥ ‖Tzw‖∞, i.e. the controller-norm term sets max(‖Tzw‖∞, ε‖K‖∞).
+pub(crate) fn controller_norm_active(opts: &DesignOptions, gamma: f64, k_hinf: f64) -> bool {
+    opts.objective == ObjectiveKind::Strong && gamma.is_finite() && opts.eps * k_hinf >= gamma
+}
+
 fn run_validated(
     plant: &Plant,
     opts: &DesignOptions,
@@ -208,8 +218,10 @@ fn run_validated(
             DesignStatus::BudgetExhausted
         } else if opt.best.is_none() || !opt.progress {
             DesignStatus::StabilisedOnly
+        } else if opt.best.as_ref().is_some_and(|b| b.dnorm <= opts.normtol) {
+            DesignStatus::Converged
         } else {
-            DesignStatus::Optimised
+            DesignStatus::Stopped
         };
     }
 
@@ -224,6 +236,7 @@ fn run_validated(
         alpha_cl: fig.alpha_cl,
         alpha_k: fig.alpha_k,
         objective: fig.objective,
+        controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
         dnorm: certificate.0,
         evaldist: certificate.1,
         phases,

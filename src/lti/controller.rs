@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use faer::Mat;
 use serde_json::Value;
 
-use super::matrix_json::{json_shape, matrix_from_json, matrix_to_json, MatrixJsonError};
+use super::matrix_json::{json_shape, json_type, matrix_from_json, matrix_to_json, MatrixJsonError};
 
 /// Controller matrices (Ak, Bk, Ck, Dk).
 #[derive(Debug, Clone, PartialEq)]
@@ -32,8 +32,7 @@ pub struct Controller {
 pub struct ControllerError {
     /// The file (or a label).
     pub file: PathBuf,
-    /// What is wrong.
-    #[source]
+    /// What is wrong (part of the message, so not also a `source`).
     pub kind: ControllerErrorKind,
 }
 
@@ -43,7 +42,7 @@ pub struct ControllerError {
 pub enum ControllerErrorKind {
     /// Could not be read.
     #[error("cannot read: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// Not valid JSON.
     #[error("invalid JSON at line {line}, column {column}: {message}")]
     Json {
@@ -109,11 +108,12 @@ impl Controller {
         let path = path.as_ref();
         if super::mat_file::is_mat_path(path) {
             let err = |kind| ControllerError { file: path.to_path_buf(), kind };
-            let bytes = std::fs::read(path).map_err(|e| err(e.into()))?;
+            let bytes = crate::input::read_capped(path, crate::input::MAX_CONTROLLER_BYTES, "controller file")
+                .map_err(|e| err(ControllerErrorKind::Io(e)))?;
             return super::mat_file::controller_from_mat(&bytes).map_err(err);
         }
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ControllerError { file: path.to_path_buf(), kind: e.into() })?;
+        let text = crate::input::read_capped_string(path, crate::input::MAX_CONTROLLER_BYTES, "controller file")
+            .map_err(|e| ControllerError { file: path.to_path_buf(), kind: ControllerErrorKind::Io(e) })?;
         Self::from_json_str(&text, path)
     }
 
@@ -136,18 +136,22 @@ impl Controller {
         };
         let shape = |key: &'static str| -> Result<(usize, usize), ControllerErrorKind> {
             let v = obj.get(key).ok_or(ControllerErrorKind::Matrix { matrix: key, problem: MatrixJsonError::Missing })?;
-            json_shape(v).ok_or(ControllerErrorKind::Matrix {
-                matrix: key,
-                problem: MatrixJsonError::NotArray { found: "a non-array" },
-            })
+            let problem = match v.as_array() {
+                None => Some(MatrixJsonError::NotArray { found: json_type(v) }),
+                Some(rows) => rows
+                    .iter()
+                    .position(|r| !r.is_array())
+                    .map(|i| MatrixJsonError::RowNotArray { row: i + 1, found: json_type(&rows[i]) }),
+            };
+            match problem {
+                Some(problem) => Err(ControllerErrorKind::Matrix { matrix: key, problem }),
+                None => Ok(json_shape(v).expect("checked to be an array of rows")),
+            }
         };
         let (m, p) = shape("DK")?;
         let nk = shape("AK")?.0;
         if m == 0 || p == 0 {
-            return Err(ControllerErrorKind::Matrix {
-                matrix: "DK",
-                problem: MatrixJsonError::RowCount { expected: 1, got: 0 },
-            });
+            return Err(ControllerErrorKind::Matrix { matrix: "DK", problem: MatrixJsonError::Empty { rows: m, cols: p } });
         }
         Ok(Controller { ak: mat("AK", nk, nk)?, bk: mat("BK", nk, p)?, ck: mat("CK", m, nk)?, dk: mat("DK", m, p)? })
     }
@@ -208,6 +212,16 @@ mod tests {
         assert_eq!((k.order(), k.m(), k.p()), (0, 2, 2));
         let back = Controller::from_json_value(&k.to_json()).unwrap();
         assert_eq!(back, k);
+    }
+
+    #[test]
+    fn flat_dk_is_named_as_such() {
+        // issue 15: `DK: [1.0, 2.0]` was reported as "has 0 rows".
+        let e = Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [[]], "DK": [1.0, 2.0]}"#, "k.json").unwrap_err();
+        let s = e.to_string();
+        assert!(s.contains("`DK` row 1 must be an array") && s.contains("a number"), "{s}");
+        let e = Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [], "DK": []}"#, "k.json").unwrap_err();
+        assert!(e.to_string().contains("at least one row and one column, found 0×0"), "{e}");
     }
 
     #[test]

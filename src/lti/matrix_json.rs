@@ -9,6 +9,10 @@
 use faer::Mat;
 use serde_json::Value;
 
+/// Largest accepted matrix dimension (rows or columns): 1 048 576. Far above any plant this
+/// program can handle; it keeps a typo in `dims` from becoming a huge allocation or loop.
+pub const MAX_MATRIX_DIM: usize = 1 << 20;
+
 /// What is wrong with one matrix in a JSON document (the caller adds file and matrix name).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -58,6 +62,22 @@ pub enum MatrixJsonError {
         /// The JSON text found.
         found: String,
     },
+    /// A matrix that must have entries has none.
+    #[error("must have at least one row and one column, found {rows}×{cols}")]
+    Empty {
+        /// Rows found.
+        rows: usize,
+        /// Columns found.
+        cols: usize,
+    },
+    /// The expected shape exceeds [`MAX_MATRIX_DIM`].
+    #[error("would be {rows}×{cols}, larger than the limit of {MAX_MATRIX_DIM} rows or columns")]
+    TooLarge {
+        /// Expected rows.
+        rows: usize,
+        /// Expected columns.
+        cols: usize,
+    },
     /// A number that is not finite.
     #[error("entry ({row}, {col}) is not finite ({value})")]
     NotFinite {
@@ -70,7 +90,7 @@ pub enum MatrixJsonError {
     },
 }
 
-fn json_type(v: &Value) -> &'static str {
+pub(crate) fn json_type(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",
         Value::Bool(_) => "a boolean",
@@ -91,6 +111,9 @@ pub fn matrix_from_json(
     let arr = value
         .as_array()
         .ok_or(MatrixJsonError::NotArray { found: json_type(value) })?;
+    if rows > MAX_MATRIX_DIM || cols > MAX_MATRIX_DIM {
+        return Err(MatrixJsonError::TooLarge { rows, cols });
+    }
     // `[]` stands for any matrix with no entries.
     if arr.is_empty() && (rows == 0 || cols == 0) {
         return Ok(Mat::zeros(rows, cols));
@@ -98,7 +121,9 @@ pub fn matrix_from_json(
     if arr.len() != rows {
         return Err(MatrixJsonError::RowCount { expected: rows, got: arr.len() });
     }
-    let mut m = Mat::zeros(rows, cols);
+    // Every row is checked before anything is allocated: the expected shape comes from the
+    // file's `dims`, and a huge dimension must be an error, not a rows × cols allocation.
+    let mut entries = Vec::with_capacity(rows);
     for (i, row) in arr.iter().enumerate() {
         let r = row
             .as_array()
@@ -106,6 +131,10 @@ pub fn matrix_from_json(
         if r.len() != cols {
             return Err(MatrixJsonError::RowLength { row: i + 1, expected: cols, got: r.len() });
         }
+        entries.push(r);
+    }
+    let mut m = Mat::zeros(rows, cols);
+    for (i, r) in entries.into_iter().enumerate() {
         for (j, e) in r.iter().enumerate() {
             let x = e.as_f64().ok_or_else(|| MatrixJsonError::NotNumber {
                 row: i + 1,
@@ -160,6 +189,25 @@ mod tests {
         assert_eq!(matrix_from_json(Some(&json!([])), 0, 3).unwrap().nrows(), 0);
         assert_eq!(matrix_from_json(Some(&json!([])), 2, 0).unwrap().nrows(), 2);
         assert_eq!(matrix_from_json(Some(&json!([[], []])), 2, 0).unwrap().ncols(), 0);
+    }
+
+    #[test]
+    fn huge_expected_width_is_an_error_not_an_allocation() {
+        // Found by the fuzz test: a plant with dims.m1 = 10^15 and B1 of n rows made the reader
+        // allocate n × 10^15 before it looked at a row.
+        let e = matrix_from_json(Some(&json!([[1.0], [2.0]])), 2, 1_000_000_000_000_000).unwrap_err();
+        assert!(matches!(e, MatrixJsonError::TooLarge { .. }), "{e}");
+        let e = matrix_from_json(Some(&json!([[1.0], [2.0]])), 2, usize::MAX).unwrap_err();
+        assert!(matches!(e, MatrixJsonError::TooLarge { .. }), "{e}");
+        // within the limit, the rows are checked before the allocation
+        let e = matrix_from_json(Some(&json!([[1.0], [2.0]])), 2, MAX_MATRIX_DIM).unwrap_err();
+        assert!(matches!(e, MatrixJsonError::RowLength { row: 1, .. }), "{e}");
+        // an empty block with a huge other dimension
+        let e = matrix_from_json(Some(&json!([])), 0, 1 << 40).unwrap_err();
+        assert!(matches!(e, MatrixJsonError::TooLarge { .. }), "{e}");
+        let e = matrix_from_json(Some(&json!([])), usize::MAX, 0).unwrap_err();
+        assert!(matches!(e, MatrixJsonError::TooLarge { .. }), "{e}");
+        assert_eq!(matrix_from_json(Some(&json!([])), 0, 1000).unwrap().ncols(), 1000);
     }
 
     #[test]

@@ -80,8 +80,8 @@ pub struct Plant {
 pub struct PlantError {
     /// The file (or a label such as `<inline>`).
     pub file: PathBuf,
-    /// What is wrong.
-    #[source]
+    /// What is wrong (part of the message, so not also a `source`: a chain printer would repeat
+    /// it).
     pub kind: PlantErrorKind,
 }
 
@@ -91,7 +91,7 @@ pub struct PlantError {
 pub enum PlantErrorKind {
     /// The file could not be read.
     #[error("cannot read: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// Not valid JSON.
     #[error("invalid JSON at line {line}, column {column}: {message}")]
     Json {
@@ -123,10 +123,12 @@ pub enum PlantErrorKind {
         problem: String,
     },
     /// No plant of that name in the plant library.
-    #[error("no plant named `{name}` in the library (known: {known}); give a path to use another file")]
+    #[error("no plant named `{name}` in the library ({hint}known: {known}); give a path to use another file")]
     UnknownName {
         /// The name asked for.
         name: String,
+        /// `did you mean `HE1`? ` when a library name differs only in case, else empty.
+        hint: String,
         /// The library's plant names, comma-separated.
         known: String,
     },
@@ -175,11 +177,12 @@ impl Plant {
         let path = path.as_ref();
         if super::mat_file::is_mat_path(path) {
             let err = |kind| PlantError { file: path.to_path_buf(), kind };
-            let bytes = std::fs::read(path).map_err(|e| err(e.into()))?;
+            let bytes = crate::input::read_capped(path, crate::input::MAX_PLANT_BYTES, "plant file")
+                .map_err(|e| err(PlantErrorKind::Io(e)))?;
             return super::mat_file::plant_from_mat(&bytes, path).map_err(err);
         }
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| PlantError { file: path.to_path_buf(), kind: e.into() })?;
+        let text = crate::input::read_capped_string(path, crate::input::MAX_PLANT_BYTES, "plant file")
+            .map_err(|e| PlantError { file: path.to_path_buf(), kind: PlantErrorKind::Io(e) })?;
         Self::from_json_str(&text, path)
     }
 

@@ -35,10 +35,15 @@ pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
     if file.is_file() {
         return Ok(file);
     }
-    let known = shipped_plants().unwrap_or_default().join(", ");
+    let names = shipped_plants().unwrap_or_default();
+    let hint = names
+        .iter()
+        .find(|k| k.eq_ignore_ascii_case(name_or_path))
+        .map(|k| format!("did you mean `{k}`? "))
+        .unwrap_or_default();
     Err(PlantError {
         file,
-        kind: PlantErrorKind::UnknownName { name: name_or_path.to_string(), known },
+        kind: PlantErrorKind::UnknownName { name: name_or_path.to_string(), hint, known: names.join(", ") },
     })
 }
 

@@ -1,0 +1,76 @@
+//! Names (of plants, campaigns) come from files a user may not have written. Before they reach
+//! an output they are made harmless for it:
+//! * [`for_terminal`]: control characters (escape sequences, NUL, newlines, DEL, C1 controls)
+//!   become visible `\u{…}` escapes, so they can neither move the cursor nor forge lines;
+//! * [`for_csv`]: control characters are escaped the same way, and a field that a spreadsheet
+//!   would take for a formula (it starts with `=`, `+`, `-`, `@`, tab or carriage return) gets a
+//!   leading `'` (OWASP's advice against CSV injection); quoting is left to the CSV writer;
+//! * [`for_latex`]: control characters are dropped and the LaTeX specials are escaped
+//!   ([`super::latex::escape`]).
+
+/// Whether `c` must not reach an output raw.
+fn is_control(c: char) -> bool {
+    c.is_control()
+}
+
+fn escape_controls(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if is_control(c) {
+            out.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// `s` for a terminal: control characters as `\u{1b}` style escapes.
+pub fn for_terminal(s: &str) -> String {
+    escape_controls(s)
+}
+
+/// `s` as a CSV field: control characters escaped, formula-like starts defused with `'`.
+pub fn for_csv(s: &str) -> String {
+    let out = escape_controls(s);
+    if s.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+        format!("'{out}")
+    } else {
+        out
+    }
+}
+
+/// `s` for LaTeX text: control characters dropped, specials escaped (= [`super::latex::escape`],
+/// which every LaTeX table uses).
+pub fn for_latex(s: &str) -> String {
+    super::latex::escape(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn terminal_sees_no_control_characters() {
+        let s = for_terminal("HE1\x1b[2J\0\nx\u{9b}y\u{7f}");
+        assert!(!s.chars().any(char::is_control), "{s:?}");
+        assert_eq!(s, "HE1\\u{1b}[2J\\u{0}\\u{a}x\\u{9b}y\\u{7f}");
+        assert_eq!(for_terminal("AC10 ε"), "AC10 ε");
+    }
+
+    #[test]
+    fn csv_formulas_are_defused() {
+        for bad in ["=HYPERLINK(\"http://x\")", "+cmd|' /C calc'!A0", "-2+3", "@SUM(A1)", "\tx", "\rx"] {
+            let s = for_csv(bad);
+            assert!(s.starts_with('\''), "{bad:?} → {s:?}");
+            assert!(!s.chars().any(char::is_control), "{s:?}");
+        }
+        assert_eq!(for_csv("HE1"), "HE1");
+        assert_eq!(for_csv("a=b"), "a=b");
+    }
+
+    #[test]
+    fn latex_gets_no_controls_or_raw_specials() {
+        assert_eq!(for_latex("a_b\n\\input{x}\0"), "a\\_b\\textbackslash{}input\\{x\\}");
+    }
+}

@@ -1,0 +1,72 @@
+//! Bounded reading of input files. Every file the program reads (plant, controller, campaign,
+//! journal, trace) goes through [`read_capped`] with a documented limit, so a wrong argument
+//! such as `/dev/zero` or a huge file is a clear error instead of reading until memory runs out.
+//! The limits are far above any real file of their kind (the largest shipped plant file is a
+//! few hundred kB).
+
+use std::io::{self, Read};
+use std::path::Path;
+
+const MIB: u64 = 1 << 20;
+
+/// Largest plant file: 256 MiB (a dense n = 2 500 plant is about 130 MB of JSON).
+pub const MAX_PLANT_BYTES: u64 = 256 * MIB;
+/// Largest controller file: 64 MiB.
+pub const MAX_CONTROLLER_BYTES: u64 = 64 * MIB;
+/// Largest campaign file: 1 MiB.
+pub const MAX_CAMPAIGN_BYTES: u64 = MIB;
+/// Largest journal `runs.jsonl`: 1 GiB (a few hundred thousand records with their controllers).
+pub const MAX_JOURNAL_BYTES: u64 = 1024 * MIB;
+/// Largest trace file read by `campaign trace`: 256 MiB (a trace holds about 300 bytes per
+/// iteration).
+pub const MAX_TRACE_BYTES: u64 = 256 * MIB;
+
+/// Reads at most `limit` bytes of `path`; a longer file (or an endless device) is an
+/// `InvalidData` error saying so. `what` names the kind of file in that message.
+pub fn read_capped(path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> {
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    if meta.is_dir() {
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, "is a directory, not a file"));
+    }
+    if meta.is_file() && meta.len() > limit {
+        return Err(too_large(limit, what));
+    }
+    let mut buf = Vec::new();
+    file.take(limit.saturating_add(1)).read_to_end(&mut buf)?;
+    if buf.len() as u64 > limit {
+        return Err(too_large(limit, what));
+    }
+    Ok(buf)
+}
+
+/// As [`read_capped`], as UTF-8 text.
+pub fn read_capped_string(path: &Path, limit: u64, what: &str) -> io::Result<String> {
+    String::from_utf8(read_capped(path, limit, what)?)
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not UTF-8 text ({})", e.utf8_error())))
+}
+
+fn too_large(limit: u64, what: &str) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidData, format!("larger than {} MiB, the limit for a {what}", limit / MIB))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn endless_device_and_large_file_are_refused() {
+        if Path::new("/dev/zero").exists() {
+            let e = read_capped(Path::new("/dev/zero"), 1000, "plant file").unwrap_err();
+            assert!(e.to_string().contains("limit for a plant file"), "{e}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f");
+        std::fs::write(&p, vec![b'x'; 2 * MIB as usize]).unwrap();
+        assert!(read_capped(&p, MIB, "campaign file").unwrap_err().to_string().contains("1 MiB"));
+        assert_eq!(read_capped(&p, 2 * MIB, "x").unwrap().len(), 2 * MIB as usize);
+        assert!(read_capped(dir.path(), MIB, "x").unwrap_err().to_string().contains("directory"));
+        std::fs::write(&p, [0xff, 0xfe]).unwrap();
+        assert!(read_capped_string(&p, MIB, "x").unwrap_err().to_string().contains("UTF-8"));
+    }
+}

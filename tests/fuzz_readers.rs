@@ -1,0 +1,401 @@
+//! Property-based fuzzing of every reader of outside input (issue 15, item 10): the plant and
+//! controller JSON readers, the campaign-file reader, the journal reader, and
+//! `design::validate`. The property is always the same: any input gives `Ok` or a clear `Err`,
+//! never a panic (proptest turns a panic into a failing case and shrinks it).
+//!
+//! Inputs are partly free (arbitrary JSON, TOML-ish text, bytes) and partly mutations of valid
+//! files (one field replaced by an arbitrary value, bytes flipped, the text cut short), so that
+//! the deep paths (shapes, dims, option ranges, record fields) are reached too.
+//!
+//! `cargo test --test fuzz_readers` runs a fast subset ([`FAST_CASES`] per target). The full run,
+//! `cargo test --release --test fuzz_readers -- --ignored --nocapture`, runs
+//! [`FULL_CASES`] per target (≥ 100 000 in all) and prints the counts.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
+
+use hinfix::campaign::journal::parse_journal;
+use hinfix::campaign::record::JobRecord;
+use hinfix::campaign::{expand, Campaign, RunnerTag};
+use hinfix::design::{validate, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats};
+use hinfix::lti::{Controller, Plant};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use serde_json::{json, Value};
+
+/// Cases per target in `cargo test`.
+const FAST_CASES: u32 = 300;
+/// Cases per target in the ignored full run (5 targets → 250 000 inputs).
+const FULL_CASES: u32 = 50_000;
+
+fn manifest(p: &str) -> String {
+    format!("{}/{p}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn he1_text() -> &'static str {
+    static T: OnceLock<String> = OnceLock::new();
+    T.get_or_init(|| std::fs::read_to_string(manifest("plants/HE1.json")).unwrap())
+}
+
+fn he1() -> &'static Plant {
+    static P: OnceLock<Plant> = OnceLock::new();
+    P.get_or_init(|| Plant::from_json_str(he1_text(), "HE1.json").unwrap())
+}
+
+const CONTROLLER: &str = r#"{"AK": [[-1.0, 0.5], [0.0, -2.0]], "BK": [[1.0], [0.5]], "CK": [[1.0, 0.0], [0.0, 1.0]], "DK": [[0.1], [0.2]]}"#;
+
+/// A valid journal line (a converged HE1 job with every field filled in).
+fn record_line() -> &'static str {
+    static L: OnceLock<String> = OnceLock::new();
+    L.get_or_init(|| {
+        let c = Campaign::from_toml_str(&format!("name = \"f\"\n[[problem]]\nplant = \"{}\"\norders = [2]\n", manifest("plants/HE1.json")), Path::new("f.toml")).unwrap();
+        let job = &expand(&c, RunnerTag::Design)[0];
+        let out = DesignOutcome {
+            status: DesignStatus::Converged,
+            controller: serde_json::from_str(CONTROLLER).unwrap(),
+            gamma: 0.2,
+            k_hinf: 3.0,
+            alpha_cl: -0.1,
+            alpha_k: Some(-1.0),
+            objective: 0.2,
+            controller_norm_active: false,
+            dnorm: Some(1e-4),
+            evaldist: Some(1e-3),
+            phases: vec![PhaseStats { phase: Phase::Optimisation, iters: 10, evals: 20, cpu_s: 0.5 }],
+            iters: 10,
+            evals: 20,
+            cpu_s: 0.5,
+        };
+        let r = JobRecord::from_run("f", job, false, Ok(out), 1.0, 1.5).unwrap();
+        serde_json::to_string(&r).unwrap()
+    })
+}
+
+/// Keys that the readers look for, so that generated objects hit real fields.
+const KEYS: &[&str] = &[
+    "name", "dims", "n", "m1", "m2", "p1", "p2", "A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22", "source",
+    "citation", "order", "AK", "BK", "CK", "DK", "status", "kind", "gamma", "eps", "options", "controller",
+    "schema_version", "certificate", "phases",
+];
+
+fn arb_key() -> impl Strategy<Value = String> {
+    prop_oneof![3 => proptest::sample::select(KEYS).prop_map(str::to_string), 1 => ".{0,6}"]
+}
+
+fn arb_number() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        any::<f64>().prop_map(|x| json!(x)),
+        any::<i64>().prop_map(|x| json!(x)),
+        any::<u64>().prop_map(|x| json!(x)),
+        (-3i64..10).prop_map(|x| json!(x)),
+        Just(json!(1e308)),
+        Just(json!(-0.0)),
+    ]
+}
+
+fn arb_json() -> impl Strategy<Value = Value> {
+    let leaf = prop_oneof![
+        Just(Value::Null),
+        any::<bool>().prop_map(Value::Bool),
+        arb_number(),
+        prop_oneof![Just("inf".to_string()), Just("nan".to_string()), ".{0,12}"].prop_map(Value::String),
+    ];
+    leaf.prop_recursive(4, 48, 6, |inner| {
+        prop_oneof![
+            prop::collection::vec(inner.clone(), 0..6).prop_map(Value::Array),
+            prop::collection::vec((arb_key(), inner), 0..6).prop_map(|kv| Value::Object(kv.into_iter().collect())),
+        ]
+    })
+}
+
+/// Replaces the value at a random path (object keys and array indices, by position) of `doc`;
+/// the path stops early at a leaf or an empty container, whose value is replaced.
+fn replace_at(doc: &mut Value, path: &[usize], new: Value) {
+    let Some((&i, rest)) = path.split_first() else {
+        *doc = new;
+        return;
+    };
+    match doc {
+        Value::Object(o) if !o.is_empty() => {
+            let k = o.keys().nth(i % o.len()).unwrap().clone();
+            replace_at(o.get_mut(&k).unwrap(), rest, new);
+        }
+        Value::Array(a) if !a.is_empty() => {
+            let n = a.len();
+            replace_at(&mut a[i % n], rest, new);
+        }
+        _ => *doc = new,
+    }
+}
+
+/// Text mutations: cut, flip a byte, insert, delete.
+#[derive(Debug, Clone)]
+enum Edit {
+    Cut(usize),
+    Set(usize, u8),
+    Insert(usize, Vec<u8>),
+    Delete(usize, usize),
+}
+
+fn arb_edits() -> impl Strategy<Value = Vec<Edit>> {
+    let edit = prop_oneof![
+        any::<usize>().prop_map(Edit::Cut),
+        (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Edit::Set(i, b)),
+        (any::<usize>(), prop::collection::vec(any::<u8>(), 1..8)).prop_map(|(i, b)| Edit::Insert(i, b)),
+        (any::<usize>(), 1usize..16).prop_map(|(i, n)| Edit::Delete(i, n)),
+    ];
+    prop::collection::vec(edit, 1..4)
+}
+
+fn apply(text: &str, edits: &[Edit]) -> Vec<u8> {
+    let mut b = text.as_bytes().to_vec();
+    for e in edits {
+        let n = b.len().max(1);
+        match e {
+            Edit::Cut(i) => b.truncate(i % n),
+            Edit::Set(i, x) => {
+                if !b.is_empty() {
+                    let k = i % b.len();
+                    b[k] = *x;
+                }
+            }
+            Edit::Insert(i, x) => {
+                let k = i % (b.len() + 1);
+                b.splice(k..k, x.iter().copied());
+            }
+            Edit::Delete(i, len) => {
+                if !b.is_empty() {
+                    let k = i % b.len();
+                    let end = (k + len).min(b.len());
+                    b.drain(k..end);
+                }
+            }
+        }
+    }
+    b
+}
+
+/// A document: free JSON, a valid document with one value replaced, or a valid text edited.
+fn arb_doc(valid: &'static str) -> impl Strategy<Value = String> {
+    let base: Value = serde_json::from_str(valid).unwrap();
+    prop_oneof![
+        1 => arb_json().prop_map(|v| v.to_string()),
+        2 => (prop::collection::vec(any::<usize>(), 1..5), arb_json()).prop_map(move |(path, v)| {
+            let mut d = base.clone();
+            replace_at(&mut d, &path, v);
+            d.to_string()
+        }),
+        2 => arb_edits().prop_map(move |e| String::from_utf8_lossy(&apply(valid, &e)).into_owned()),
+    ]
+}
+
+/// The fast subset uses a fixed seed (the same inputs in every `cargo test`); the full run a
+/// fresh one each time, to explore further.
+fn runner(cases: u32) -> TestRunner {
+    let config = Config { cases, failure_persistence: None, max_shrink_iters: 2000, ..Config::default() };
+    if cases <= FAST_CASES {
+        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha))
+    } else {
+        TestRunner::new(config)
+    }
+}
+
+/// Inputs tried by one target, and how many of them the reader accepted (`Ok`): a share of
+/// accepted inputs shows that the mutations reach past the first checks.
+#[derive(Debug, Clone, Copy)]
+struct Counts {
+    tried: usize,
+    accepted: usize,
+}
+
+/// Runs one target; `f` says whether the input was accepted.
+fn fuzz<S: Strategy>(name: &str, cases: u32, strategy: S, f: impl Fn(S::Value) -> bool) -> Counts
+where
+    S::Value: std::fmt::Debug,
+{
+    let tried = AtomicUsize::new(0);
+    let accepted = AtomicUsize::new(0);
+    let result = runner(cases).run(&strategy, |input| {
+        tried.fetch_add(1, Ordering::Relaxed);
+        if f(input) {
+            accepted.fetch_add(1, Ordering::Relaxed);
+        }
+        Ok(())
+    });
+    if let Err(e) = result {
+        panic!("{name}: {e}");
+    }
+    Counts { tried: tried.into_inner(), accepted: accepted.into_inner() }
+}
+
+fn plant_target(cases: u32) -> Counts {
+    fuzz("plant reader", cases, arb_doc(he1_text()), |text| Plant::from_json_str(&text, "fuzz.json").is_ok())
+}
+
+fn controller_target(cases: u32) -> Counts {
+    fuzz("controller reader", cases, arb_doc(CONTROLLER), |text| match Controller::from_json_str(&text, "k.json") {
+        Ok(k) => {
+            let _ = k.check_fits(he1());
+            true
+        }
+        Err(_) => false,
+    })
+}
+
+/// Campaign text: a template whose values are generated (so counts, ranges and option values
+/// reach the checks), or a valid file edited byte-wise.
+fn arb_campaign() -> impl Strategy<Value = String> {
+    // Mostly valid values (HE1 has n = 4), so that whole files get through, and every kind of
+    // invalid one.
+    let int = prop_oneof![
+        6 => (1i64..4).prop_map(|x| x.to_string()),
+        1 => any::<i64>().prop_map(|x| x.to_string()),
+        1 => (-2i64..12).prop_map(|x| x.to_string()),
+        1 => Just("9223372036854775807".to_string()),
+    ];
+    let float = prop_oneof![
+        8 => (1e-6f64..1.0).prop_map(|x| format!("{x:?}")),
+        1 => any::<f64>().prop_map(|x| format!("{x:?}")),
+        1 => Just("inf".to_string()),
+        1 => Just("nan".to_string()),
+        1 => Just("-1.0".to_string()),
+        1 => Just("1e300".to_string()),
+        1 => Just("1e-20".to_string()),
+    ];
+    let orders = prop_oneof![
+        int.clone(),
+        prop::collection::vec(int.clone(), 0..4).prop_map(|v| format!("[{}]", v.join(", "))),
+        (int.clone(), int.clone()).prop_map(|(a, b)| format!("{{ from = {a}, to = {b} }}")),
+    ];
+    let seeds = prop_oneof![int.clone(), prop::collection::vec(int.clone(), 0..4).prop_map(|v| format!("[{}]", v.join(", ")))];
+    let eps = prop_oneof![float.clone(), prop::collection::vec(float.clone(), 0..3).prop_map(|v| format!("[{}]", v.join(", ")))];
+    let name = prop_oneof![6 => Just("\"ok\"".to_string()), 1 => ".{0,8}".prop_map(|s| format!("{s:?}")), 1 => Just(format!("\"{}\"", "x".repeat(300)))];
+    let option = prop_oneof![
+        float.clone().prop_map(|v| format!("cpumax = {v}")),
+        float.clone().prop_map(|v| format!("hinf_tol = {v}")),
+        float.clone().prop_map(|v| format!("normtol = {v}")),
+        float.clone().prop_map(|v| format!("evaldist = {v}")),
+        int.clone().prop_map(|v| format!("nrand = {v}")),
+        int.clone().prop_map(|v| format!("maxit = {v}")),
+        Just("objective = \"plain\"".to_string()),
+        Just("warm_start = true".to_string()),
+    ];
+    let template = (name, orders, seeds, eps, int.clone(), prop::collection::vec(option, 0..3)).prop_map(
+        |(name, orders, seeds, eps, threads, opts)| {
+            format!(
+                "name = {name}\n[defaults]\nthreads = {threads}\n[[problem]]\nplant = \"HE1\"\norders = {orders}\nseeds = {seeds}\neps = {eps}\n{}\n",
+                opts.join("\n")
+            )
+        },
+    );
+    const GOOD: &str = "name = \"g\"\n[defaults]\neps = [1e-2, 1e-3]\nseeds = 2\ncpumax = 5.0\n[[problem]]\nplant = \"HE1\"\norders = { from = 1, to = 3 }\nwarm_start = true\n";
+    prop_oneof![3 => template, 1 => arb_edits().prop_map(|e| String::from_utf8_lossy(&apply(GOOD, &e)).into_owned())]
+}
+
+fn campaign_target(cases: u32) -> Counts {
+    // Bare plant names resolve in the project's plant library.
+    std::env::set_var(hinfix::lti::PLANTS_ENV, manifest("plants"));
+    fuzz("campaign reader", cases, arb_campaign(), |text| Campaign::from_toml_str(&text, Path::new("fuzz.toml")).is_ok())
+}
+
+fn journal_target(cases: u32) -> Counts {
+    let line = record_line();
+    let base: Value = serde_json::from_str(line).unwrap();
+    let mutated_line = (prop::collection::vec(any::<usize>(), 1..4), arb_json()).prop_map(move |(path, v)| {
+        let mut d = base.clone();
+        replace_at(&mut d, &path, v);
+        d.to_string()
+    });
+    let journal = prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..256),
+        (mutated_line, any::<bool>()).prop_map(move |(l, nl)| format!("{line}\n{l}{}", if nl { "\n" } else { "" }).into_bytes()),
+        arb_edits().prop_map(move |e| apply(&format!("{line}\n{line}\n"), &e)),
+    ];
+    fuzz("journal reader", cases, journal, |bytes| {
+        match parse_journal(&bytes, Path::new("runs.jsonl")) {
+            Ok(read) => {
+                // What was read can be written again and read back.
+                for r in read.records {
+                    let again = serde_json::to_string(&r).unwrap();
+                    serde_json::from_str::<JobRecord>(&again).unwrap();
+                }
+                true
+            }
+            Err(_) => false,
+        }
+    })
+}
+
+#[allow(clippy::needless_update)]
+fn validate_target(cases: u32) -> Counts {
+    // Mostly valid values, so that every check is reached, and every kind of invalid one.
+    let size = prop_oneof![4 => 1usize..4, 1 => Just(0usize), 1 => any::<usize>()];
+    let float = prop_oneof![
+        6 => 1e-12f64..1.0,
+        1 => any::<f64>(),
+        1 => prop_oneof![Just(f64::INFINITY), Just(f64::NAN), Just(0.0), Just(-1.0), Just(1e-15), Just(1e308)],
+    ];
+    let opts = (
+        (size.clone(), float.clone(), any::<u64>(), float.clone(), size.clone()),
+        (any::<bool>(), float.clone(), size.clone(), float.clone(), float.clone(), any::<bool>(), size.clone()),
+    )
+        .prop_map(|((order, eps, seed, cpumax, nrand), (plain, hinf_tol, maxit, normtol, evaldist, gs, gsm))| DesignOptions {
+            order,
+            eps,
+            seed,
+            cpumax,
+            nrand,
+            objective: if plain { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
+            hinf_tol,
+            maxit,
+            normtol,
+            evaldist,
+            gradient_sampling: gs,
+            gradsamp_maxit: gsm,
+            // (options that other issues add keep their defaults)
+            ..DesignOptions::default()
+        });
+    let init = prop::option::weighted(0.3, (0usize..4, 0usize..3, 0usize..3, float.clone()).prop_map(|(nk, m, p, x)| {
+        let mut k = Controller::zeros(nk, m, p);
+        if m > 0 && p > 0 {
+            k.dk[(0, 0)] = x;
+        }
+        k
+    }));
+    fuzz("design::validate", cases, (opts, init), |(o, k)| {
+        validate(he1(), &o, k.as_ref()).is_ok()
+    })
+}
+
+fn all(cases: u32) -> Vec<(&'static str, Counts)> {
+    vec![
+        ("plant reader", plant_target(cases)),
+        ("controller reader", controller_target(cases)),
+        ("campaign reader", campaign_target(cases)),
+        ("journal reader", journal_target(cases)),
+        ("design::validate", validate_target(cases)),
+    ]
+}
+
+#[test]
+fn readers_never_panic_fast_subset() {
+    for (name, c) in all(FAST_CASES) {
+        assert!(c.tried as u32 >= FAST_CASES, "{name}: {c:?}");
+        // Some inputs must get through, or the mutations only test the first check.
+        assert!(c.accepted > 0 && c.accepted < c.tried, "{name}: {c:?}");
+    }
+}
+
+#[test]
+#[ignore = "about a minute in release: cargo test --release --test fuzz_readers -- --ignored --nocapture"]
+fn readers_never_panic_full() {
+    let t = std::time::Instant::now();
+    let counts = all(FULL_CASES);
+    let total: usize = counts.iter().map(|c| c.1.tried).sum();
+    for (name, c) in &counts {
+        eprintln!("fuzz {name:<20} {:>7} inputs ({:>6} accepted, {:>6} clear errors), 0 panics", c.tried, c.accepted, c.tried - c.accepted);
+    }
+    eprintln!("fuzz total {total} inputs, 0 panics, {:.1} s", t.elapsed().as_secs_f64());
+    assert!(total >= 100_000, "{total}");
+}
