@@ -10,6 +10,7 @@ mod freq_response;
 mod full_order;
 mod gradient;
 mod hinf;
+mod level_set_pencil;
 mod matrix_json;
 mod plant;
 mod plant_library;
