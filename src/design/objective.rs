@@ -22,14 +22,14 @@
 //! controller costs almost nothing. Each evaluation stores its components (‖Tzw‖∞, ‖K‖∞, α's) in
 //! a small cache keyed by x, from which [`ObserverAdapter`] reports them per iteration.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::collections::VecDeque;
 use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
     closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    spectral_abscissa, Controller, ControllerGradient, Plant,
+    hinf_lower_bound, spectral_abscissa, Controller, ControllerGradient, Plant,
 };
 use crate::optim::{IterRecord, Objective, Observer, SolverKind};
 
@@ -105,6 +105,9 @@ pub struct DesignObjective<'p> {
     eps: f64,
     hinf_tol: f64,
     cache: Rc<RefCell<ComponentCache>>,
+    /// Peak frequency of ‖Tzw‖∞ at the last finite performance evaluation (NaN: none yet), where
+    /// σmax(Tzw(iω)) gives a line search's trial point a cheap lower bound of f.
+    peak_hint: Cell<f64>,
 }
 
 impl<'p> DesignObjective<'p> {
@@ -119,7 +122,7 @@ impl<'p> DesignObjective<'p> {
         hinf_tol: f64,
         cache: Rc<RefCell<ComponentCache>>,
     ) -> Self {
-        DesignObjective { plant, shape, phase, strong, eps, hinf_tol, cache }
+        DesignObjective { plant, shape, phase, strong, eps, hinf_tol, cache, peak_hint: Cell::new(f64::NAN) }
     }
 
     /// The cache this objective writes to.
@@ -173,7 +176,12 @@ impl<'p> DesignObjective<'p> {
             k_term = (self.eps * norm.value, Some(g));
         }
         let (gamma, g_cl) = match closed_loop_hinf_grad(self.plant, k, self.hinf_tol) {
-            Ok((norm, g)) => (norm.value, Some(g)),
+            Ok((norm, g)) => {
+                if norm.value.is_finite() {
+                    self.peak_hint.set(norm.peak_freq);
+                }
+                (norm.value, Some(g))
+            }
             Err(_) => (f64::INFINITY, None),
         };
         c.hinf_cl = gamma;
@@ -187,6 +195,24 @@ impl<'p> DesignObjective<'p> {
         } else {
             c.f = gamma;
             (c, g_cl)
+        }
+    }
+}
+
+impl DesignObjective<'_> {
+    /// A lower bound of the performance objective at `k` without any eigenvalue computation of
+    /// the closed loop: max(σmax(Tzw(iω)) at ω = ∞ and the last peak frequency, ε‖K‖∞) (‖K‖∞ is
+    /// of the small controller, computed in full). +∞ for an ill-posed loop. Exact: f(k) ≥ it
+    /// whether or not the loop is stable (f = +∞ when it is not).
+    fn performance_lower_bound(&self, k: &Controller) -> f64 {
+        let mut lb = f64::NEG_INFINITY;
+        if self.strong {
+            let (norm, _) = controller_hinf_grad(k, self.hinf_tol);
+            lb = self.eps * norm.value;
+        }
+        match closed_loop(self.plant, k) {
+            Ok(cl) => lb.max(hinf_lower_bound(&cl, &[self.peak_hint.get()])),
+            Err(_) => f64::INFINITY,
         }
     }
 }
@@ -216,6 +242,20 @@ impl Objective for DesignObjective<'_> {
         }
         self.cache.borrow_mut().insert(x, c);
         c.f
+    }
+
+    /// In the performance phase, a trial point whose cheap lower bound
+    /// ([`DesignObjective::performance_lower_bound`]) already reaches `threshold` is rejected
+    /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13).
+    fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
+        if self.phase == ObjectivePhase::Performance {
+            let lb = self.performance_lower_bound(&self.shape.controller(x));
+            if lb >= threshold {
+                g.iter_mut().for_each(|v| *v = f64::NAN);
+                return lb;
+            }
+        }
+        self.eval(x, g)
     }
 }
 

@@ -113,6 +113,23 @@ pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
     }
 }
 
+/// A lower bound of ‖sys‖∞ from a few frequencies: max σmax(G(iω)) over `freqs` and ω = ∞, with
+/// no eigenvalue computation. Valid whether or not the system is stable (the norm of an unstable
+/// system is +∞); +∞ if the data are not finite. One Hessenberg reduction plus O(n²m) per
+/// frequency: the cheap test behind the exact rejection of line-search trial points.
+pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
+    if !sys.is_finite() {
+        return f64::INFINITY;
+    }
+    let mut fr = FreqResponse::new(sys);
+    let mut best = fr.sigma_max(f64::INFINITY);
+    for &w in freqs.iter().filter(|w| !w.is_nan()) {
+        let s = fr.sigma_max(w.abs());
+        best = if s.is_nan() { f64::INFINITY } else { best.max(s) };
+    }
+    best
+}
+
 /// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
 /// test). The data must be finite.
 pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) -> HinfNorm {

@@ -26,7 +26,7 @@ pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
     ControllerGradient,
 };
-pub use hinf::{hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
+pub use hinf::{hinf_lower_bound, hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
