@@ -245,7 +245,8 @@ impl Objective for DesignObjective<'_> {
     }
 
     /// In the performance phase, a trial point whose cheap lower bound
-    /// ([`DesignObjective::performance_lower_bound`]) already reaches `threshold` is rejected
+    /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and at the last peak, ε‖K‖∞) already
+    /// reaches `threshold` is rejected
     /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13).
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
         if self.phase == ObjectivePhase::Performance {
