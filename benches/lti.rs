@@ -7,7 +7,14 @@
 //! * `--dump DIR`: also write the random systems as JSON (`random_n{n}.json`, `damped_n{n}.json`, keys A, B, C, D) so
 //!   that `scripts/ab13dd_bench.py DIR` can time SLICOT's AB13DD on exactly the same data;
 //! * `--quick`: fewer repetitions;
-//! * `--only N`: just the H∞ norm at order N, 200 times (for a profiler).
+//! * `--only N`: just the H∞ norm at order N, 200 times (for a profiler);
+//! * `--design-cpumax S`: CPU budget of each design run of the last table (default 20, as in
+//!   issue 13's `campaign design --order 1 --eps 1e-3 --seed 1 --cpumax 20`); `--no-design`
+//!   skips that table.
+//!
+//! The last table is machine-independent: CPU ms per objective evaluation over a whole design run
+//! (`cpu_s / evals` of the outcome) divided by the CPU time of one dense eigenvalue solve (faer,
+//! values only) of a random matrix of size 2(n + nK), timed in the same process.
 
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -15,7 +22,7 @@ use std::rc::Rc;
 
 use faer::Mat;
 use hinfix::design::objective::ComponentCache;
-use hinfix::design::{controller_to_x, ControllerShape, DesignObjective, ObjectivePhase};
+use hinfix::design::{controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase};
 use hinfix::lti::{hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL};
 use hinfix::optim::{thread_cpu_time, Objective};
 use rand::SeedableRng;
@@ -133,6 +140,45 @@ fn output_free_controller(nk: usize, m: usize, p: usize, gain: f64) -> Controlle
     k
 }
 
+/// CPU seconds of one dense eigenvalue solve (faer `evd_real`, values only) of a random
+/// standard-normal matrix of size `size` (median of `reps`).
+fn dense_eig_seconds(size: usize, reps: usize) -> f64 {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd;
+    let mut rng = ChaCha8Rng::seed_from_u64(size as u64);
+    let a = randn(&mut rng, size, size, 1.0);
+    let par = faer::Par::Seq;
+    let mut mem = MemBuffer::new(evd::evd_scratch::<f64>(size, evd::ComputeEigenvectors::No, evd::ComputeEigenvectors::No, par, Default::default()));
+    let (t, _) = time(reps, || {
+        let mut wr = faer::diag::Diag::<f64>::zeros(size);
+        let mut wi = faer::diag::Diag::<f64>::zeros(size);
+        evd::evd_real(a.as_ref(), wr.as_mut(), wi.as_mut(), None, None, par, MemStack::new(&mut mem), Default::default()).unwrap();
+        wr[0] + wi[0]
+    });
+    t
+}
+
+/// One design run (order `nk`, ε = 1e-3, seed 1, budget `cpumax`): CPU ms per evaluation and its
+/// ratio to one dense eigensolve of size 2(n + nK).
+fn design_ratio(name: &str, nk: usize, cpumax: f64) {
+    let p = plant(name);
+    let size = 2 * (p.dims.n + nk);
+    let eig = dense_eig_seconds(size, if size > 300 { 9 } else { 31 });
+    let opts = DesignOptions { order: nk, eps: 1e-3, seed: 1, cpumax, ..DesignOptions::default() };
+    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let ms = o.cpu_s * 1e3 / o.evals as f64;
+    println!(
+        "{name:<6} n={:<4} nK={nk} γ = {:<12.6} {:>6} evals {:>7.2} s {:>9.3} ms/eval   eig({size}) {:>8.3} ms   ratio {:>6.3}",
+        p.dims.n,
+        o.gamma,
+        o.evals,
+        o.cpu_s,
+        ms,
+        eig * 1e3,
+        ms / (eig * 1e3)
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
@@ -181,4 +227,13 @@ fn main() {
     let cm4 = plant("CM4");
     let d = cm4.dims;
     evals_per_second("CM4", &cm4, &output_free_controller(4, d.m2, d.p2, 1e-2), secs);
+    if args.iter().any(|a| a == "--no-design") {
+        return;
+    }
+    let cpumax: f64 = args.iter().position(|a| a == "--design-cpumax").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok()).unwrap_or(20.0);
+    println!();
+    println!("Design run (order nK, ε = 1e-3, seed 1, cpumax {cpumax} s): ms per evaluation / one dense eig of size 2(n + nK)");
+    for (name, nk) in [("HE1", 1), ("BDT2", 1), ("CM4", 1)] {
+        design_ratio(name, nk, cpumax);
+    }
 }

@@ -11,6 +11,7 @@ pub(crate) mod freq_response;
 mod full_order;
 mod gradient;
 mod hinf;
+mod level_set_pencil;
 pub mod mat_file;
 mod matrix_json;
 mod plant;
@@ -27,7 +28,7 @@ pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
     ControllerGradient,
 };
-pub use hinf::{hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
+pub use hinf::{hinf_lower_bound, hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub(crate) use spectral::eigenvalues as eigenvalues_of;

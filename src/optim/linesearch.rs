@@ -103,7 +103,10 @@ pub(crate) fn weak_wolfe(
         for i in 0..n {
             x[i] = x0[i] + t * d[i];
         }
-        let f = match ev.eval_checked(&x, &mut g) {
+        // A trial is rejected unless f < max(Armijo bound, fvalquit): the objective may prove
+        // f ≥ that bound cheaply instead of computing f (exact, see Objective::eval_below).
+        let threshold = (f0 + p.c1 * t * g0d).max(p.fvalquit);
+        let f = match ev.eval_checked_below(&x, &mut g, threshold) {
             Ok(f) => f,
             Err(reason) => return done(alpha, xa, fa, ga, LsStatus::Stopped(reason)),
         };

@@ -11,6 +11,14 @@ pub trait Objective {
     /// f(x), writing ∇f(x) into `g` (len nvar). Outside the domain return f = +∞ (g: anything,
     /// e.g. NaN). NaN f is treated like +∞ by the line search.
     fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64;
+    /// f(x) at a trial point that is of use only if f(x) < `threshold` (a line search's Armijo
+    /// bound). An objective that can show f(x) ≥ `threshold` more cheaply than computing f may
+    /// instead return any v with `threshold` ≤ v ≤ f(x) and fill `g` with NaN: the caller then
+    /// rejects the point exactly as it would have with the true f. Default: [`Objective::eval`].
+    fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
+        let _ = threshold;
+        self.eval(x, g)
+    }
 }
 
 /// Adapts a closure `FnMut(x, g) -> f` with a fixed dimension into an [`Objective`].
@@ -81,6 +89,16 @@ impl<'a> Evaluator<'a> {
             return Err(t);
         }
         Ok(self.eval(x, g))
+    }
+
+    /// [`Evaluator::eval_checked`] for a point of use only if f < `threshold`
+    /// ([`Objective::eval_below`]).
+    pub(crate) fn eval_checked_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> Result<f64, Termination> {
+        if let Some(t) = self.must_stop() {
+            return Err(t);
+        }
+        self.evals += 1;
+        Ok(self.obj.eval_below(x, g, threshold))
     }
 
     /// Total for the observer.
