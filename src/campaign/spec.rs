@@ -125,6 +125,11 @@ struct RawDefaults {
     evaldist: Option<Spanned<f64>>,
     hinf_tol: Option<Spanned<f64>>,
     gradient_sampling: Option<bool>,
+    maxevals: Option<Spanned<usize>>,
+    stall_starts: Option<Spanned<usize>>,
+    stall_rtol: Option<Spanned<f64>>,
+    max_starts: Option<Spanned<usize>>,
+    hop_scales: Option<Spanned<Vec<f64>>>,
     threads: Option<Spanned<usize>>,
 }
 
@@ -145,6 +150,11 @@ struct RawProblem {
     evaldist: Option<Spanned<f64>>,
     hinf_tol: Option<Spanned<f64>>,
     gradient_sampling: Option<bool>,
+    maxevals: Option<Spanned<usize>>,
+    stall_starts: Option<Spanned<usize>>,
+    stall_rtol: Option<Spanned<f64>>,
+    max_starts: Option<Spanned<usize>>,
+    hop_scales: Option<Spanned<Vec<f64>>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -415,6 +425,34 @@ impl Campaign {
             }
             if let Some(g) = p.gradient_sampling.or(d.gradient_sampling) {
                 base.gradient_sampling = g;
+            }
+            let limits = [
+                (&p.maxevals, &d.maxevals, "maxevals", &mut base.maxevals),
+                (&p.max_starts, &d.max_starts, "max_starts", &mut base.max_starts),
+            ];
+            for (v, dv, name, slot) in limits {
+                if let Some(s) = v.as_ref().or(dv.as_ref()) {
+                    if *s.get_ref() == 0 {
+                        return Err(at(s.span(), format!("{name} must be at least 1 (leave it out for no limit)")));
+                    }
+                    *slot = Some(*s.get_ref());
+                }
+            }
+            if let Some(s) = p.stall_starts.as_ref().or(d.stall_starts.as_ref()) {
+                base.stall_starts = *s.get_ref();
+            }
+            if let Some(s) = p.stall_rtol.as_ref().or(d.stall_rtol.as_ref()) {
+                let x = *s.get_ref();
+                if !(x.is_finite() && x >= 0.0) {
+                    return Err(at(s.span(), format!("stall_rtol must be finite and >= 0, found {x}")));
+                }
+                base.stall_rtol = x;
+            }
+            if let Some(s) = p.hop_scales.as_ref().or(d.hop_scales.as_ref()) {
+                if let Some(bad) = s.get_ref().iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+                    return Err(at(s.span(), format!("every hop scale must be finite and positive, found {bad}")));
+                }
+                base.hop_scales = s.get_ref().clone();
             }
             if let Some(s) = p.nrand.as_ref().or(d.nrand.as_ref()) {
                 if *s.get_ref() == 0 {
