@@ -235,7 +235,7 @@ fn random_plant(seed: u64) -> Plant {
     let n = 4 + (seed as usize * 7) % 17; // 4..=20
     let (m1, p1, m2, p2) = (1 + seed as usize % 2, 1 + (seed as usize / 2) % 2, 1 + (seed as usize / 3) % 2, 1 + (seed as usize / 5) % 2);
     let mut randn = |r: usize, c: usize, s: f64| -> Vec<Vec<f64>> {
-        (0..r).map(|_| (0..c).map(|_| s * StandardNormal.sample(&mut rng) as f64).collect()).collect()
+        (0..r).map(|_| (0..c).map(|_| { let v: f64 = StandardNormal.sample(&mut rng); s * v }).collect()).collect()
     };
     loop {
         // Eigenvalues of A/√n spread over the unit disc: shifted so that a few lie in the right half-plane.
