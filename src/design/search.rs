@@ -18,15 +18,17 @@
 //!    basin-hopping perturbation x* + ξ ∘ (‖x*‖·r) of the best point x* for each r in
 //!    `hop_scales`, then one fresh standard-normal start. x* is the best point of f_h, or of f_s
 //!    while no stable point has been found: stabilisation is restarted, never given up, until a
-//!    budget or the stall rule ends the run.
+//!    budget ends the run (the stall rule applies only once a stable point is known, or when no
+//!    budget — cpumax, maxevals, max_starts — is finite).
 //!
 //! # When it stops
 //! Before each new local search (and within one, between evaluations) the run stops on the CPU
 //! budget `cpumax`, the evaluation budget `maxevals`, a cancel request, or when `max_starts`
 //! local searches were made. The **stall rule**: after the first starts, the search stops once
 //! `stall_starts` consecutive local searches have not lowered the best objective by at least
-//! `stall_rtol`·|best| (f_h once a stable point exists, else f_s, whose improvements count at
-//! least `stall_rtol` in absolute terms near 0). `stall_starts = 0` is HIFOO's search.
+//! `stall_rtol`·|best| (f_h once a stable point exists; before that, f_s, whose improvements count
+//! at least `stall_rtol` in absolute terms near 0, and only if no budget is finite).
+//! `stall_starts = 0` is HIFOO's search.
 //!
 //! # Gradient sampling on the incumbent
 //! If gradient sampling is on, [`GS_RESERVE`] of each budget (CPU and evaluations) is kept for
@@ -302,7 +304,10 @@ impl Search<'_, '_, '_> {
                     stop = Some(SearchStop::Starts);
                     break;
                 }
-                if st.stall >= opts.stall_starts {
+                // Stabilisation is never given up while a budget bounds the run: the stall rule
+                // applies once a stable point is known (or when nothing else would end the run).
+                let bounded = search_ctl.cpumax().is_finite() || opts.maxevals.is_some() || opts.max_starts.is_some();
+                if st.stall >= opts.stall_starts && (st.stabilised || !bounded) {
                     stop = Some(SearchStop::Stall);
                     break;
                 }
