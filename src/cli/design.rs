@@ -48,7 +48,8 @@ pub struct DesignArgs {
     pub nrand: usize,
     /// After the first starts, keep starting local searches (basin hops of the best point and
     /// random starts) until this many in a row have not improved the best objective by
-    /// --stall-rtol, or a budget ends the run. 0: HIFOO's search (the first starts only).
+    /// --stall-rtol, or a budget ends the run. While no stabilising controller is found, only a
+    /// budget ends it. 0: HIFOO's search (the first starts only).
     #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS)]
     pub stall_starts: usize,
     /// Relative improvement that resets the stall count.
