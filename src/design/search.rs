@@ -32,7 +32,7 @@
 //!
 //! # Gradient sampling on the incumbent
 //! If gradient sampling is on, [`GS_RESERVE`] of each budget (CPU and evaluations) is kept for
-//! it: the local searches run under the remaining part, then gradient sampling on f_h runs from
+//! it once a stable point is known: from then on the local searches run under the remaining part, then gradient sampling on f_h runs from
 //! the best point (HANSO 2.0's rule: only if its certificate dnorm > normtol) under the whole
 //! budget, and replaces the best point if it lowers f_h.
 //!
@@ -285,8 +285,11 @@ impl Search<'_, '_, '_> {
         let mut k = 0usize; // local searches made
         let mut gs_fallback_done = false;
         let mut stop = None;
+        let full_ctl = self.ctl;
         while stop.is_none() {
-            if let Some(s) = ctl_stop(&search_ctl) {
+            // The gradient-sampling reserve is kept only once there is a stable point to refine.
+            let search_ctl = if st.stabilised { &search_ctl } else { full_ctl };
+            if let Some(s) = ctl_stop(search_ctl) {
                 stop = Some(s);
                 break;
             }
@@ -295,10 +298,10 @@ impl Search<'_, '_, '_> {
                 break;
             }
             let (s, better) = if k < first.len() {
-                self.local(&mut st, &first[k], k, &search_ctl)?
+                self.local(&mut st, &first[k], k, search_ctl)?
             } else if !st.stabilised && opts.gradient_sampling && !gs_fallback_done {
                 gs_fallback_done = true;
-                self.gs_stabilise(&mut st, k, &search_ctl)?
+                self.gs_stabilise(&mut st, k, search_ctl)?
             } else {
                 if opts.stall_starts == 0 {
                     stop = Some(SearchStop::Starts);
@@ -312,7 +315,7 @@ impl Search<'_, '_, '_> {
                     break;
                 }
                 let x0 = self.next_start(&st, k - first.len() - gs_fallback_done as usize, nvar);
-                self.local(&mut st, &x0, k, &search_ctl)?
+                self.local(&mut st, &x0, k, search_ctl)?
             };
             k += 1;
             st.stall = if better { 0 } else { st.stall + 1 };
