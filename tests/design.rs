@@ -1,11 +1,12 @@
 //! Seeded end-to-end checks of `design::run` on the shipped plants (plants/ is part of the crate,
-//! not ../shared). Each run takes well under a second in the test profile.
+//! not ../shared). Each run takes well under a second in the test profile: runs that do not test
+//! the continued search use HIFOO's (`stall_starts: 0`), the others an evaluation budget.
 
 use std::ops::ControlFlow;
 
 use hinfix::design::{
     controller_to_x, run, DesignError, DesignIterRecord, DesignObserver, DesignOptions, DesignStatus, NoDesignObserver,
-    ObjectiveKind, Phase,
+    ObjectiveKind, Phase, SearchStop,
 };
 use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
 
@@ -33,7 +34,7 @@ fn check_recomputed(p: &Plant, o: &hinfix::design::DesignOutcome) {
 #[test]
 fn rea2_order1_reaches_the_published_gamma() {
     let p = plant("REA2");
-    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, cpumax: 30.0, ..Default::default() };
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, cpumax: 30.0, stall_starts: 0, ..Default::default() };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
     assert!(o.gamma <= 1.134 * 1.01, "γ = {}", o.gamma);
@@ -44,7 +45,7 @@ fn rea2_order1_reaches_the_published_gamma() {
 #[test]
 fn he1_order1_reaches_the_published_gamma() {
     let p = plant("HE1");
-    let opts = DesignOptions { order: 1, eps: 1e-4, seed: 1, cpumax: 30.0, ..Default::default() };
+    let opts = DesignOptions { order: 1, eps: 1e-4, seed: 1, cpumax: 30.0, stall_starts: 0, ..Default::default() };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
     assert!(o.gamma <= 0.1235 * 1.01, "γ = {}", o.gamma);
@@ -71,8 +72,20 @@ fn non_stabilisable() -> Plant {
 fn non_stabilisable_plant_is_an_outcome_not_an_error() {
     let p = non_stabilisable();
     for objective in [ObjectiveKind::Strong, ObjectiveKind::Plain] {
-        let opts = DesignOptions { order: 1, seed: 3, cpumax: 20.0, objective, maxit: 200, gradsamp_maxit: 50, ..Default::default() };
+        // The search restarts the stabilisation, past the stall rule, until a budget stops it.
+        let opts = DesignOptions {
+            order: 1,
+            seed: 3,
+            cpumax: 20.0,
+            objective,
+            maxit: 200,
+            gradsamp_maxit: 50,
+            stall_starts: 2,
+            max_starts: Some(9),
+            ..Default::default()
+        };
         let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+        assert_eq!((o.search.starts, o.search.stop), (9, SearchStop::Starts), "{:?}", o.search);
         match o.status {
             DesignStatus::NotStabilised { best_alpha } => {
                 assert!(best_alpha >= 1.0 - 1e-9, "the uncontrollable mode stays at 1: {best_alpha}")
@@ -89,7 +102,7 @@ fn non_stabilisable_plant_is_an_outcome_not_an_error() {
 #[test]
 fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
     let p = plant("HE1");
-    let base = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: 30.0, ..Default::default() };
+    let base = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: 30.0, stall_starts: 0, ..Default::default() };
     let o1 = run(&p, &base, None, &mut NoDesignObserver).unwrap();
     let k1 = controller(&o1);
     let opts2 = DesignOptions { order: 2, cpumax: 10.0, nrand: 2, ..base.clone() };
@@ -107,7 +120,7 @@ fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
 #[test]
 fn same_seed_gives_the_same_controller_bits() {
     let p = plant("REA2");
-    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: f64::INFINITY, ..Default::default() };
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: f64::INFINITY, max_starts: Some(8), ..Default::default() };
     let a = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     let b = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     let bits = |o: &hinfix::design::DesignOutcome| controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect::<Vec<_>>();
@@ -135,7 +148,7 @@ impl DesignObserver for StopAfter {
 #[test]
 fn observer_sees_components_and_break_interrupts() {
     let p = plant("REA2");
-    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 0, cpumax: 30.0, ..Default::default() };
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 0, cpumax: 30.0, stall_starts: 0, ..Default::default() };
     let mut obs = StopAfter { n: 40, seen: Vec::new() };
     let o = run(&p, &opts, None, &mut obs).unwrap();
     assert_eq!(o.status, DesignStatus::Interrupted);
@@ -164,6 +177,11 @@ fn bad_options_and_init_are_errors() {
         (DesignOptions { nrand: 0, ..ok.clone() }, "nrand"),
         (DesignOptions { order: 5, ..ok.clone() }, "order"),
         (DesignOptions { hinf_tol: 0.0, ..ok.clone() }, "hinf_tol"),
+        (DesignOptions { maxevals: Some(0), ..ok.clone() }, "maxevals"),
+        (DesignOptions { max_starts: Some(0), ..ok.clone() }, "max_starts"),
+        (DesignOptions { stall_rtol: -1.0, ..ok.clone() }, "stall_rtol"),
+        (DesignOptions { hop_scales: vec![0.1, f64::NAN], ..ok.clone() }, "hop_scales"),
+        (DesignOptions { cpumax: f64::INFINITY, stall_rtol: 0.0, ..ok.clone() }, "stall_rtol"),
     ];
     for (opts, field) in cases {
         match run(&p, &opts, None, &mut NoDesignObserver) {
@@ -185,4 +203,67 @@ fn tiny_budget_is_honoured() {
     // one evaluation of HE1 takes well under 10 ms
     assert!(o.cpu_s < 0.05 + 0.1, "cpu {}", o.cpu_s);
     assert!(matches!(o.status, DesignStatus::BudgetExhausted | DesignStatus::NotStabilised { .. }), "{:?}", o.status);
+}
+
+fn bits(o: &hinfix::design::DesignOutcome) -> Vec<u64> {
+    controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect()
+}
+
+/// Reproducibility under an evaluation budget: the same job run on the test thread, and twice at
+/// the same time on two threads while two more threads keep the machine busy, gives the same
+/// controller bit for bit (the CPU budget is far from binding).
+#[test]
+fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
+    let p = plant("HE1");
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 5, cpumax: 1e6, maxevals: Some(4000), ..Default::default() };
+    let alone = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    assert_eq!(alone.search.stop, SearchStop::Maxevals, "{:?}", alone.search);
+    assert!(alone.evals <= 4000 + 2, "{} evaluations", alone.evals);
+    assert!(alone.search.starts > opts.nrand, "{:?}", alone.search);
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let load: Vec<_> = (0..2)
+        .map(|_| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                let mut x = 1.0f64;
+                while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    x = (x * 1.000001).sin() + 1.0;
+                }
+                x
+            })
+        })
+        .collect();
+    let both: Vec<_> = std::thread::scope(|s| {
+        let h: Vec<_> = (0..2).map(|_| s.spawn(|| run(&p, &opts, None, &mut NoDesignObserver).unwrap())).collect();
+        h.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    for l in load {
+        l.join().unwrap();
+    }
+    for o in &both {
+        assert_eq!(bits(o), bits(&alone));
+        assert_eq!((o.evals, o.iters, &o.search.stop, o.search.starts, o.search.best_start),
+                   (alone.evals, alone.iters, &alone.search.stop, alone.search.starts, alone.search.best_start));
+        assert_eq!(o.search.evals_to_best, alone.search.evals_to_best);
+    }
+}
+
+/// The continued search makes the first starts exactly as HIFOO's search does and then more, so
+/// (without the final gradient sampling, which draws from the same generator) it can only be
+/// better; and it records how the search went.
+#[test]
+fn continued_search_is_never_worse_than_the_first_starts_and_is_recorded() {
+    let p = plant("REA2");
+    let base = DesignOptions { order: 2, eps: 1e-3, seed: 4, cpumax: 1e6, gradient_sampling: false, ..Default::default() };
+    let hifoo = run(&p, &DesignOptions { stall_starts: 0, ..base.clone() }, None, &mut NoDesignObserver).unwrap();
+    assert_eq!((hifoo.search.starts, hifoo.search.stop), (3, SearchStop::Starts));
+    let more = run(&p, &DesignOptions { max_starts: Some(15), ..base }, None, &mut NoDesignObserver).unwrap();
+    assert_eq!((more.search.starts, more.search.stop), (15, SearchStop::Starts));
+    assert!(more.objective <= hifoo.objective, "{} > {}", more.objective, hifoo.objective);
+    check_recomputed(&p, &more);
+    let s = &more.search;
+    assert!(s.best_start < 15);
+    assert!(s.evals_to_best >= 1 && s.evals_to_best <= more.evals, "{s:?}");
+    assert!(s.cpu_to_best_s >= 0.0 && s.cpu_to_best_s <= more.cpu_s, "{s:?}");
 }

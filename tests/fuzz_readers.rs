@@ -66,6 +66,13 @@ fn record_line() -> &'static str {
             iters: 10,
             evals: 20,
             cpu_s: 0.5,
+            search: hinfix::design::SearchSummary {
+                starts: 3,
+                best_start: 1,
+                cpu_to_best_s: 0.25,
+                evals_to_best: 12,
+                stop: hinfix::design::SearchStop::Stall,
+            },
         };
         let r = JobRecord::from_run("f", job, false, Ok(out), 1.0, 1.5).unwrap();
         serde_json::to_string(&r).unwrap()

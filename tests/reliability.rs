@@ -66,6 +66,13 @@ fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
         iters: 1,
         evals: 1,
         cpu_s: x,
+        search: hinfix::design::SearchSummary {
+            starts: 1,
+            best_start: 0,
+            cpu_to_best_s: x,
+            evals_to_best: 1,
+            stop: hinfix::design::SearchStop::Stall,
+        },
     }
 }
 

@@ -15,7 +15,7 @@ use sha2::{Digest, Sha256};
 
 use super::jobs::{Job, RunnerTag};
 use super::scheduler::JobRunner;
-use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats};
+use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats, SearchStop, SearchSummary};
 use crate::lti::Controller;
 
 /// The hidden variable that selects the fake runner; its value is the pause between fake
@@ -115,6 +115,7 @@ impl JobRunner for FakeRunner {
             iters,
             evals: iters,
             cpu_s: 0.0,
+            search: SearchSummary { starts: 1, best_start: 0, cpu_to_best_s: 0.0, evals_to_best: iters, stop: SearchStop::Starts },
         })
     }
 }

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::jobs::{Job, JobId, RunnerTag};
 use super::provenance::Provenance;
-use crate::design::{serde_f64_or_string, serde_opt_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats};
+use crate::design::{serde_f64_or_string, serde_opt_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats, SearchSummary};
 
 /// Version of the journal line format. Readers refuse newer versions.
 pub const SCHEMA_VERSION: u32 = 1;
@@ -124,6 +124,10 @@ pub struct JobRecord {
     pub evaluations: usize,
     /// Per-phase counters.
     pub phases: Vec<PhaseStats>,
+    /// The multi-start search: starts made, the best one, CPU time to best, stop reason
+    /// (absent in journals written before it existed, and for failed jobs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub search: Option<SearchSummary>,
     /// CPU seconds as counted by the design run.
     #[serde(with = "serde_f64_or_string")]
     pub design_cpu_s: f64,
@@ -184,6 +188,7 @@ impl JobRecord {
             iterations: 0,
             evaluations: 0,
             phases: Vec::new(),
+            search: None,
             design_cpu_s: 0.0,
             cpu_s,
             wall_s,
@@ -217,6 +222,7 @@ impl JobRecord {
                 r.iterations = out.iters;
                 r.evaluations = out.evals;
                 r.phases = out.phases;
+                r.search = Some(out.search);
                 r.design_cpu_s = out.cpu_s;
                 r.controller = Some(out.controller);
             }
@@ -238,6 +244,9 @@ impl JobRecord {
                         p.remove("cpu_s");
                     }
                 }
+            }
+            if let Some(serde_json::Value::Object(search)) = obj.get_mut("search") {
+                search.remove("cpu_to_best_s");
             }
         }
         v

@@ -139,6 +139,11 @@ struct RawDefaults {
     evaldist: Option<Spanned<f64>>,
     hinf_tol: Option<Spanned<f64>>,
     gradient_sampling: Option<bool>,
+    maxevals: Option<Spanned<usize>>,
+    stall_starts: Option<Spanned<usize>>,
+    stall_rtol: Option<Spanned<f64>>,
+    max_starts: Option<Spanned<usize>>,
+    hop_scales: Option<Spanned<Vec<f64>>>,
     threads: Option<Spanned<usize>>,
 }
 
@@ -159,6 +164,11 @@ struct RawProblem {
     evaldist: Option<Spanned<f64>>,
     hinf_tol: Option<Spanned<f64>>,
     gradient_sampling: Option<bool>,
+    maxevals: Option<Spanned<usize>>,
+    stall_starts: Option<Spanned<usize>>,
+    stall_rtol: Option<Spanned<f64>>,
+    max_starts: Option<Spanned<usize>>,
+    hop_scales: Option<Spanned<Vec<f64>>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -422,6 +432,26 @@ impl Campaign {
             if let Some(g) = p.gradient_sampling.or(d.gradient_sampling) {
                 base.gradient_sampling = g;
             }
+            let maxevals = pick_n(&p.maxevals, &d.maxevals);
+            let max_starts = pick_n(&p.max_starts, &d.max_starts);
+            let stall_starts = pick_n(&p.stall_starts, &d.stall_starts);
+            let stall_rtol = pick(&p.stall_rtol, &d.stall_rtol);
+            let hop_scales = p.hop_scales.as_ref().or(d.hop_scales.as_ref()).map(|s| (s.get_ref().clone(), s.span()));
+            if let Some((x, _)) = &maxevals {
+                base.maxevals = Some(*x);
+            }
+            if let Some((x, _)) = &max_starts {
+                base.max_starts = Some(*x);
+            }
+            if let Some((x, _)) = &stall_starts {
+                base.stall_starts = *x;
+            }
+            if let Some((x, _)) = &stall_rtol {
+                base.stall_rtol = *x;
+            }
+            if let Some((x, _)) = &hop_scales {
+                base.hop_scales = x.clone();
+            }
 
             let plant_arg = p.plant.get_ref().clone();
             let pspan = p.plant.span();
@@ -447,6 +477,11 @@ impl Campaign {
                         "hinf_tol" => hinf_tol.as_ref().map(|c| c.1.clone()),
                         "nrand" => nrand.as_ref().map(|c| c.1.clone()),
                         "maxit" => maxit.as_ref().map(|c| c.1.clone()),
+                        "maxevals" => maxevals.as_ref().map(|c| c.1.clone()),
+                        "max_starts" => max_starts.as_ref().map(|c| c.1.clone()),
+                        "stall_starts" => stall_starts.as_ref().map(|c| c.1.clone()),
+                        "stall_rtol" => stall_rtol.as_ref().map(|c| c.1.clone()),
+                        "hop_scales" => hop_scales.as_ref().map(|c| c.1.clone()),
                         _ => None,
                     };
                     return Err(at(span.unwrap_or(pspan.clone()), err.to_string()));

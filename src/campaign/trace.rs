@@ -4,7 +4,8 @@
 //! `jsonschema`):
 //! * [`ITER_TOPIC`] — one message per optimiser iteration ([`iter_message`]: phase, start,
 //!   iteration, f, ‖Tzw‖∞, ‖K‖∞, α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds);
-//! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled.
+//! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled (with its
+//!   `search` summary: starts, best start, CPU time to best, stop reason).
 //!
 //! Non-finite numbers are written as the strings `"inf"`, `"-inf"` or `"nan"` (JSON has no
 //! such numbers); the schema allows number or string for every float.
@@ -330,6 +331,9 @@ pub struct TraceSummary {
     pub final_status: Option<String>,
     /// Recorded γ of the final result.
     pub final_gamma: Option<f64>,
+    /// The search summary of the final result (starts, best start, CPU time to best, stop
+    /// reason), if the result has one.
+    pub search: Option<crate::design::SearchSummary>,
 }
 
 /// Calls `f(topic, message)` for every message of the trace at `path`, in file order.
@@ -396,6 +400,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
         elapsed_cpu_s: f64::NAN,
         final_status: None,
         final_gamma: None,
+        search: None,
     };
     each_message(path, |topic, v| {
         if topic == ITER_TOPIC {
@@ -428,6 +433,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
         } else if topic == RESULT_TOPIC {
             s.final_status = v["status"]["kind"].as_str().map(str::to_string);
             s.final_gamma = Some(f64_from_json(&v["gamma"]));
+            s.search = serde_json::from_value(v["search"].clone()).ok();
         }
     })?;
     Ok(s)
@@ -446,9 +452,21 @@ impl fmt::Display for TraceSummary {
             writeln!(f, "  {name:<16} {:>6} msgs  f {:.6e} → {:.6e}", p.messages, p.first_f, p.last_f)?;
         }
         match (&self.final_status, self.final_gamma) {
-            (Some(st), Some(g)) => writeln!(f, "  final: {st}  γ = {g:.6}"),
-            (Some(st), None) => writeln!(f, "  final: {st}"),
-            _ => writeln!(f, "  final: none (incomplete trace)"),
+            (Some(st), Some(g)) => writeln!(f, "  final: {st}  γ = {g:.6}")?,
+            (Some(st), None) => writeln!(f, "  final: {st}")?,
+            _ => writeln!(f, "  final: none (incomplete trace)")?,
         }
+        if let Some(s) = &self.search {
+            writeln!(
+                f,
+                "  search: {} starts, best from start {}, CPU to best {:.2} s ({} evaluations), stopped: {}",
+                s.starts,
+                s.best_start,
+                s.cpu_to_best_s,
+                s.evals_to_best,
+                s.stop.name()
+            )?;
+        }
+        Ok(())
     }
 }

@@ -1,4 +1,5 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
+//! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--max-starts N] [--hop-scales 0.01,0.1,1]
 //! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`hinfix::fs_atomic`).
@@ -13,7 +14,9 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use anyhow::Context;
-use hinfix::design::{run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind};
+use hinfix::design::{
+    run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, DEFAULT_STALL_STARTS,
+};
 use hinfix::fs_atomic::write_atomic;
 use hinfix::lti::{resolve_plant, Controller, Plant};
 use hinfix::optim::RunControl;
@@ -36,12 +39,32 @@ pub struct DesignArgs {
     /// Seed of the random starting points.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// CPU-second budget of the whole design, > 0.
+    /// CPU-second budget of the whole design (thread CPU time; a run it ends is not
+    /// reproducible bit for bit).
     #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub cpumax: f64,
-    /// Number of random starts (or of perturbations of --init), 1..=10000.
+    /// Evaluation budget of the whole design (deterministic: same seed, same controller).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub maxevals: Option<u64>,
+    /// Number of first random starts (HIFOO's nrand), or of perturbations of --init, 1..=10000.
     #[arg(long, default_value_t = 3)]
     pub nrand: usize,
+    /// After the first starts, keep starting local searches (basin hops of the best point and
+    /// random starts) until this many in a row have not improved the best objective by
+    /// --stall-rtol, or a budget ends the run. While no stabilising controller is found, only a
+    /// budget ends it. 0: HIFOO's search (the first starts only).
+    #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS)]
+    pub stall_starts: usize,
+    /// Relative improvement that resets the stall count.
+    #[arg(long, value_name = "R", default_value_t = 1e-6, allow_negative_numbers = true)]
+    pub stall_rtol: f64,
+    /// Largest number of local searches (first starts included; deterministic).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_starts: Option<u64>,
+    /// Relative sizes of the basin-hopping perturbations of the best point, comma-separated
+    /// (one hop per size, then one random start, in turn). "none": random starts only.
+    #[arg(long, value_name = "R,R,...", default_value = "0.01,0.1,1")]
+    pub hop_scales: String,
     /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
     #[arg(long)]
     pub init: Option<PathBuf>,
@@ -69,7 +92,12 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         eps: a.eps,
         seed: a.seed,
         cpumax: a.cpumax,
+        maxevals: a.maxevals.map(|n| n as usize),
         nrand: a.nrand,
+        stall_starts: a.stall_starts,
+        stall_rtol: a.stall_rtol,
+        max_starts: a.max_starts.map(|n| n as usize),
+        hop_scales: parse_scales(&a.hop_scales)?,
         objective: if a.no_strong { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
         ..Default::default()
     };
@@ -98,6 +126,19 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         DesignStatus::NotStabilised { .. } => ExitCode::from(EXIT_NOT_STABILISED),
         _ => ExitCode::SUCCESS,
     })
+}
+
+/// `--hop-scales`: comma-separated positive numbers, or "none" (empty).
+fn parse_scales(text: &str) -> anyhow::Result<Vec<f64>> {
+    if text.trim() == "none" || text.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    text.split(',')
+        .map(|t| match t.trim().parse::<f64>() {
+            Ok(r) if r.is_finite() && r > 0.0 => Ok(r),
+            _ => anyhow::bail!("--hop-scales: {t:?} is not a finite positive number"),
+        })
+        .collect()
 }
 
 /// `path` can receive the controller: not a directory, and its `.tmp` sibling can be created
@@ -152,6 +193,15 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
     }
     let per_eval = if o.evals > 0 { o.cpu_s / o.evals as f64 } else { f64::NAN };
     s += &format!("CPU {:.2} s, {} iterations, {} evaluations ({:.3} ms/eval)\n", o.cpu_s, o.iters, o.evals, 1e3 * per_eval);
+    let sr = &o.search;
+    s += &format!(
+        "search: {} local searches, best from start {}, reached after {:.2} CPU s ({} evaluations), stopped: {}\n",
+        sr.starts,
+        sr.best_start,
+        sr.cpu_to_best_s,
+        sr.evals_to_best,
+        sr.stop.name()
+    );
     if let (Some(d), Some(e)) = (o.dnorm, o.evaldist) {
         s += &format!("certificate: dnorm = {d:.2e}, evaldist = {e:.2e}\n");
     }

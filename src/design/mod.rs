@@ -5,8 +5,9 @@
 //! * [`starts`]: seeded random starts, perturbations of an initial controller, warm-start padding;
 //! * [`objective`]: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
 //!   observer adapter;
-//! * `phases`: stabilisation (BFGS per start, fvalquit 0, then gradient sampling) and
-//!   optimisation (HANSO);
+//! * `phases`: the optimiser options of the two phases;
+//! * `search`: the multi-start search (local searches until a budget or the stall rule, basin
+//!   hopping, gradient sampling on the best point);
 //! * [`run`]: the entry point.
 mod float_serde;
 pub mod objective;
@@ -15,11 +16,13 @@ mod outcome;
 pub mod params;
 mod phases;
 mod run;
+mod search;
 pub mod starts;
 
 pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
 pub use objective::{Components, DesignObjective, ObjectivePhase};
-pub use options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
-pub use outcome::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats};
+pub use options::{DesignOptions, ObjectiveKind, DEFAULT_HOP_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND};
+pub use outcome::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary};
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};
+pub use search::{GS_RESERVE, TIME_TO_BEST_RTOL};

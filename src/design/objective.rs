@@ -279,6 +279,25 @@ pub struct ObserverAdapter<'a, 'p> {
     phase: Phase,
     evals_base: usize,
     interrupted: bool,
+    improvements: [Vec<Improvement>; 2],
+}
+
+/// An iterate that lowered the best objective value seen so far (per objective).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Improvement {
+    /// The objective value.
+    pub f: f64,
+    /// CPU seconds since the run started.
+    pub cpu_s: f64,
+    /// Evaluations made in the run so far.
+    pub evals: usize,
+}
+
+fn slot(p: ObjectivePhase) -> usize {
+    match p {
+        ObjectivePhase::Stabilisation => 0,
+        ObjectivePhase::Performance => 1,
+    }
 }
 
 impl<'a, 'p> ObserverAdapter<'a, 'p> {
@@ -287,7 +306,30 @@ impl<'a, 'p> ObserverAdapter<'a, 'p> {
         let o = objective;
         let objective_for_misses =
             DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache());
-        ObserverAdapter { inner, objective_for_misses, phase, evals_base: 0, interrupted: false }
+        ObserverAdapter {
+            inner,
+            objective_for_misses,
+            phase,
+            evals_base: 0,
+            interrupted: false,
+            improvements: [Vec::new(), Vec::new()],
+        }
+    }
+
+    /// Reports the iterations of `objective` as `phase` from now on (one adapter serves a whole
+    /// search, whose local searches alternate between the two objectives).
+    pub fn switch(&mut self, objective: &DesignObjective<'p>, phase: Phase) {
+        let o = objective;
+        self.objective_for_misses =
+            DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache());
+        self.phase = phase;
+    }
+
+    /// The first iterate of objective `phase` whose value was within a relative `rtol` of `f`
+    /// (|f_i − f| ≤ rtol·|f|, or below f): when the value f was first reached.
+    pub fn first_reached(&self, phase: ObjectivePhase, f: f64, rtol: f64) -> Option<Improvement> {
+        let tol = rtol * f.abs();
+        self.improvements[slot(phase)].iter().find(|i| i.f <= f + tol).copied()
     }
 
     /// Sets the number of evaluations made in the run before the next optimiser call.
@@ -310,6 +352,10 @@ impl Observer for ObserverAdapter<'_, '_> {
     fn on_iter(&mut self, rec: &IterRecord<'_>) -> ControlFlow<()> {
         if self.interrupted {
             return ControlFlow::Break(());
+        }
+        let hist = &mut self.improvements[slot(self.objective_for_misses.phase)];
+        if rec.f.is_finite() && hist.last().is_none_or(|last| rec.f < last.f) {
+            hist.push(Improvement { f: rec.f, cpu_s: rec.cpu_s, evals: self.evals_base + rec.evals });
         }
         let wants = self.inner.wants_components();
         let obj = &self.objective_for_misses;

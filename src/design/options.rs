@@ -22,7 +22,14 @@ pub enum ObjectiveKind {
     Plain,
 }
 
-/// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (docs/ALGORITHMS.md §8).
+/// Default of [`DesignOptions::stall_starts`].
+pub const DEFAULT_STALL_STARTS: usize = 60;
+
+/// Default of [`DesignOptions::hop_scales`].
+pub const DEFAULT_HOP_SCALES: [f64; 3] = [1e-2, 1e-1, 1.0];
+
+/// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (docs/ALGORITHMS.md §8), except that
+/// the search goes on after HIFOO's starts (`stall_starts`, `hop_scales`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DesignOptions {
@@ -33,11 +40,38 @@ pub struct DesignOptions {
     pub eps: f64,
     /// Seed of the run's random number generator.
     pub seed: u64,
-    /// CPU-second budget of the whole run (both phases and gradient sampling).
+    /// CPU-second budget of the whole run (both phases and gradient sampling). Thread CPU time:
+    /// a run stopped by it is not reproducible bit for bit (it depends on the machine's speed).
     #[serde(with = "serde_f64_or_string")]
     pub cpumax: f64,
-    /// Number of random starting points (HIFOO `nrand`, default 3).
+    /// Evaluation budget of the whole run (objective evaluations, both phases and gradient
+    /// sampling); `None`: no limit. Deterministic: the same job stops at the same evaluation on
+    /// any machine and under any load.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub maxevals: Option<usize>,
+    /// Number of random starting points (HIFOO `nrand`, default 3), or of perturbations of an
+    /// initial controller. These starts are always made (unless a budget ends the run first).
     pub nrand: usize,
+    /// Stall rule of the continued search (see [`crate::design`], "Search"): after the first
+    /// starts, new local searches are started until `stall_starts` consecutive ones have not
+    /// improved the best objective by a relative `stall_rtol` (or a budget ends the run).
+    /// 0 = HIFOO 3.5's search: only the first starts. (Missing in a serialised record: 0, the
+    /// behaviour before this option existed.)
+    #[serde(default)]
+    pub stall_starts: usize,
+    /// Relative improvement of the best objective that resets the stall count (see
+    /// `stall_starts`).
+    #[serde(with = "serde_f64_or_string")]
+    pub stall_rtol: f64,
+    /// Largest number of local searches (first starts included); `None`: no limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_starts: Option<usize>,
+    /// Relative sizes r of the basin-hopping perturbations x* + ξ ∘ (‖x*‖·r), ξ ~ N(0, I), of the
+    /// best point x* (the same form as the perturbations of an initial controller). The
+    /// continued search cycles through one perturbation per size, then one fresh random start.
+    /// Empty: random starts only. (Missing in a serialised record: empty.)
+    #[serde(default)]
+    pub hop_scales: Vec<f64>,
     /// Strong stabilisation or plain H∞.
     pub objective: ObjectiveKind,
     /// Relative tolerance of the H∞ norm computation.
@@ -65,7 +99,12 @@ impl Default for DesignOptions {
             eps: 1e-3,
             seed: 0,
             cpumax: 60.0,
+            maxevals: None,
             nrand: 3,
+            stall_starts: DEFAULT_STALL_STARTS,
+            stall_rtol: 1e-6,
+            max_starts: None,
+            hop_scales: DEFAULT_HOP_SCALES.to_vec(),
             objective: ObjectiveKind::Strong,
             hinf_tol: 1e-10,
             maxit: 1000,

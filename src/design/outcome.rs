@@ -58,6 +58,56 @@ pub struct PhaseStats {
     pub cpu_s: f64,
 }
 
+/// Why the search stopped starting new local searches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SearchStop {
+    /// The CPU budget (`cpumax`) ran out (not reproducible bit for bit).
+    Budget,
+    /// The evaluation budget (`maxevals`) ran out.
+    Maxevals,
+    /// The stall rule: `stall_starts` consecutive local searches without a relative improvement
+    /// of `stall_rtol`.
+    Stall,
+    /// The fixed number of starts was made (`max_starts`, or the first starts with
+    /// `stall_starts = 0`).
+    Starts,
+    /// Cancelled or stopped by the observer.
+    Interrupted,
+}
+
+impl SearchStop {
+    /// The name used in journals and traces.
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchStop::Budget => "budget",
+            SearchStop::Maxevals => "maxevals",
+            SearchStop::Stall => "stall",
+            SearchStop::Starts => "starts",
+            SearchStop::Interrupted => "interrupted",
+        }
+    }
+}
+
+/// How the multi-start search went.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SearchSummary {
+    /// Local searches started (the first starts included).
+    pub starts: usize,
+    /// Index (0-based, in the order started) of the local search that produced the returned
+    /// controller.
+    pub best_start: usize,
+    /// CPU seconds from the start of the run until the returned objective value was first
+    /// reached within a relative 1e-6 (the final objective of a not-stabilised run: its best
+    /// abscissa).
+    #[serde(with = "serde_f64_or_string")]
+    pub cpu_to_best_s: f64,
+    /// Evaluations made until then.
+    pub evals_to_best: usize,
+    /// Why no further local search was started.
+    pub stop: SearchStop,
+}
+
 /// The result of [`crate::design::run`]. Every figure is recomputed from `controller`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct DesignOutcome {
@@ -100,6 +150,8 @@ pub struct DesignOutcome {
     /// Total CPU seconds of the run.
     #[serde(with = "serde_f64_or_string")]
     pub cpu_s: f64,
+    /// The multi-start search: starts made, the best one, time to best, stop reason.
+    pub search: SearchSummary,
 }
 
 /// One iteration as seen by a design observer (the campaign's trace writer).

@@ -10,22 +10,25 @@ use rand_chacha::ChaCha8Rng;
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL,
 };
-use crate::optim::{RunControl, Termination};
+use crate::optim::RunControl;
 
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
-use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase};
+use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase, SearchStop};
 use super::params::{controller_to_x, ControllerShape};
-use super::phases::{optimise, stabilise};
+use super::search::Search;
 use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
 
 /// Designs a controller of order `opts.order` for `plant` (HIFOO, strong stabilisation unless
-/// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds.
+/// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds and
+/// `opts.maxevals` evaluations.
 ///
 /// `init` (optional) is a starting controller of order ≤ `opts.order`; a lower order is padded
 /// with decoupled stable modes (docs/ALGORITHMS.md §8.2), and it is used together with `opts.nrand`
 /// relative perturbations of itself. Without `init`, `opts.nrand` standard-normal starts are drawn
-/// from a ChaCha8 generator seeded with `opts.seed`.
+/// from a ChaCha8 generator seeded with `opts.seed`. After these starts the search goes on
+/// (basin hopping and fresh random starts) until a budget or the stall rule ends it
+/// ([`super::search`]).
 ///
 /// Failing to stabilise is an outcome ([`DesignStatus::NotStabilised`]), not an error; `Err` is
 /// for invalid options or an initial controller that does not fit. γ, ‖K‖∞ and the abscissas of
@@ -71,6 +74,21 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     }
     if !(1..=MAX_NRAND).contains(&opts.nrand) {
         return Err(opt_err("nrand", format!("must be in 1..={MAX_NRAND}, got {}", opts.nrand)));
+    }
+    if opts.maxevals == Some(0) {
+        return Err(opt_err("maxevals", "must be at least 1 (omit it for no limit)"));
+    }
+    if opts.max_starts == Some(0) {
+        return Err(opt_err("max_starts", "must be at least 1 (omit it for no limit)"));
+    }
+    if !(opts.stall_rtol.is_finite() && opts.stall_rtol >= 0.0) {
+        return Err(opt_err("stall_rtol", format!("must be finite and >= 0, got {}", opts.stall_rtol)));
+    }
+    if let Some(bad) = opts.hop_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+        return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
+    }
+    if opts.stall_starts > 0 && !opts.cpumax.is_finite() && opts.maxevals.is_none() && opts.max_starts.is_none() && opts.stall_rtol == 0.0 {
+        return Err(opt_err("stall_rtol", "must be > 0 when no budget (cpumax, maxevals, max_starts) bounds the search"));
     }
     if opts.order > plant.dims.n {
         return Err(opt_err(
@@ -170,64 +188,40 @@ fn run_validated(
 ) -> Result<DesignOutcome, DesignError> {
     let shape = ControllerShape { nk: opts.order, m: plant.dims.m2, p: plant.dims.p2 };
     let strong = opts.objective == ObjectiveKind::Strong;
+    let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let starts = starting_points(plant, opts, init, shape, &mut rng);
+    let first = starting_points(plant, opts, init, shape, &mut rng);
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
-
-    // Phase 1: stabilisation.
     let mut stab_obj =
         DesignObjective::new(plant, shape, ObjectivePhase::Stabilisation, strong, opts.eps, opts.hinf_tol, Rc::clone(&cache));
+    let mut perf_obj = DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
-    let stab = stabilise(&mut stab_obj, &starts, opts, &mut rng, ctl, &mut adapter, 0)?;
-    let mut interrupted = adapter.interrupted() || ctl.cancelled() || stab.stopped == Some(Termination::Interrupted);
-    let obs = adapter.into_inner();
-    let mut phases = vec![stab.stats.clone()];
-    let mut evals = stab.stats.evals;
+    let res = Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
+        .run(opts, &first, shape.nvar())?;
+    let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
 
-    let mut final_x = stab.best_x.clone();
-    let mut certificate = (None, None);
-    let status;
-    if stab.stable.is_empty() {
-        status = if interrupted { DesignStatus::Interrupted } else { DesignStatus::NotStabilised { best_alpha: stab.best_f } };
-    } else if interrupted {
-        status = DesignStatus::Interrupted;
+    let (final_x, certificate) = match &res.perf {
+        Some(b) => (b.x.clone(), (Some(b.dnorm), Some(b.evaldist))),
+        None => (res.stab.x.clone(), (None, None)),
+    };
+    let status = if interrupted {
+        DesignStatus::Interrupted
+    } else if !res.stabilised {
+        DesignStatus::NotStabilised { best_alpha: res.stab.f }
+    } else if res.truncated {
+        DesignStatus::BudgetExhausted
+    } else if res.perf.as_ref().is_none_or(|b| b.x == b.from) {
+        DesignStatus::StabilisedOnly
+    } else if res.perf.as_ref().is_some_and(|b| b.dnorm <= opts.normtol) {
+        DesignStatus::Converged
     } else {
-        // Phase 2: optimisation from every stable point.
-        let mut perf_obj =
-            DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
-        let mut adapter = ObserverAdapter::new(obs, &perf_obj, Phase::Optimisation);
-        let opt = optimise(&mut perf_obj, &stab.stable, opts, &mut rng, ctl, &mut adapter, evals)?;
-        interrupted = adapter.interrupted() || ctl.cancelled() || opt.stopped == Some(Termination::Interrupted);
-        phases.push(opt.bfgs_stats.clone());
-        evals += opt.bfgs_stats.evals;
-        if let Some(gs) = &opt.gs_stats {
-            phases.push(gs.clone());
-            evals += gs.evals;
-        }
-        let budget = stab.stopped == Some(Termination::CpuBudget) || opt.stopped == Some(Termination::CpuBudget);
-        match &opt.best {
-            Some(best) => {
-                final_x = best.x.clone();
-                certificate = (Some(best.dnorm), Some(best.evaldist));
-            }
-            None => final_x = stab.stable[0].clone(),
-        }
-        status = if interrupted {
-            DesignStatus::Interrupted
-        } else if budget {
-            DesignStatus::BudgetExhausted
-        } else if opt.best.is_none() || !opt.progress {
-            DesignStatus::StabilisedOnly
-        } else if opt.best.as_ref().is_some_and(|b| b.dnorm <= opts.normtol) {
-            DesignStatus::Converged
-        } else {
-            DesignStatus::Stopped
-        };
-    }
+        DesignStatus::Stopped
+    };
 
     let k = shape.controller(&final_x);
     let fig = figures(plant, opts, &k);
-    let iters = phases.iter().map(|p| p.iters).sum();
+    let iters = res.phases.iter().map(|p| p.iters).sum();
+    let evals = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {
         status,
         controller: k.to_json(),
@@ -239,9 +233,10 @@ fn run_validated(
         controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
         dnorm: certificate.0,
         evaldist: certificate.1,
-        phases,
+        phases: res.phases,
         iters,
         evals,
         cpu_s: ctl.cpu_elapsed(),
+        search: res.summary,
     })
 }

@@ -43,27 +43,29 @@ pub fn logspace(a: f64, b: f64, n: usize) -> Vec<f64> {
     }
 }
 
-/// `nrand` standard-normal starting points in ℝ^nvar.
-pub fn random_starts(nvar: usize, nrand: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
-    (0..nrand).map(|_| (0..nvar).map(|_| StandardNormal.sample(&mut *rng)).collect()).collect()
+/// `nrand` standard-normal starting points in ℝ^nvar (one implementation, shared with the
+/// optimiser's multi-start driver).
+pub use crate::optim::random_starts;
+
+/// One relative perturbation x + ξ ∘ (‖x‖ · r), ξ ~ N(0, I) (also the search's basin hops).
+/// For x = 0 the perturbation is absolute, ξ·r, so that a zero point can still move.
+pub fn perturb(x: &[f64], r: f64, rng: &mut dyn RngCore) -> Vec<f64> {
+    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let scale = if norm > 0.0 { norm * r } else { r };
+    x.iter()
+        .map(|&v| {
+            let xi: f64 = StandardNormal.sample(&mut *rng);
+            v + xi * scale
+        })
+        .collect()
 }
 
 /// x_init followed by `nrand` relative perturbations x_init + ξ ∘ (‖x_init‖ · r_i),
 /// r = logspace(−3, −1, nrand).
 pub fn perturbed_starts(x_init: &[f64], nrand: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
-    let norm = x_init.iter().map(|v| v * v).sum::<f64>().sqrt();
     let mut out = vec![x_init.to_vec()];
     for r in logspace(PERTURB_LOG10_RANGE.0, PERTURB_LOG10_RANGE.1, nrand) {
-        let scale = norm * r;
-        out.push(
-            x_init
-                .iter()
-                .map(|&v| {
-                    let xi: f64 = StandardNormal.sample(&mut *rng);
-                    v + xi * scale
-                })
-                .collect(),
-        );
+        out.push(perturb(x_init, r, rng));
     }
     out
 }

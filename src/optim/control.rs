@@ -6,8 +6,13 @@
 //! The solvers check [`RunControl::cpu_exhausted`] and [`RunControl::cancelled`] between objective
 //! evaluations (also inside line searches and sampling loops), so the budget is honoured to
 //! within one evaluation.
+//!
+//! An optional **evaluation budget** (`maxevals`, [`RunControl::with_maxevals`]) counts objective
+//! evaluations over the whole run (every solver call made with this control or a clone of it
+//! shares one counter). Unlike CPU time it does not depend on the machine or its load, so a run
+//! stopped by it is reproducible bit for bit.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// CPU seconds used so far by the calling thread: `clock_gettime(CLOCK_THREAD_CPUTIME_ID)`.
@@ -32,12 +37,16 @@ pub fn thread_cpu_time() -> f64 {
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
-/// Shared budget (CPU seconds of this thread since [`RunControl::new`]) and an optional cancel flag.
+/// Shared budget (CPU seconds of this thread since [`RunControl::new`], and optionally a number
+/// of objective evaluations) and an optional cancel flag. Clones share the clock, the evaluation
+/// counter and the cancel flag.
 #[derive(Debug, Clone)]
 pub struct RunControl {
     start_cpu: f64,
     cpumax: f64,
     cancel: Option<Arc<AtomicBool>>,
+    evals: Arc<AtomicUsize>,
+    maxevals: Option<usize>,
 }
 
 impl RunControl {
@@ -45,7 +54,46 @@ impl RunControl {
     /// (NaN or negative values are treated as 0, i.e. already exhausted).
     pub fn new(cpumax: f64) -> Self {
         let cpumax = if cpumax.is_nan() { 0.0 } else { cpumax.max(0.0) };
-        RunControl { start_cpu: thread_cpu_time(), cpumax, cancel: None }
+        RunControl { start_cpu: thread_cpu_time(), cpumax, cancel: None, evals: Arc::default(), maxevals: None }
+    }
+
+    /// Set an evaluation budget: once [`Self::evals`] ≥ `maxevals`, the run stops with
+    /// `Termination::EvalBudget` before the next evaluation (`None`: no limit).
+    pub fn with_maxevals(mut self, maxevals: Option<usize>) -> Self {
+        self.maxevals = maxevals;
+        self
+    }
+
+    /// A control with smaller limits on the same clock, counter and cancel flag: CPU budget
+    /// `cpu_fraction · cpumax`, evaluation budget `⌊evals_fraction · maxevals⌋` (fractions in
+    /// [0, 1]). Used to keep part of a budget for a final stage.
+    pub fn sub_budget(&self, cpu_fraction: f64, evals_fraction: f64) -> RunControl {
+        let mut c = self.clone();
+        if c.cpumax.is_finite() {
+            c.cpumax *= cpu_fraction.clamp(0.0, 1.0);
+        }
+        c.maxevals = c.maxevals.map(|m| (m as f64 * evals_fraction.clamp(0.0, 1.0)).floor() as usize);
+        c
+    }
+
+    /// Counts one objective evaluation (called by the solvers' evaluator).
+    pub fn count_eval(&self) {
+        self.evals.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Objective evaluations counted so far.
+    pub fn evals(&self) -> usize {
+        self.evals.load(Ordering::Relaxed)
+    }
+
+    /// The evaluation budget, if any.
+    pub fn maxevals(&self) -> Option<usize> {
+        self.maxevals
+    }
+
+    /// True once the evaluation budget (if any) is spent.
+    pub fn evals_exhausted(&self) -> bool {
+        self.maxevals.is_some_and(|m| self.evals() >= m)
     }
 
     /// Attach a cancel flag: once it is set, the run stops with `Termination::Interrupted`

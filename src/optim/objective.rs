@@ -69,6 +69,7 @@ impl<'a> Evaluator<'a> {
     /// Evaluate without any budget check (used for the starting point).
     pub(crate) fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
         self.evals += 1;
+        self.ctl.count_eval();
         self.obj.eval(x, g)
     }
 
@@ -78,6 +79,8 @@ impl<'a> Evaluator<'a> {
             Some(Termination::Interrupted)
         } else if self.ctl.cpu_exhausted() {
             Some(Termination::CpuBudget)
+        } else if self.ctl.evals_exhausted() {
+            Some(Termination::EvalBudget)
         } else {
             None
         }

@@ -101,6 +101,8 @@ pub(crate) fn run<S: Solver>(
             Some(t)
         } else if ctl.cpu_exhausted() {
             Some(Termination::CpuBudget)
+        } else if ctl.evals_exhausted() {
+            Some(Termination::EvalBudget)
         } else if iter >= lim.maxit {
             Some(Termination::MaxIters)
         } else if flow == ControlFlow::Break(()) || ctl.cancelled() {

@@ -19,6 +19,8 @@ pub enum Termination {
     XNormExceeded,
     /// The CPU budget of the [`RunControl`](super::RunControl) is spent (info 4).
     CpuBudget,
+    /// The evaluation budget (`maxevals`) of the [`RunControl`](super::RunControl) is spent.
+    EvalBudget,
     /// f or ∇f not finite at the start (info 5); only seen in `NotRun` reasons and results of
     /// the multi-start driver, the solvers themselves return `Err(NonFiniteStart)`.
     NonFiniteStart,
@@ -44,6 +46,7 @@ impl Termination {
             Termination::TargetReached => "f dropped below fvalquit",
             Termination::XNormExceeded => "norm of x exceeded xnormquit",
             Termination::CpuBudget => "CPU time budget exhausted",
+            Termination::EvalBudget => "evaluation budget (maxevals) exhausted",
             Termination::NonFiniteStart => "f or its gradient is not finite at the starting point",
             Termination::NotDescent => "search direction is not a descent direction",
             Termination::LineSearchFailed => "line search bracketed a step but could not satisfy the Wolfe conditions",
@@ -65,7 +68,7 @@ impl Termination {
             Termination::NotDescent => Some(6),
             Termination::LineSearchFailed => Some(7),
             Termination::Unbounded => Some(8),
-            Termination::Interrupted | Termination::GradSampConverged => None,
+            Termination::Interrupted | Termination::GradSampConverged | Termination::EvalBudget => None,
         }
     }
 
@@ -74,6 +77,7 @@ impl Termination {
         matches!(
             self,
             Termination::CpuBudget
+                | Termination::EvalBudget
                 | Termination::Interrupted
                 | Termination::TargetReached
                 | Termination::XNormExceeded

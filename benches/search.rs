@@ -1,0 +1,308 @@
+//! The budget-spending search against the paper's published HIFOO values, and against HIFOO's own
+//! search on random plants (NOT CI; long: up to ~80 CPU minutes with every part).
+//!
+//! ```text
+//! cargo bench --bench search -- [--parts paper,singles,random] [--threads 2] [--cpumax 60]
+//!                               [--eps 1e-2,1e-3] [--seed 1] [--plants HE1,REA2,AC8,Enns]
+//!                               [--single-cpumax 300] [--random 12] [--random-cpumax 20]
+//! ```
+//!
+//! * `paper`: one job per (plant, order of the paper's tables, ε), seed 1, `--cpumax` CPU s each,
+//!   the project's default search. Per order: the best γ over the ε values whose controller is
+//!   re-verified (closed loop and controller stable, γ recomputed from the controller), against
+//!   the published value; the target is γ ≤ paper·(1 + 1e-3).
+//! * `singles`: one job each of `--single-cpumax` CPU s (ε = 1e-3, seed 1): Enns n_K = 4
+//!   (target 1.1682), AC10 n_K = 1 (stabilised, ≤ 10.874), BDT2 n_K = 1 (≤ 0.6436).
+//! * `random`: `--random` random open-loop-unstable plants (n = 4…20, seeded), n_K = 1 and 2,
+//!   ε = 1e-3, seed 1: HIFOO's search (`stall_starts = 0`) against the default search, both
+//!   with `--random-cpumax` CPU s. Counts the entries where the new search is at or below the
+//!   old one and where it is better by more than 1 %.
+//!
+//! Jobs run on `--threads` worker threads; budgets are thread CPU time, so a busy machine slows
+//! the wall clock, not the result.
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
+use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver};
+use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+struct Args {
+    parts: Vec<String>,
+    threads: usize,
+    cpumax: f64,
+    eps: Vec<f64>,
+    seed: u64,
+    plants: Vec<String>,
+    single_cpumax: f64,
+    random: usize,
+    random_cpumax: f64,
+}
+
+fn parse_args() -> Args {
+    let mut a = Args {
+        parts: ["paper", "singles", "random"].map(String::from).to_vec(),
+        threads: 2,
+        cpumax: 60.0,
+        eps: vec![1e-2, 1e-3],
+        seed: 1,
+        plants: ["HE1", "REA2", "AC8", "Enns"].map(String::from).to_vec(),
+        single_cpumax: 300.0,
+        random: 12,
+        random_cpumax: 20.0,
+    };
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let list = |s: &str| s.split(',').filter(|x| !x.is_empty()).map(String::from).collect::<Vec<_>>();
+    let mut i = 0;
+    while i < args.len() {
+        let val = args.get(i + 1).cloned().unwrap_or_default();
+        match args[i].as_str() {
+            "--bench" => {
+                i += 1;
+                continue;
+            }
+            "--parts" => a.parts = list(&val),
+            "--threads" => a.threads = val.parse().expect("--threads N"),
+            "--cpumax" => a.cpumax = val.parse().expect("--cpumax S"),
+            "--eps" => a.eps = list(&val).iter().map(|s| s.parse().expect("--eps list")).collect(),
+            "--seed" => a.seed = val.parse().expect("--seed N"),
+            "--plants" => a.plants = list(&val),
+            "--single-cpumax" => a.single_cpumax = val.parse().expect("--single-cpumax S"),
+            "--random" => a.random = val.parse().expect("--random N"),
+            "--random-cpumax" => a.random_cpumax = val.parse().expect("--random-cpumax S"),
+            other => panic!("unknown argument {other}"),
+        }
+        i += 2;
+    }
+    a
+}
+
+fn load(name: &str) -> Plant {
+    Plant::load(format!("{}/plants/{name}.json", env!("CARGO_MANIFEST_DIR"))).expect("shipped plant")
+}
+
+/// γ recomputed from the controller if the closed loop and the controller are stable.
+fn verified_gamma(p: &Plant, o: &DesignOutcome) -> Option<f64> {
+    if matches!(o.status, DesignStatus::NotStabilised { .. }) {
+        return None;
+    }
+    let k = Controller::from_json_value(&o.controller).ok()?;
+    let cl = closed_loop(p, &k).ok()?;
+    let k_stable = k.order() == 0 || spectral_abscissa(k.ak.as_ref()) < 0.0;
+    (spectral_abscissa(cl.a.as_ref()) < 0.0 && k_stable).then(|| hinf_norm(&cl, DEFAULT_HINF_TOL).value)
+}
+
+/// One design job of the bench.
+struct Job {
+    tag: String,
+    plant: std::sync::Arc<Plant>,
+    opts: DesignOptions,
+}
+
+/// Runs `jobs` on `threads` worker threads; prints one line per finished job.
+fn run_all(jobs: Vec<Job>, threads: usize) -> Vec<(Job, DesignOutcome)> {
+    let next = AtomicUsize::new(0);
+    let out = Mutex::new(Vec::new());
+    let n = jobs.len();
+    std::thread::scope(|s| {
+        for _ in 0..threads.max(1) {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some(job) = jobs.get(i) else { break };
+                let o = run(&job.plant, &job.opts, None, &mut NoDesignObserver).expect("valid options");
+                eprintln!(
+                    "  [{:>3}/{n}] {:<28} γ {:>10.5}  {:>4} starts  best #{:<4} to best {:>6.1} s of {:>6.1} s  stop {}",
+                    i + 1,
+                    job.tag,
+                    o.gamma,
+                    o.search.starts,
+                    o.search.best_start,
+                    o.search.cpu_to_best_s,
+                    o.cpu_s,
+                    o.search.stop.name()
+                );
+                out.lock().unwrap().push((i, o));
+            });
+        }
+    });
+    let mut res = out.into_inner().unwrap();
+    res.sort_by_key(|r| r.0);
+    let mut jobs: Vec<Option<Job>> = jobs.into_iter().map(Some).collect();
+    res.into_iter().map(|(i, o)| (jobs[i].take().unwrap(), o)).collect()
+}
+
+fn paper(a: &Args) {
+    let refs = load_reference(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(REFERENCE_CSV)).expect("reference CSV");
+    let mut jobs = Vec::new();
+    let mut entries = Vec::new();
+    for name in &a.plants {
+        let p = std::sync::Arc::new(load(name));
+        let mut rows: Vec<_> = refs.iter().filter(|r| r.plant == *name && r.method == RefMethod::Hifoo).collect();
+        rows.sort_by_key(|r| r.order);
+        for r in rows {
+            entries.push((name.clone(), r.order, r.gamma));
+            for &eps in &a.eps {
+                let opts = DesignOptions { order: r.order, eps, seed: a.seed, cpumax: a.cpumax, ..Default::default() };
+                jobs.push(Job { tag: format!("{name} nk={} eps={eps:e}", r.order), plant: p.clone(), opts });
+            }
+        }
+    }
+    println!("# paper: seed {}, eps {:?}, {} CPU s per job, {} jobs on {} threads", a.seed, a.eps, a.cpumax, jobs.len(), a.threads);
+    let wall = Instant::now();
+    let done = run_all(jobs, a.threads);
+    println!(
+        "{:<5} {:>2} {:>9} {:>10} {:>9} {:>6} {:>7} {:>6} {:>6} {:>8} {:>8} {:<8}",
+        "plant", "nk", "published", "best γ", "ratio", "≤+1e-3", "ε", "starts", "best#", "to best", "cpu s", "stop"
+    );
+    let (mut ok_count, mut cpu_total) = (0, 0.0);
+    for (name, order, published) in &entries {
+        let mine: Vec<_> = done.iter().filter(|(j, _)| j.plant.name == *name && j.opts.order == *order).collect();
+        cpu_total += mine.iter().map(|(_, o)| o.cpu_s).sum::<f64>();
+        let best = mine
+            .iter()
+            .filter_map(|(j, o)| verified_gamma(&j.plant, o).map(|g| (g, j, o)))
+            .min_by(|x, y| x.0.total_cmp(&y.0));
+        match best {
+            Some((g, j, o)) => {
+                let ok = g <= published * (1.0 + 1e-3);
+                ok_count += ok as usize;
+                println!(
+                    "{:<5} {:>2} {:>9.4} {:>10.5} {:>9.5} {:>6} {:>7.0e} {:>6} {:>6} {:>8.1} {:>8.1} {:<8}",
+                    name,
+                    order,
+                    published,
+                    g,
+                    g / published,
+                    if ok { "yes" } else { "NO" },
+                    j.opts.eps,
+                    o.search.starts,
+                    o.search.best_start,
+                    o.search.cpu_to_best_s,
+                    o.cpu_s,
+                    o.search.stop.name()
+                );
+            }
+            None => println!("{name:<5} {order:>2} {published:>9.4} {:>10} {:>9} {:>6}", "none", "-", "NO"),
+        }
+    }
+    println!(
+        "# paper: {ok_count}/{} entries ≤ paper·(1+1e-3); {:.0} CPU s in all, {:.0} s wall",
+        entries.len(),
+        cpu_total,
+        wall.elapsed().as_secs_f64()
+    );
+}
+
+fn singles(a: &Args) {
+    let cases = [("Enns", 4usize, 1.1682), ("AC10", 1, 10.874), ("BDT2", 1, 0.6436)];
+    let jobs: Vec<Job> = cases
+        .iter()
+        .map(|&(name, order, _)| Job {
+            tag: format!("{name} nk={order}"),
+            plant: std::sync::Arc::new(load(name)),
+            opts: DesignOptions { order, eps: 1e-3, seed: 1, cpumax: a.single_cpumax, ..Default::default() },
+        })
+        .collect();
+    println!("# singles: ε = 1e-3, seed 1, {} CPU s each", a.single_cpumax);
+    let done = run_all(jobs, a.threads);
+    for ((j, o), (_, _, target)) in done.iter().zip(cases) {
+        let g = verified_gamma(&j.plant, o);
+        let ok = g.is_some_and(|g| g <= target);
+        println!(
+            "{:<14} target ≤ {:<8} verified γ {:<12} {}  ({} starts, best #{}, to best {:.1} s of {:.1} s, stop {}, status {:?})",
+            j.tag,
+            target,
+            g.map_or("unstable".into(), |g| format!("{g:.5}")),
+            if ok { "yes" } else { "NO" },
+            o.search.starts,
+            o.search.best_start,
+            o.search.cpu_to_best_s,
+            o.cpu_s,
+            o.search.stop.name(),
+            o.status
+        );
+    }
+}
+
+/// A seeded random plant with n states and at least one unstable open-loop eigenvalue.
+fn random_plant(seed: u64) -> Plant {
+    let mut rng = ChaCha8Rng::seed_from_u64(1000 + seed);
+    let n = 4 + (seed as usize * 7) % 17; // 4..=20
+    let (m1, p1, m2, p2) = (1 + seed as usize % 2, 1 + (seed as usize / 2) % 2, 1 + (seed as usize / 3) % 2, 1 + (seed as usize / 5) % 2);
+    let mut randn = |r: usize, c: usize, s: f64| -> Vec<Vec<f64>> {
+        (0..r).map(|_| (0..c).map(|_| { let v: f64 = StandardNormal.sample(&mut rng); s * v }).collect()).collect()
+    };
+    loop {
+        // Eigenvalues of A/√n spread over the unit disc: shifted so that a few lie in the right half-plane.
+        let mut a = randn(n, n, 1.0 / (n as f64).sqrt());
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] -= 0.6;
+        }
+        let doc = serde_json::json!({
+            "name": format!("rand{seed}"),
+            "dims": {"n": n, "m1": m1, "m2": m2, "p1": p1, "p2": p2},
+            "A": a, "B1": randn(n, m1, 1.0), "B2": randn(n, m2, 1.0),
+            "C1": randn(p1, n, 1.0), "C2": randn(p2, n, 1.0),
+            "D11": randn(p1, m1, 0.0), "D12": randn(p1, m2, 0.3), "D21": randn(p2, m1, 0.3), "D22": randn(p2, m2, 0.0),
+        });
+        let p = Plant::from_json_str(&doc.to_string(), format!("<random plant {seed}>")).expect("valid random plant");
+        if spectral_abscissa(p.a.as_ref()) > 0.0 {
+            return p;
+        }
+    }
+}
+
+fn random(a: &Args) {
+    let mut jobs = Vec::new();
+    for s in 0..a.random as u64 {
+        let p = std::sync::Arc::new(random_plant(s));
+        for order in [1usize, 2] {
+            let base = DesignOptions { order, eps: 1e-3, seed: 1, cpumax: a.random_cpumax, ..Default::default() };
+            let tag = format!("rand{s} n={} nk={order}", p.dims.n);
+            jobs.push(Job { tag: format!("{tag} old"), plant: p.clone(), opts: DesignOptions { stall_starts: 0, ..base.clone() } });
+            jobs.push(Job { tag: format!("{tag} new"), plant: p.clone(), opts: base });
+        }
+    }
+    println!("# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old) vs default (new)", a.random, a.random_cpumax);
+    let done = run_all(jobs, a.threads);
+    println!("{:<22} {:>12} {:>12} {:>9} {:>8} {:>8}", "problem", "old γ", "new γ", "new/old", "old cpu", "new cpu");
+    let (mut entries, mut at_or_below, mut better1, mut both_unstable) = (0, 0, 0, 0);
+    for pair in done.chunks(2) {
+        let [(jo, oo), (jn, on)] = pair else { continue };
+        let (go, gn) = (verified_gamma(&jo.plant, oo), verified_gamma(&jn.plant, on));
+        let tag = jo.tag.trim_end_matches(" old");
+        match (go, gn) {
+            (None, None) => {
+                both_unstable += 1;
+                println!("{tag:<22} {:>12} {:>12}", "unstable", "unstable");
+                continue;
+            }
+            _ => {}
+        }
+        entries += 1;
+        let (go, gn) = (go.unwrap_or(f64::INFINITY), gn.unwrap_or(f64::INFINITY));
+        at_or_below += (gn <= go) as usize;
+        better1 += (gn < go / 1.01) as usize;
+        println!("{tag:<22} {go:>12.5} {gn:>12.5} {:>9.4} {:>8.1} {:>8.1}", gn / go, oo.cpu_s, on.cpu_s);
+    }
+    println!(
+        "# random: {entries} entries with a stabilising controller; new ≤ old on {at_or_below}, better by > 1 % on {better1}; {both_unstable} not stabilised by either"
+    );
+}
+
+fn main() {
+    let a = parse_args();
+    for part in &a.parts {
+        match part.as_str() {
+            "paper" => paper(&a),
+            "singles" => singles(&a),
+            "random" => random(&a),
+            other => panic!("unknown part {other} (paper, singles, random)"),
+        }
+    }
+}

@@ -1,0 +1,388 @@
+//! The multi-start search of a design run: local searches until a budget or the stall rule ends
+//! it, then gradient sampling from the best point.
+//!
+//! # One local search (docs/ALGORITHMS.md §8.3, §8.4)
+//! From a start x₀: BFGS on f_s = max(α(Acl), ε·α(Ak)) with fvalquit = 0 (it stops as soon as
+//! f_s < 0: Acl and Ak Hurwitz; a start that is already stable costs one evaluation); if the end
+//! point is stable, BFGS on f_h = max(‖Tzw‖∞, ε·‖K‖∞) from it. Each local search has a fresh
+//! inverse-Hessian approximation — restarting BFGS is itself useful on nonsmooth functions.
+//!
+//! # The starts
+//! 1. The first starts, as HIFOO 3.5: `nrand` standard-normal points, or an initial controller
+//!    and `nrand` perturbations of it ([`super::starts`]). They are always made (unless a budget
+//!    ends the run first).
+//! 2. If none of them was stabilised and gradient sampling is on: gradient sampling on f_s
+//!    (fvalquit = 0) from the point with the smallest f_s (HIFOO's fallback), then BFGS on f_h
+//!    from its end point if stable.
+//! 3. The continued search (`stall_starts > 0`): further local searches, cycling through one
+//!    basin-hopping perturbation x* + ξ ∘ (‖x*‖·r) of the best point x* for each r in
+//!    `hop_scales`, then one fresh standard-normal start. x* is the best point of f_h, or of f_s
+//!    while no stable point has been found: stabilisation is restarted, never given up, until a
+//!    budget ends the run (the stall rule applies only once a stable point is known, or when no
+//!    budget — cpumax, maxevals, max_starts — is finite).
+//!
+//! # When it stops
+//! Before each new local search (and within one, between evaluations) the run stops on the CPU
+//! budget `cpumax`, the evaluation budget `maxevals`, a cancel request, or when `max_starts`
+//! local searches were made. The **stall rule**: after the first starts, the search stops once
+//! `stall_starts` consecutive local searches have not lowered the best objective by at least
+//! `stall_rtol`·|best| (f_h once a stable point exists; before that, f_s, whose improvements count
+//! at least `stall_rtol` in absolute terms near 0, and only if no budget is finite).
+//! `stall_starts = 0` is HIFOO's search.
+//!
+//! # Gradient sampling on the incumbent
+//! If gradient sampling is on, [`GS_RESERVE`] of each budget (CPU and evaluations) is kept for
+//! it once a stable point is known: from then on the local searches run under the remaining part, then gradient sampling on f_h runs from
+//! the best point (HANSO 2.0's rule: only if its certificate dnorm > normtol) under the whole
+//! budget, and replaces the best point if it lowers f_h.
+//!
+//! # Reproducibility
+//! All randomness comes from the run's ChaCha8 generator, drawn in a fixed order. With
+//! `maxevals`, `max_starts` or the stall rule ending the run, and the CPU budget not binding, the
+//! run's path — and the returned controller, bit for bit — does not depend on timing, threads or
+//! load. A run ended by `cpumax` depends on the machine's speed.
+
+use rand::RngCore;
+
+use crate::optim::{bfgs, gradient_sampling, OptimError, OptimResult, RunControl, Termination};
+
+use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
+use super::options::DesignOptions;
+use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary};
+use super::phases::{bfgs_options, gradsamp_options, optim_error};
+use super::starts::{perturb, random_starts};
+
+/// Share of the CPU and evaluation budgets kept for the final gradient sampling (when enabled).
+pub const GS_RESERVE: f64 = 0.1;
+
+/// Relative tolerance of "first reached" for [`SearchSummary::cpu_to_best_s`].
+pub const TIME_TO_BEST_RTOL: f64 = 1e-6;
+
+/// The best point of one objective, with where it came from.
+#[derive(Debug, Clone)]
+pub(crate) struct Best {
+    /// The point.
+    pub x: Vec<f64>,
+    /// Its objective value.
+    pub f: f64,
+    /// Its certificate (f_h only).
+    pub dnorm: f64,
+    /// See `dnorm`.
+    pub evaldist: f64,
+    /// The local search that produced it.
+    pub start: usize,
+    /// The stable point its f_h local search started from (to tell whether it moved).
+    pub from: Vec<f64>,
+}
+
+/// What the search produced.
+#[derive(Debug, Clone)]
+pub(crate) struct SearchResult {
+    /// Best stable point by f_h (None if none was stabilised or f_h was never finite).
+    pub perf: Option<Best>,
+    /// Best point by f_s.
+    pub stab: Best,
+    /// Whether any stable point was found.
+    pub stabilised: bool,
+    /// Per-phase counters: stabilisation, optimisation (if a stable point was found), gradient
+    /// sampling (if it ran).
+    pub phases: Vec<PhaseStats>,
+    /// The search summary (time to best filled in by the caller's adapter).
+    pub summary: SearchSummary,
+    /// True if a budget ended the run before the first starts were all made.
+    pub truncated: bool,
+}
+
+fn stop_of(t: Termination) -> Option<SearchStop> {
+    match t {
+        Termination::CpuBudget => Some(SearchStop::Budget),
+        Termination::EvalBudget => Some(SearchStop::Maxevals),
+        Termination::Interrupted => Some(SearchStop::Interrupted),
+        _ => None,
+    }
+}
+
+fn ctl_stop(ctl: &RunControl) -> Option<SearchStop> {
+    if ctl.cancelled() {
+        Some(SearchStop::Interrupted)
+    } else if ctl.cpu_exhausted() {
+        Some(SearchStop::Budget)
+    } else if ctl.evals_exhausted() {
+        Some(SearchStop::Maxevals)
+    } else {
+        None
+    }
+}
+
+/// True if `new` improves on `old` by the stall rule's tolerance.
+fn improves(new: f64, old: f64, rtol: f64, abs_floor: f64) -> bool {
+    new.is_finite() && (!old.is_finite() || new < old - rtol * old.abs().max(abs_floor))
+}
+
+/// Mutable state of the search.
+struct State<'s> {
+    opts: &'s DesignOptions,
+    stats: [PhaseStats; 3],
+    perf: Option<Best>,
+    stab: Option<Best>,
+    stabilised: bool,
+    stall: usize,
+}
+
+impl State<'_> {
+    fn evals(&self) -> usize {
+        self.stats.iter().map(|s| s.evals).sum()
+    }
+
+    fn add(&mut self, which: usize, r: &OptimResult, cpu0: f64, cpu1: f64) {
+        let s = &mut self.stats[which];
+        s.iters += r.iters;
+        s.evals += r.evals;
+        s.cpu_s += cpu1 - cpu0;
+    }
+
+    /// Records an f_s end point; returns whether it improved the best f_s (stall sense).
+    fn offer_stab(&mut self, x: Vec<f64>, f: f64, start: usize) -> bool {
+        let f = if f.is_nan() { f64::INFINITY } else { f };
+        let old = self.stab.as_ref().map_or(f64::INFINITY, |b| b.f);
+        let better = improves(f, old, self.opts.stall_rtol, 1.0);
+        if self.stab.is_none() || f < old {
+            self.stab = Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start });
+        }
+        better
+    }
+
+    /// Records an f_h end point; returns whether it improved the best f_h (stall sense).
+    fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize) -> bool {
+        let old = self.perf.as_ref().map_or(f64::INFINITY, |b| b.f);
+        let better = improves(r.f, old, self.opts.stall_rtol, 0.0);
+        if r.f.is_finite() && r.f < old {
+            self.perf =
+                Some(Best { x: r.x.clone(), f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from: from.to_vec() });
+        }
+        better
+    }
+}
+
+/// Everything one search needs besides its state.
+pub(crate) struct Search<'r, 'o, 'a> {
+    pub stab_obj: &'r mut DesignObjective<'o>,
+    pub perf_obj: &'r mut DesignObjective<'o>,
+    pub adapter: &'r mut ObserverAdapter<'a, 'o>,
+    pub rng: &'r mut dyn RngCore,
+    /// The whole run's control.
+    pub ctl: &'r RunControl,
+}
+
+impl Search<'_, '_, '_> {
+    /// One local search from `x0` (module docs). Returns the stop reason if a budget or an
+    /// interrupt ended it, and whether it improved the incumbent (stall sense).
+    fn local(&mut self, st: &mut State<'_>, x0: &[f64], k: usize, ctl: &RunControl) -> Result<(Option<SearchStop>, bool), DesignError> {
+        let opts = st.opts;
+        self.adapter.switch(self.stab_obj, Phase::Stabilisation);
+        self.adapter.set_evals_base(st.evals());
+        let c0 = ctl.cpu_elapsed();
+        let (xs, fs) = match bfgs(self.stab_obj, x0, k, &bfgs_options(opts, 0.0), ctl, self.adapter) {
+            Ok(r) => {
+                st.add(0, &r, c0, ctl.cpu_elapsed());
+                if let Some(stop) = stop_of(r.termination) {
+                    let better = st.offer_stab(r.x, r.f, k);
+                    return Ok((Some(stop), better));
+                }
+                (r.x, r.f)
+            }
+            Err(OptimError::NonFiniteStart { f }) => {
+                st.stats[0].evals += 1;
+                (x0.to_vec(), f)
+            }
+            Err(e) => return Err(optim_error(e)),
+        };
+        let stab_better = st.offer_stab(xs.clone(), fs, k);
+        if !(fs < 0.0) {
+            // Not stabilised: progress only counts while no stable point is known.
+            return Ok((None, !st.stabilised && stab_better));
+        }
+        st.stabilised = true;
+        self.optimise_from(st, &xs, k, ctl)
+    }
+
+    /// BFGS on f_h from the stable point `xs`.
+    fn optimise_from(&mut self, st: &mut State<'_>, xs: &[f64], k: usize, ctl: &RunControl) -> Result<(Option<SearchStop>, bool), DesignError> {
+        let opts = st.opts;
+        self.adapter.switch(self.perf_obj, Phase::Optimisation);
+        self.adapter.set_evals_base(st.evals());
+        let c0 = ctl.cpu_elapsed();
+        match bfgs(self.perf_obj, xs, k, &bfgs_options(opts, f64::NEG_INFINITY), ctl, self.adapter) {
+            Ok(r) => {
+                st.add(1, &r, c0, ctl.cpu_elapsed());
+                let better = st.offer_perf(&r, xs, k);
+                Ok((stop_of(r.termination), better))
+            }
+            // f_h = +∞ at a point with α just below 0 (the norm's stability test has a margin):
+            // nothing to optimise from here.
+            Err(OptimError::NonFiniteStart { .. }) => {
+                st.stats[1].evals += 1;
+                Ok((None, false))
+            }
+            Err(e) => Err(optim_error(e)),
+        }
+    }
+
+    /// HIFOO's fallback when no first start was stabilised: gradient sampling on f_s from the
+    /// best f_s point, then f_h from its end point if stable.
+    fn gs_stabilise(&mut self, st: &mut State<'_>, k: usize, ctl: &RunControl) -> Result<(Option<SearchStop>, bool), DesignError> {
+        let opts = st.opts;
+        let Some(x0) = st.stab.as_ref().filter(|b| b.f.is_finite()).map(|b| b.x.clone()) else {
+            return Ok((None, false));
+        };
+        self.adapter.switch(self.stab_obj, Phase::Stabilisation);
+        self.adapter.set_evals_base(st.evals());
+        let c0 = ctl.cpu_elapsed();
+        match gradient_sampling(self.stab_obj, &x0, &gradsamp_options(opts, 0.0), self.rng, ctl, self.adapter) {
+            Ok(r) => {
+                st.add(0, &r, c0, ctl.cpu_elapsed());
+                let better = st.offer_stab(r.x.clone(), r.f, k);
+                if let Some(stop) = stop_of(r.termination) {
+                    return Ok((Some(stop), better));
+                }
+                if r.f < 0.0 {
+                    st.stabilised = true;
+                    return self.optimise_from(st, &r.x, k, ctl);
+                }
+                Ok((None, better))
+            }
+            Err(OptimError::NonFiniteStart { .. }) => {
+                st.stats[0].evals += 1;
+                Ok((None, false))
+            }
+            Err(e) => Err(optim_error(e)),
+        }
+    }
+
+    /// The start of continued local search number `j` (0-based after the first starts).
+    fn next_start(&mut self, st: &State<'_>, j: usize, nvar: usize) -> Vec<f64> {
+        let scales = &st.opts.hop_scales;
+        let centre = st.perf.as_ref().or(st.stab.as_ref()).filter(|b| b.x.iter().all(|v| v.is_finite()));
+        match (j % (scales.len() + 1), centre) {
+            (i, Some(c)) if i < scales.len() => perturb(&c.x, scales[i], self.rng),
+            _ => random_starts(nvar, 1, self.rng).remove(0),
+        }
+    }
+
+    /// Runs the whole search from the first starts `first` (module docs).
+    pub(crate) fn run(&mut self, opts: &DesignOptions, first: &[Vec<f64>], nvar: usize) -> Result<SearchResult, DesignError> {
+        let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
+        let search_ctl = self.ctl.sub_budget(reserve, reserve);
+        let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
+        let mut st = State {
+            opts,
+            stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
+            perf: None,
+            stab: None,
+            stabilised: false,
+            stall: 0,
+        };
+        let mut k = 0usize; // local searches made
+        let mut gs_fallback_done = false;
+        let mut stop = None;
+        let full_ctl = self.ctl;
+        while stop.is_none() {
+            // The gradient-sampling reserve is kept only once there is a stable point to refine.
+            let search_ctl = if st.stabilised { &search_ctl } else { full_ctl };
+            if let Some(s) = ctl_stop(search_ctl) {
+                stop = Some(s);
+                break;
+            }
+            if opts.max_starts.is_some_and(|m| k >= m) {
+                stop = Some(SearchStop::Starts);
+                break;
+            }
+            let (s, better) = if k < first.len() {
+                self.local(&mut st, &first[k], k, search_ctl)?
+            } else if !st.stabilised && opts.gradient_sampling && !gs_fallback_done {
+                gs_fallback_done = true;
+                self.gs_stabilise(&mut st, k, search_ctl)?
+            } else {
+                if opts.stall_starts == 0 {
+                    stop = Some(SearchStop::Starts);
+                    break;
+                }
+                // Stabilisation is never given up while a budget bounds the run: the stall rule
+                // applies once a stable point is known (or when nothing else would end the run).
+                let bounded = search_ctl.cpumax().is_finite() || opts.maxevals.is_some() || opts.max_starts.is_some();
+                if st.stall >= opts.stall_starts && (st.stabilised || !bounded) {
+                    stop = Some(SearchStop::Stall);
+                    break;
+                }
+                let x0 = self.next_start(&st, k - first.len() - gs_fallback_done as usize, nvar);
+                self.local(&mut st, &x0, k, search_ctl)?
+            };
+            k += 1;
+            st.stall = if better { 0 } else { st.stall + 1 };
+            stop = s;
+        }
+        let stop = stop.unwrap_or(SearchStop::Starts);
+        let truncated = k < first.len() && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
+
+        // Gradient sampling from the best stable point, under the whole budget.
+        let mut gs_ran = false;
+        if opts.gradient_sampling && stop != SearchStop::Interrupted {
+            if let Some(best) = st.perf.clone() {
+                if best.dnorm > opts.normtol && ctl_stop(self.ctl).is_none() {
+                    self.adapter.switch(self.perf_obj, Phase::Optimisation);
+                    self.adapter.set_evals_base(st.evals());
+                    let c0 = self.ctl.cpu_elapsed();
+                    let gopts = gradsamp_options(opts, f64::NEG_INFINITY);
+                    match gradient_sampling(self.perf_obj, &best.x, &gopts, self.rng, self.ctl, self.adapter) {
+                        Ok(r) => {
+                            st.add(2, &r, c0, self.ctl.cpu_elapsed());
+                            gs_ran = true;
+                            let b = st.perf.as_mut().expect("checked above");
+                            if r.f < b.f {
+                                b.x = r.x;
+                                b.f = r.f;
+                                b.dnorm = r.dnorm;
+                                b.evaldist = r.evaldist;
+                            } else if r.x == b.x && r.dnorm < b.dnorm {
+                                b.dnorm = r.dnorm;
+                                b.evaldist = r.evaldist;
+                            }
+                        }
+                        Err(OptimError::NonFiniteStart { .. }) => st.stats[2].evals += 1,
+                        Err(e) => return Err(optim_error(e)),
+                    }
+                }
+            }
+        }
+        let [s0, s1, s2] = st.stats;
+        let mut phases = vec![s0];
+        if st.stabilised {
+            phases.push(s1);
+        }
+        if gs_ran {
+            phases.push(s2);
+        }
+        let stab = st.stab.unwrap_or_else(|| Best {
+            x: first[0].clone(),
+            f: f64::INFINITY,
+            dnorm: f64::NAN,
+            evaldist: f64::NAN,
+            start: 0,
+            from: first[0].clone(),
+        });
+        let best_start = st.perf.as_ref().map_or(stab.start, |b| b.start);
+        let (phase, f) = match &st.perf {
+            Some(b) => (ObjectivePhase::Performance, b.f),
+            None => (ObjectivePhase::Stabilisation, stab.f),
+        };
+        let reached = self.adapter.first_reached(phase, f, TIME_TO_BEST_RTOL);
+        let summary = SearchSummary {
+            starts: k,
+            best_start,
+            cpu_to_best_s: reached.map_or(0.0, |r| r.cpu_s),
+            evals_to_best: reached.map_or(0, |r| r.evals),
+            stop,
+        };
+        Ok(SearchResult { perf: st.perf, stab, stabilised: st.stabilised, phases, summary, truncated })
+    }
+}
