@@ -113,7 +113,7 @@ fn concurrent_runs_on_one_folder_with_a_kill_then_resume_run_every_job_once() {
     assert!(names.iter().all(|n| n.ends_with(".mcap")), "leftovers: {names:?}");
     for id in expected.keys() {
         let s = summarise(&traces.join(format!("{id}.mcap"))).unwrap();
-        assert_eq!(s.final_status.as_deref(), Some("optimised"), "{id}");
+        assert_eq!(s.final_status.as_deref(), Some("converged"), "{id}");
         assert_eq!(s.iterations, 10, "{id}");
     }
     // No claim is left held; the killed process's claims were released by its death.

@@ -455,9 +455,11 @@ fn item7_design_and_check_exit_4_when_not_stabilised() {
 #[test]
 fn item7_failed_means_one_thing_in_best_csv() {
     let plant = std::sync::Arc::new(Plant::load(format!("{PLANTS}/HE1.json")).unwrap());
-    let plants: PlantMap = [("HE1".to_string(), plant)].into_iter().collect();
+    let plants: PlantMap = [(plant.fingerprint(), plant)].into_iter().collect();
     let not_stab = record(Ok(outcome(DesignStatus::NotStabilised { best_alpha: 0.5 }, f64::INFINITY)));
-    let failed = record(Err("boom".into()));
+    // another job of the same (plant, order): records of one job id count once (issue 14)
+    let mut failed = record(Err("boom".into()));
+    failed.job_id.0 = format!("{}-other", failed.job_id.0);
     let rows = best_per_order(&[not_stab.clone(), failed.clone()], &plants);
     assert_eq!((rows[0].runs, rows[0].verified, rows[0].failed, rows[0].unverified), (2, 0, 1, 1));
     assert!(failed.failed() && !not_stab.failed());

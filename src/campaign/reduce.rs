@@ -247,7 +247,7 @@ mod tests {
         // and a record of a plant the campaign no longer has does not verify against another
         let other = plant("NEW", 3.0);
         let rows = best_per_order(&[record(&other, "NEW", 0)], &map(&[&p]));
-        assert_eq!((rows[0].verified, rows[0].failed), (0, 1));
+        assert_eq!((rows[0].verified, rows[0].failed, rows[0].unverified), (0, 0, 1));
     }
 
     #[test]

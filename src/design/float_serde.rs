@@ -76,6 +76,34 @@ pub mod serde_opt_f64_or_string {
     }
 }
 
+/// `#[serde(default, with = "serde_vec_f64_or_string")]` for a `Vec<f64>`: each element as
+/// [`serde_f64_or_string`] writes it (and reads it, `null` as NaN).
+pub mod serde_vec_f64_or_string {
+    use super::*;
+    use serde::ser::SerializeSeq;
+
+    /// A JSON array of numbers or "inf" / "-inf" / "nan".
+    pub fn serialize<S: Serializer>(xs: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        let mut seq = s.serialize_seq(Some(xs.len()))?;
+        for x in xs {
+            seq.serialize_element(&super::f64_to_json(*x))?;
+        }
+        seq.end()
+    }
+
+    /// An array whose elements are numbers, one of the strings, or `null` (NaN).
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        let raw = Vec::<Option<NumOrStr>>::deserialize(d)?;
+        raw.into_iter()
+            .map(|v| match v {
+                None => Ok(f64::NAN),
+                Some(NumOrStr::Num(x)) => Ok(x),
+                Some(NumOrStr::Str(s)) => from_str_form(&s),
+            })
+            .collect()
+    }
+}
+
 /// A float as a JSON value in the same convention: finite → number, else "inf" / "-inf" / "nan".
 pub fn f64_to_json(x: f64) -> serde_json::Value {
     serde_f64_or_string::serialize(&x, serde_json::value::Serializer).unwrap_or(serde_json::Value::Null)

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::float_serde::serde_f64_or_string;
+use super::float_serde::{serde_f64_or_string, serde_vec_f64_or_string};
 
 /// Largest accepted number of random starts `nrand` (each start is a BFGS run of its own).
 pub const MAX_NRAND: usize = 10_000;
@@ -70,7 +70,7 @@ pub struct DesignOptions {
     /// best point x* (the same form as the perturbations of an initial controller). The
     /// continued search cycles through one perturbation per size, then one fresh random start.
     /// Empty: random starts only. (Missing in a serialised record: empty.)
-    #[serde(default)]
+    #[serde(default, with = "serde_vec_f64_or_string")]
     pub hop_scales: Vec<f64>,
     /// Strong stabilisation or plain H∞.
     pub objective: ObjectiveKind,

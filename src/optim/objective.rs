@@ -101,6 +101,7 @@ impl<'a> Evaluator<'a> {
             return Err(t);
         }
         self.evals += 1;
+        self.ctl.count_eval();
         Ok(self.obj.eval_below(x, g, threshold))
     }
 

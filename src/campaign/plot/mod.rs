@@ -132,7 +132,7 @@ pub fn write_plots(
         } else {
             out.skipped.push(format!("convergence of {tag}: no trace {}", trace.display()));
         }
-        let (Some(plant), Some(rec)) = (plants.get(&row.plant), records.iter().find(|r| r.job_id.0 == job)) else { continue };
+        let (Some(plant), Some(rec)) = (plants.get(&row.plant_fingerprint), records.iter().find(|r| r.job_id.0 == job)) else { continue };
         let Some(k) = rec.controller.as_ref().and_then(|c| Controller::from_json_value(c).ok()) else { continue };
         let fig = sigma_figure(plant, &k, format!("σ-plot: {title}"))?;
         out.files.extend(write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}")))?);
