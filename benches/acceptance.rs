@@ -105,7 +105,19 @@ fn main() {
     );
     println!(
         "{:<5} {:>2} {:>9} {:>10} {:>8} {:>5} {:>8} {:>5} {:>5} {:>4} {:>8} {:>8} {:>8}",
-        "plant", "nk", "published", "best γ", "ratio", "≤1%", "ε", "seed", "check", "runs", "cpu/run", "evals/run", "ms/eval"
+        "plant",
+        "nk",
+        "published",
+        "best γ",
+        "ratio",
+        "≤1%",
+        "ε",
+        "seed",
+        "check",
+        "runs",
+        "cpu/run",
+        "evals/run",
+        "ms/eval"
     );
     let wall = Instant::now();
     let (mut reached, mut total) = (0, 0);
@@ -144,21 +156,51 @@ fn main() {
                     let chk = if cl_ok && k_ok && (g_check - g).abs() <= 1e-9 * g { "ok" } else { "FAIL" };
                     println!(
                         "{:<5} {:>2} {:>9.4} {:>10.5} {:>8.4} {:>5} {:>8.0e} {:>5} {:>5} {:>4} {:>8.2} {:>8.0} {:>8.3}",
-                        name, r.order, r.gamma, g, g / r.gamma, if ok { "yes" } else { "NO" }, eps, seed, chk, runs,
-                        cpu / runs as f64, evals as f64 / runs as f64, ms_eval
+                        name,
+                        r.order,
+                        r.gamma,
+                        g,
+                        g / r.gamma,
+                        if ok { "yes" } else { "NO" },
+                        eps,
+                        seed,
+                        chk,
+                        runs,
+                        cpu / runs as f64,
+                        evals as f64 / runs as f64,
+                        ms_eval
                     );
                 }
                 None => println!(
                     "{:<5} {:>2} {:>9.4} {:>10} {:>8} {:>5} {:>8} {:>5} {:>5} {:>4} {:>8.2} {:>8.0} {:>8.3}",
-                    name, r.order, r.gamma, "none", "-", "NO", "-", "-", "-", runs, cpu / runs as f64,
-                    evals as f64 / runs as f64, ms_eval
+                    name,
+                    r.order,
+                    r.gamma,
+                    "none",
+                    "-",
+                    "NO",
+                    "-",
+                    "-",
+                    "-",
+                    runs,
+                    cpu / runs as f64,
+                    evals as f64 / runs as f64,
+                    ms_eval
                 ),
             }
         }
     }
-    println!("# part 1: {reached}/{total} orders within 1 % of the published γ ({:.0} s wall)", wall.elapsed().as_secs_f64());
+    println!(
+        "# part 1: {reached}/{total} orders within 1 % of the published γ ({:.0} s wall)",
+        wall.elapsed().as_secs_f64()
+    );
 
-    println!("\n# large plants: orders 1-2, eps {:e}, seeds 0..{}, cpumax {} s per run", 1e-3, a.seeds.min(1), a.large_cpumax);
+    println!(
+        "\n# large plants: orders 1-2, eps {:e}, seeds 0..{}, cpumax {} s per run",
+        1e-3,
+        a.seeds.min(1),
+        a.large_cpumax
+    );
     println!(
         "{:<5} {:>4} {:>2} {:>9} {:>10} {:>8} {:<16} {:>8} {:>6} {:>8}",
         "plant", "n", "nk", "published", "γ", "ratio", "status", "cpu s", "evals", "ms/eval"
@@ -166,8 +208,10 @@ fn main() {
     for name in &a.large {
         let p = load(name);
         for order in 1..=2usize {
-            let published =
-                refs.iter().find(|r| r.plant == *name && r.method == RefMethod::Hifoo && r.order == order).map(|r| r.gamma);
+            let published = refs
+                .iter()
+                .find(|r| r.plant == *name && r.method == RefMethod::Hifoo && r.order == order)
+                .map(|r| r.gamma);
             for seed in 0..a.seeds.min(1) {
                 let opts = DesignOptions { order, eps: 1e-3, seed, cpumax: a.large_cpumax, ..Default::default() };
                 let o = run(&p, &opts, None, &mut NoDesignObserver).expect("valid options");

@@ -22,8 +22,12 @@ use std::rc::Rc;
 
 use faer::Mat;
 use hinfix::design::objective::ComponentCache;
-use hinfix::design::{controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase};
-use hinfix::lti::{hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL};
+use hinfix::design::{
+    controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase,
+};
+use hinfix::lti::{
+    hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL,
+};
 use hinfix::optim::{thread_cpu_time, Objective};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -148,11 +152,27 @@ fn dense_eig_seconds(size: usize, reps: usize) -> f64 {
     let mut rng = ChaCha8Rng::seed_from_u64(size as u64);
     let a = randn(&mut rng, size, size, 1.0);
     let par = faer::Par::Seq;
-    let mut mem = MemBuffer::new(evd::evd_scratch::<f64>(size, evd::ComputeEigenvectors::No, evd::ComputeEigenvectors::No, par, Default::default()));
+    let mut mem = MemBuffer::new(evd::evd_scratch::<f64>(
+        size,
+        evd::ComputeEigenvectors::No,
+        evd::ComputeEigenvectors::No,
+        par,
+        Default::default(),
+    ));
     let (t, _) = time(reps, || {
         let mut wr = faer::diag::Diag::<f64>::zeros(size);
         let mut wi = faer::diag::Diag::<f64>::zeros(size);
-        evd::evd_real(a.as_ref(), wr.as_mut(), wi.as_mut(), None, None, par, MemStack::new(&mut mem), Default::default()).unwrap();
+        evd::evd_real(
+            a.as_ref(),
+            wr.as_mut(),
+            wi.as_mut(),
+            None,
+            None,
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .unwrap();
         wr[0] + wi[0]
     });
     t
@@ -183,7 +203,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
     let dump = args.iter().position(|a| a == "--dump").and_then(|i| args.get(i + 1)).map(PathBuf::from);
-    let only: Option<usize> = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
+    let only: Option<usize> =
+        args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
 
     for (family, make) in [
         ("random stable (A = M/√n − 1.2 I)", random_stable as fn(usize, usize, usize, u64) -> StateSpace),
@@ -230,7 +251,12 @@ fn main() {
     if args.iter().any(|a| a == "--no-design") {
         return;
     }
-    let cpumax: f64 = args.iter().position(|a| a == "--design-cpumax").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok()).unwrap_or(20.0);
+    let cpumax: f64 = args
+        .iter()
+        .position(|a| a == "--design-cpumax")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20.0);
     println!();
     println!("Design run (order nK, ε = 1e-3, seed 1, cpumax {cpumax} s): ms per evaluation / one dense eig of size 2(n + nK)");
     for (name, nk) in [("HE1", 1), ("BDT2", 1), ("CM4", 1)] {

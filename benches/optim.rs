@@ -19,7 +19,15 @@ fn bench(name: &str, obj: &mut dyn Objective, fmin: f64, o: &HansoOptions, nstar
 }
 
 /// Starting points randn·scale.
-fn bench_scaled(name: &str, obj: &mut dyn Objective, fmin: f64, o: &HansoOptions, nstarts: usize, seed: u64, scale: f64) {
+fn bench_scaled(
+    name: &str,
+    obj: &mut dyn Objective,
+    fmin: f64,
+    o: &HansoOptions,
+    nstarts: usize,
+    seed: u64,
+    scale: f64,
+) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut starts = random_starts(obj.nvar(), nstarts, &mut rng);
     starts.iter_mut().for_each(|x| x.iter_mut().for_each(|v| *v *= scale));
@@ -31,8 +39,16 @@ fn bench_scaled(name: &str, obj: &mut dyn Objective, fmin: f64, o: &HansoOptions
     let gs_it = r.gradient_sampling.as_ref().map_or(0, |g| g.iters);
     println!(
         "{name:<28} {:>3} {:>7} {:>6} {:>8} {:>10.3e} {:>9.2e} {:>9.2e} {:>9.1} {:>8.1}  {:?}",
-        obj.nvar(), bfgs_it, gs_it, r.evals, r.best.f - fmin, r.best.dnorm, r.best.evaldist,
-        cpu * 1e3, cpu * 1e6 / r.evals as f64, r.best.termination
+        obj.nvar(),
+        bfgs_it,
+        gs_it,
+        r.evals,
+        r.best.f - fmin,
+        r.best.dnorm,
+        r.best.evaldist,
+        cpu * 1e3,
+        cpu * 1e6 / r.evals as f64,
+        r.best.termination
     );
 }
 
@@ -52,7 +68,14 @@ fn main() {
         bench("l1 ||Mx||_1", &mut L1Norm::random(n, &mut rng), 0.0, &opts(1e-8, 1e-10, 1000, false), 3, 5);
     }
     for n in [2usize, 4] {
-        bench("max-eigenvalue (6x6)", &mut MaxEigenvalue::random(n, &mut rng), 1.0, &opts(1e-8, 1e-10, 1000, true), 3, 12);
+        bench(
+            "max-eigenvalue (6x6)",
+            &mut MaxEigenvalue::random(n, &mut rng),
+            1.0,
+            &opts(1e-8, 1e-10, 1000, true),
+            3,
+            12,
+        );
     }
     bench_scaled("walled (+inf outside)", &mut Walled::new(4), 0.0, &opts(1e-8, 1e-6, 1000, false), 3, 2, 0.2);
     for n in 2..=10 {
@@ -75,7 +98,10 @@ fn main() {
 
     println!();
     println!("simplex QP min ||Gw||^2 (median of repeats): dense interior point vs clarabel");
-    println!("{:>4} {:>4} {:>12} {:>12} {:>12} {:>12}", "n", "m", "dense_ms", "clarabel_ms", "dense_obj", "clarabel_obj");
+    println!(
+        "{:>4} {:>4} {:>12} {:>12} {:>12} {:>12}",
+        "n", "m", "dense_ms", "clarabel_ms", "dense_obj", "clarabel_obj"
+    );
     use rand::Rng;
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     for &(n, m) in &[(10usize, 3usize), (20, 30), (60, 100), (300, 100)] {

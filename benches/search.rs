@@ -152,7 +152,14 @@ fn paper(a: &Args) {
             }
         }
     }
-    println!("# paper: seed {}, eps {:?}, {} CPU s per job, {} jobs on {} threads", a.seed, a.eps, a.cpumax, jobs.len(), a.threads);
+    println!(
+        "# paper: seed {}, eps {:?}, {} CPU s per job, {} jobs on {} threads",
+        a.seed,
+        a.eps,
+        a.cpumax,
+        jobs.len(),
+        a.threads
+    );
     let wall = Instant::now();
     let done = run_all(jobs, a.threads);
     println!(
@@ -233,9 +240,19 @@ fn singles(a: &Args) {
 fn random_plant(seed: u64) -> Plant {
     let mut rng = ChaCha8Rng::seed_from_u64(1000 + seed);
     let n = 4 + (seed as usize * 7) % 17; // 4..=20
-    let (m1, p1, m2, p2) = (1 + seed as usize % 2, 1 + (seed as usize / 2) % 2, 1 + (seed as usize / 3) % 2, 1 + (seed as usize / 5) % 2);
+    let (m1, p1, m2, p2) =
+        (1 + seed as usize % 2, 1 + (seed as usize / 2) % 2, 1 + (seed as usize / 3) % 2, 1 + (seed as usize / 5) % 2);
     let mut randn = |r: usize, c: usize, s: f64| -> Vec<Vec<f64>> {
-        (0..r).map(|_| (0..c).map(|_| { let v: f64 = StandardNormal.sample(&mut rng); s * v }).collect()).collect()
+        (0..r)
+            .map(|_| {
+                (0..c)
+                    .map(|_| {
+                        let v: f64 = StandardNormal.sample(&mut rng);
+                        s * v
+                    })
+                    .collect()
+            })
+            .collect()
     };
     loop {
         // Eigenvalues of A/√n spread over the unit disc: shifted so that a few lie in the right half-plane.
@@ -264,11 +281,18 @@ fn random(a: &Args) {
         for order in [1usize, 2] {
             let base = DesignOptions { order, eps: 1e-3, seed: 1, cpumax: a.random_cpumax, ..Default::default() };
             let tag = format!("rand{s} n={} nk={order}", p.dims.n);
-            jobs.push(Job { tag: format!("{tag} old"), plant: p.clone(), opts: DesignOptions { stall_starts: 0, ..base.clone() } });
+            jobs.push(Job {
+                tag: format!("{tag} old"),
+                plant: p.clone(),
+                opts: DesignOptions { stall_starts: 0, ..base.clone() },
+            });
             jobs.push(Job { tag: format!("{tag} new"), plant: p.clone(), opts: base });
         }
     }
-    println!("# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old) vs default (new)", a.random, a.random_cpumax);
+    println!(
+        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old) vs default (new)",
+        a.random, a.random_cpumax
+    );
     let done = run_all(jobs, a.threads);
     println!("{:<22} {:>12} {:>12} {:>9} {:>8} {:>8}", "problem", "old γ", "new γ", "new/old", "old cpu", "new cpu");
     let (mut entries, mut at_or_below, mut better1, mut both_unstable) = (0, 0, 0, 0);
@@ -276,13 +300,10 @@ fn random(a: &Args) {
         let [(jo, oo), (jn, on)] = pair else { continue };
         let (go, gn) = (verified_gamma(&jo.plant, oo), verified_gamma(&jn.plant, on));
         let tag = jo.tag.trim_end_matches(" old");
-        match (go, gn) {
-            (None, None) => {
-                both_unstable += 1;
-                println!("{tag:<22} {:>12} {:>12}", "unstable", "unstable");
-                continue;
-            }
-            _ => {}
+        if let (None, None) = (go, gn) {
+            both_unstable += 1;
+            println!("{tag:<22} {:>12} {:>12}", "unstable", "unstable");
+            continue;
         }
         entries += 1;
         let (go, gn) = (go.unwrap_or(f64::INFINITY), gn.unwrap_or(f64::INFINITY));

@@ -18,10 +18,10 @@
 // failure); clippy's suggested `partial_cmp` form would hide that intent.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod campaign;
+pub mod design;
 pub mod fs_atomic;
 pub mod input;
+pub mod lti;
 pub(crate) mod numeric;
 pub mod optim;
-pub mod lti;
-pub mod design;
-pub mod campaign;

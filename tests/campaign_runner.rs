@@ -83,7 +83,11 @@ fn kill_minus_nine_at_random_moments_then_resume_equals_an_uninterrupted_run() {
     let killed = dir.join("killed");
     let mut rng = ChaCha8Rng::seed_from_u64(2026);
     for _ in 0..5 {
-        let mut child = command(&file, &killed, true).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::null()).spawn().unwrap();
+        let mut child = command(&file, &killed, true)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
         std::thread::sleep(Duration::from_millis(rng.random_range(50..700)));
         child.kill().unwrap(); // SIGKILL on Unix
         child.wait().unwrap();
@@ -144,14 +148,20 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     let search = recs[0].search.clone().expect("the record has its search summary");
     let slack = 2 * search.starts + 4;
     assert_eq!(s.iterations, recs[0].iterations);
-    assert!(s.messages > s.iterations && s.messages <= recs[0].iterations + slack, "{} vs {}", s.messages, recs[0].iterations);
+    assert!(
+        s.messages > s.iterations && s.messages <= recs[0].iterations + slack,
+        "{} vs {}",
+        s.messages,
+        recs[0].iterations
+    );
     assert_eq!(s.search.as_ref(), Some(&search));
     assert!(search.starts >= 3 && search.best_start < search.starts, "{search:?}");
 
     latex_compiles(&t);
 
     // Bad campaign file: a clear error naming the file and the line, exit code 1, no panic.
-    std::fs::write(&file, "name = \"t\"\n[defaults]\nepz = [1e-2]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n").unwrap();
+    std::fs::write(&file, "name = \"t\"\n[defaults]\nepz = [1e-2]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n")
+        .unwrap();
     let out = command(&file, &results, false).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);

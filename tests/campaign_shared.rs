@@ -48,7 +48,12 @@ fn command(sub: &str, file: &Path, results: &Path, pause_ms: u64) -> Command {
 }
 
 fn ok(out: Output) -> Output {
-    assert!(out.status.success(), "failed: {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     out
 }
 
@@ -67,7 +72,12 @@ fn all_records(results: &Path) -> Vec<(PathBuf, JobRecord)> {
 fn once(records: &[(PathBuf, JobRecord)]) -> BTreeMap<String, serde_json::Value> {
     let mut m = BTreeMap::new();
     for (path, r) in records {
-        assert!(m.insert(r.job_id.0.clone(), r.comparable()).is_none(), "job {} journaled twice (again in {})", r.job_id.0, path.display());
+        assert!(
+            m.insert(r.job_id.0.clone(), r.comparable()).is_none(),
+            "job {} journaled twice (again in {})",
+            r.job_id.0,
+            path.display()
+        );
     }
     m
 }
@@ -83,7 +93,15 @@ fn concurrent_runs_on_one_folder_with_a_kill_then_resume_run_every_job_once() {
 
     let shared = dir.join("shared");
     let mut procs: Vec<Child> = (0..3)
-        .map(|_| command("run", &file, &shared, 30).arg("--threads").arg("2").stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap())
+        .map(|_| {
+            command("run", &file, &shared, 30)
+                .arg("--threads")
+                .arg("2")
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
         .collect();
     std::thread::sleep(Duration::from_millis(700));
     let mut victim = procs.remove(1);
@@ -109,7 +127,8 @@ fn concurrent_runs_on_one_folder_with_a_kill_then_resume_run_every_job_once() {
 
     // Every trace is complete and readable; no tmp file is left behind.
     let traces = shared.join("t").join("traces");
-    let names: BTreeSet<String> = std::fs::read_dir(&traces).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().to_string()).collect();
+    let names: BTreeSet<String> =
+        std::fs::read_dir(&traces).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().to_string()).collect();
     assert!(names.iter().all(|n| n.ends_with(".mcap")), "leftovers: {names:?}");
     for id in expected.keys() {
         let s = summarise(&traces.join(format!("{id}.mcap"))).unwrap();
@@ -158,7 +177,10 @@ fn shards_in_separate_folders_merge_into_the_whole_campaign() {
     extra(&mut c);
     let text = String::from_utf8_lossy(&ok(c.output().unwrap()).stdout).to_string();
     assert!(text.contains("3 journal(s)"), "{text}");
-    assert!(text.lines().any(|l| l.split_whitespace().collect::<Vec<_>>() == ["total", "12", "12", "0", "0", "0"]), "{text}");
+    assert!(
+        text.lines().any(|l| l.split_whitespace().collect::<Vec<_>>() == ["total", "12", "12", "0", "0", "0"]),
+        "{text}"
+    );
     let mut c = command("report", &file, &roots[0], 1);
     extra(&mut c);
     ok(c.output().unwrap());
@@ -193,7 +215,15 @@ fn shards_sharing_one_folder_run_each_job_once() {
     let file = campaign_file(&dir, 2);
     let shared = dir.join("r");
     let procs: Vec<Child> = (1..=3)
-        .map(|k| command("run", &file, &shared, 5).arg("--shard").arg(format!("{k}/3")).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap())
+        .map(|k| {
+            command("run", &file, &shared, 5)
+                .arg("--shard")
+                .arg(format!("{k}/3"))
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
         .collect();
     for p in procs {
         ok(p.wait_with_output().unwrap());

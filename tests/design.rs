@@ -120,10 +120,19 @@ fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
 #[test]
 fn same_seed_gives_the_same_controller_bits() {
     let p = plant("REA2");
-    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: f64::INFINITY, max_starts: Some(8), ..Default::default() };
+    let opts = DesignOptions {
+        order: 1,
+        eps: 1e-3,
+        seed: 2,
+        cpumax: f64::INFINITY,
+        max_starts: Some(8),
+        ..Default::default()
+    };
     let a = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     let b = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
-    let bits = |o: &hinfix::design::DesignOutcome| controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    let bits = |o: &hinfix::design::DesignOutcome| {
+        controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    };
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.evals, b.evals);
     let c = run(&p, &DesignOptions { seed: 3, ..opts }, None, &mut NoDesignObserver).unwrap();
@@ -243,8 +252,10 @@ fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
     }
     for o in &both {
         assert_eq!(bits(o), bits(&alone));
-        assert_eq!((o.evals, o.iters, &o.search.stop, o.search.starts, o.search.best_start),
-                   (alone.evals, alone.iters, &alone.search.stop, alone.search.starts, alone.search.best_start));
+        assert_eq!(
+            (o.evals, o.iters, &o.search.stop, o.search.starts, o.search.best_start),
+            (alone.evals, alone.iters, &alone.search.stop, alone.search.starts, alone.search.best_start)
+        );
         assert_eq!(o.search.evals_to_best, alone.search.evals_to_best);
     }
 }
@@ -255,7 +266,8 @@ fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
 #[test]
 fn continued_search_is_never_worse_than_the_first_starts_and_is_recorded() {
     let p = plant("REA2");
-    let base = DesignOptions { order: 2, eps: 1e-3, seed: 4, cpumax: 1e6, gradient_sampling: false, ..Default::default() };
+    let base =
+        DesignOptions { order: 2, eps: 1e-3, seed: 4, cpumax: 1e6, gradient_sampling: false, ..Default::default() };
     let hifoo = run(&p, &DesignOptions { stall_starts: 0, ..base.clone() }, None, &mut NoDesignObserver).unwrap();
     assert_eq!((hifoo.search.starts, hifoo.search.stop), (3, SearchStop::Starts));
     let more = run(&p, &DesignOptions { max_starts: Some(15), ..base }, None, &mut NoDesignObserver).unwrap();

@@ -43,13 +43,18 @@ fn he1() -> &'static Plant {
     P.get_or_init(|| Plant::from_json_str(he1_text(), "HE1.json").unwrap())
 }
 
-const CONTROLLER: &str = r#"{"AK": [[-1.0, 0.5], [0.0, -2.0]], "BK": [[1.0], [0.5]], "CK": [[1.0, 0.0], [0.0, 1.0]], "DK": [[0.1], [0.2]]}"#;
+const CONTROLLER: &str =
+    r#"{"AK": [[-1.0, 0.5], [0.0, -2.0]], "BK": [[1.0], [0.5]], "CK": [[1.0, 0.0], [0.0, 1.0]], "DK": [[0.1], [0.2]]}"#;
 
 /// A valid journal line (a converged HE1 job with every field filled in).
 fn record_line() -> &'static str {
     static L: OnceLock<String> = OnceLock::new();
     L.get_or_init(|| {
-        let c = Campaign::from_toml_str(&format!("name = \"f\"\n[[problem]]\nplant = \"{}\"\norders = [2]\n", manifest("plants/HE1.json")), Path::new("f.toml")).unwrap();
+        let c = Campaign::from_toml_str(
+            &format!("name = \"f\"\n[[problem]]\nplant = \"{}\"\norders = [2]\n", manifest("plants/HE1.json")),
+            Path::new("f.toml"),
+        )
+        .unwrap();
         let job = &expand(&c, RunnerTag::Design)[0];
         let out = DesignOutcome {
             status: DesignStatus::Converged,
@@ -81,9 +86,38 @@ fn record_line() -> &'static str {
 
 /// Keys that the readers look for, so that generated objects hit real fields.
 const KEYS: &[&str] = &[
-    "name", "dims", "n", "m1", "m2", "p1", "p2", "A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22", "source",
-    "citation", "order", "AK", "BK", "CK", "DK", "status", "kind", "gamma", "eps", "options", "controller",
-    "schema_version", "certificate", "phases",
+    "name",
+    "dims",
+    "n",
+    "m1",
+    "m2",
+    "p1",
+    "p2",
+    "A",
+    "B1",
+    "B2",
+    "C1",
+    "C2",
+    "D11",
+    "D12",
+    "D21",
+    "D22",
+    "source",
+    "citation",
+    "order",
+    "AK",
+    "BK",
+    "CK",
+    "DK",
+    "status",
+    "kind",
+    "gamma",
+    "eps",
+    "options",
+    "controller",
+    "schema_version",
+    "certificate",
+    "phases",
 ];
 
 fn arb_key() -> impl Strategy<Value = String> {
@@ -275,8 +309,12 @@ fn arb_campaign() -> impl Strategy<Value = String> {
         prop::collection::vec(int.clone(), 0..4).prop_map(|v| format!("[{}]", v.join(", "))),
         (int.clone(), int.clone()).prop_map(|(a, b)| format!("{{ from = {a}, to = {b} }}")),
     ];
-    let seeds = prop_oneof![int.clone(), prop::collection::vec(int.clone(), 0..4).prop_map(|v| format!("[{}]", v.join(", ")))];
-    let eps = prop_oneof![float.clone(), prop::collection::vec(float.clone(), 0..3).prop_map(|v| format!("[{}]", v.join(", ")))];
+    let seeds =
+        prop_oneof![int.clone(), prop::collection::vec(int.clone(), 0..4).prop_map(|v| format!("[{}]", v.join(", ")))];
+    let eps = prop_oneof![
+        float.clone(),
+        prop::collection::vec(float.clone(), 0..3).prop_map(|v| format!("[{}]", v.join(", ")))
+    ];
     let name = prop_oneof![6 => Just("\"ok\"".to_string()), 1 => ".{0,8}".prop_map(|s| format!("{s:?}")), 1 => Just(format!("\"{}\"", "x".repeat(300)))];
     let option = prop_oneof![
         float.clone().prop_map(|v| format!("cpumax = {v}")),
@@ -303,7 +341,9 @@ fn arb_campaign() -> impl Strategy<Value = String> {
 fn campaign_target(cases: u32) -> Counts {
     // Bare plant names resolve in the project's plant library.
     std::env::set_var(hinfix::lti::PLANTS_ENV, manifest("plants"));
-    fuzz("campaign reader", cases, arb_campaign(), |text| Campaign::from_toml_str(&text, Path::new("fuzz.toml")).is_ok())
+    fuzz("campaign reader", cases, arb_campaign(), |text| {
+        Campaign::from_toml_str(&text, Path::new("fuzz.toml")).is_ok()
+    })
 }
 
 fn journal_target(cases: u32) -> Counts {
@@ -316,7 +356,8 @@ fn journal_target(cases: u32) -> Counts {
     });
     let journal = prop_oneof![
         prop::collection::vec(any::<u8>(), 0..256),
-        (mutated_line, any::<bool>()).prop_map(move |(l, nl)| format!("{line}\n{l}{}", if nl { "\n" } else { "" }).into_bytes()),
+        (mutated_line, any::<bool>())
+            .prop_map(move |(l, nl)| format!("{line}\n{l}{}", if nl { "\n" } else { "" }).into_bytes()),
         arb_edits().prop_map(move |e| apply(&format!("{line}\n{line}\n"), &e)),
     ];
     fuzz("journal reader", cases, journal, |bytes| {
@@ -347,32 +388,35 @@ fn validate_target(cases: u32) -> Counts {
         (size.clone(), float.clone(), any::<u64>(), float.clone(), size.clone()),
         (any::<bool>(), float.clone(), size.clone(), float.clone(), float.clone(), any::<bool>(), size.clone()),
     )
-        .prop_map(|((order, eps, seed, cpumax, nrand), (plain, hinf_tol, maxit, normtol, evaldist, gs, gsm))| DesignOptions {
-            order,
-            eps,
-            seed,
-            cpumax,
-            nrand,
-            objective: if plain { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
-            hinf_tol,
-            maxit,
-            normtol,
-            evaldist,
-            gradient_sampling: gs,
-            gradsamp_maxit: gsm,
-            // (options that other issues add keep their defaults)
-            ..DesignOptions::default()
+        .prop_map(|((order, eps, seed, cpumax, nrand), (plain, hinf_tol, maxit, normtol, evaldist, gs, gsm))| {
+            DesignOptions {
+                order,
+                eps,
+                seed,
+                cpumax,
+                nrand,
+                objective: if plain { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
+                hinf_tol,
+                maxit,
+                normtol,
+                evaldist,
+                gradient_sampling: gs,
+                gradsamp_maxit: gsm,
+                // (options that other issues add keep their defaults)
+                ..DesignOptions::default()
+            }
         });
-    let init = prop::option::weighted(0.3, (0usize..4, 0usize..3, 0usize..3, float.clone()).prop_map(|(nk, m, p, x)| {
-        let mut k = Controller::zeros(nk, m, p);
-        if m > 0 && p > 0 {
-            k.dk[(0, 0)] = x;
-        }
-        k
-    }));
-    fuzz("design::validate", cases, (opts, init), |(o, k)| {
-        validate(he1(), &o, k.as_ref()).is_ok()
-    })
+    let init = prop::option::weighted(
+        0.3,
+        (0usize..4, 0usize..3, 0usize..3, float.clone()).prop_map(|(nk, m, p, x)| {
+            let mut k = Controller::zeros(nk, m, p);
+            if m > 0 && p > 0 {
+                k.dk[(0, 0)] = x;
+            }
+            k
+        }),
+    );
+    fuzz("design::validate", cases, (opts, init), |(o, k)| validate(he1(), &o, k.as_ref()).is_ok())
 }
 
 fn all(cases: u32) -> Vec<(&'static str, Counts)> {
@@ -401,7 +445,12 @@ fn readers_never_panic_full() {
     let counts = all(FULL_CASES);
     let total: usize = counts.iter().map(|c| c.1.tried).sum();
     for (name, c) in &counts {
-        eprintln!("fuzz {name:<20} {:>7} inputs ({:>6} accepted, {:>6} clear errors), 0 panics", c.tried, c.accepted, c.tried - c.accepted);
+        eprintln!(
+            "fuzz {name:<20} {:>7} inputs ({:>6} accepted, {:>6} clear errors), 0 panics",
+            c.tried,
+            c.accepted,
+            c.tried - c.accepted
+        );
     }
     eprintln!("fuzz total {total} inputs, 0 panics, {:.1} s", t.elapsed().as_secs_f64());
     assert!(total >= 100_000, "{total}");

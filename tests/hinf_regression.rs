@@ -45,8 +45,16 @@ fn my3_with_second_order_controller_reaches_the_true_peak() {
     assert!(PEAK / sigma_d - 1.0 < 5e-6, "the case must stay in the γ ≈ σmax(D) regime");
 
     let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
-    assert!(h.value >= PEAK * (1.0 - 2.0 * DEFAULT_HINF_TOL), "‖Tzw‖∞ = {} at ω = {}, below the peak {PEAK}", h.value, h.peak_freq);
-    assert!((sigma_direct(&cl, h.peak_freq) - h.value).abs() <= 1e-12 * h.value, "the value is attained at the returned frequency");
+    assert!(
+        h.value >= PEAK * (1.0 - 2.0 * DEFAULT_HINF_TOL),
+        "‖Tzw‖∞ = {} at ω = {}, below the peak {PEAK}",
+        h.value,
+        h.peak_freq
+    );
+    assert!(
+        (sigma_direct(&cl, h.peak_freq) - h.value).abs() <= 1e-12 * h.value,
+        "the value is attained at the returned frequency"
+    );
     assert!(h.value <= PEAK * (1.0 + 1e-12), "{} exceeds the peak", h.value);
     assert!((h.peak_freq / PEAK_FREQ).ln().abs() < 1e-3, "peak at {} instead of {PEAK_FREQ}", h.peak_freq);
 

@@ -3,7 +3,9 @@
 //! optimiser takes bit-for-bit the same path as with the full evaluation — and it must happen.
 
 use hinfix::optim::test_problems::MaxQuad;
-use hinfix::optim::{hanso, random_starts, BfgsOptions, GradSampOptions, HansoOptions, NoObserver, Objective, RunControl};
+use hinfix::optim::{
+    hanso, random_starts, BfgsOptions, GradSampOptions, HansoOptions, NoObserver, Objective, RunControl,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 

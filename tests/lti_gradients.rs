@@ -109,7 +109,9 @@ fn gradients_match_finite_differences() {
 
         // α(Acl)
         let (alpha, g) = closed_loop_abscissa_grad(&plant, &k).unwrap();
-        check_fd(&format!("{label} α_cl"), &k, &g, |kk| spectral_abscissa(closed_loop(&plant, kk).unwrap().a.as_ref()));
+        check_fd(&format!("{label} α_cl"), &k, &g, |kk| {
+            spectral_abscissa(closed_loop(&plant, kk).unwrap().a.as_ref())
+        });
         // ‖Tzw‖∞ (only where the loop is stable)
         if alpha < 0.0 {
             let (h, g) = closed_loop_hinf_grad(&plant, &k, FD_HINF_TOL).unwrap();

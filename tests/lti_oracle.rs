@@ -137,7 +137,11 @@ fn check_hinfnorm_cases(dir: &str, attained_tol: f64) {
             continue;
         }
         if !close(got.value, want, 0.0) {
-            failures.push(format!("{name} ({kind}): hinf {} vs {want} (rel {:.2e})", got.value, (got.value - want).abs() / want));
+            failures.push(format!(
+                "{name} ({kind}): hinf {} vs {want} (rel {:.2e})",
+                got.value,
+                (got.value - want).abs() / want
+            ));
         }
         if kind == "lightly-damped" {
             let wf = num(&doc["peak_freq"]).unwrap();
@@ -200,7 +204,12 @@ fn closed_loop_cases_match_slicot() {
         if h.value.is_finite() {
             assert!((h2.value - h.value).abs() <= 1e-12 * h.value, "{name}");
             assert!(g.dk.norm_l2().is_finite(), "{name}");
-            eprintln!("{name:22} hinf {:.12e} at ω = {:.6e} (oracle ω = {:?})", h.value, h.peak_freq, num(&exp["closed_loop_peak_freq"]));
+            eprintln!(
+                "{name:22} hinf {:.12e} at ω = {:.6e} (oracle ω = {:?})",
+                h.value,
+                h.peak_freq,
+                num(&exp["closed_loop_peak_freq"])
+            );
         } else {
             assert!(g.dk[(0, 0)].is_nan(), "{name}: unstable loop must give a NaN gradient");
         }

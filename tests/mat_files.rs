@@ -49,7 +49,15 @@ fn same_plant_as_mat_and_json_gives_bit_identical_designs() {
     let json = he1_json();
     let mat = Plant::load(fixture("HE1.mat")).unwrap();
     // Short deterministic runs (iteration limits, not the CPU budget, end them).
-    let opts = DesignOptions { order: 1, seed: 3, nrand: 1, maxit: 40, cpumax: 60.0, gradient_sampling: false, ..Default::default() };
+    let opts = DesignOptions {
+        order: 1,
+        seed: 3,
+        nrand: 1,
+        maxit: 40,
+        cpumax: 60.0,
+        gradient_sampling: false,
+        ..Default::default()
+    };
     let a = run(&json, &opts, None, &mut NoDesignObserver).unwrap();
     let b = run(&mat, &opts, None, &mut NoDesignObserver).unwrap();
     assert_eq!(a.controller, b.controller);
@@ -116,7 +124,10 @@ fn bad_files_name_the_file_and_the_variable() {
     assert!(e.contains("matrix `A` is missing"), "{e}");
     // Shapes are checked as for JSON: a controller whose BK has the wrong height.
     let k = Controller::load(fixture("K2.json")).unwrap();
-    let bad = hinfix::lti::mat_file::write_mat(&[("AK", k.ak.as_ref()), ("BK", k.ck.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())], "bad");
+    let bad = hinfix::lti::mat_file::write_mat(
+        &[("AK", k.ak.as_ref()), ("BK", k.ck.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())],
+        "bad",
+    );
     let kp = dir.path().join("k.mat");
     std::fs::write(&kp, bad).unwrap();
     let e = Controller::load(&kp).unwrap_err().to_string();
@@ -124,7 +135,11 @@ fn bad_files_name_the_file_and_the_variable() {
 }
 
 fn cli(args: &[&str]) -> std::process::Output {
-    let out = Command::new(BIN).args(args).env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants")).output().unwrap();
+    let out = Command::new(BIN)
+        .args(args)
+        .env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"))
+        .output()
+        .unwrap();
     assert!(out.status.success(), "campaign {args:?} failed: {}", String::from_utf8_lossy(&out.stderr));
     out
 }
@@ -153,7 +168,8 @@ fn command_line_designs_into_mat_checks_plots_and_exports_it() {
     assert!(p.contains("K = control.ss(AK, BK, CK, DK)") && p.contains("import control"), "{p}");
     // The printed DK reads back to the controller's exact value.
     let dk_line = m.lines().find(|l| l.starts_with("DK = [")).unwrap();
-    let first: f64 = dk_line.trim_start_matches("DK = [").split([',', ';', ']']).next().unwrap().trim().parse().unwrap();
+    let first: f64 =
+        dk_line.trim_start_matches("DK = [").split([',', ';', ']']).next().unwrap().trim().parse().unwrap();
     assert_eq!(first.to_bits(), kk.dk[(0, 0)].to_bits());
 }
 
@@ -163,7 +179,14 @@ fn a_campaign_may_name_a_mat_plant_and_gets_the_same_job_ids() {
     let dir = tempfile::tempdir().unwrap();
     let ids = |plant: &Path| {
         let f = dir.path().join("c.toml");
-        std::fs::write(&f, format!("name = \"m\"\n[defaults]\nseeds = 2\n[[problem]]\nplant = \"{}\"\norders = [1, 2]\n", plant.display())).unwrap();
+        std::fs::write(
+            &f,
+            format!(
+                "name = \"m\"\n[defaults]\nseeds = 2\n[[problem]]\nplant = \"{}\"\norders = [1, 2]\n",
+                plant.display()
+            ),
+        )
+        .unwrap();
         let c = Campaign::load(&f).unwrap_or_else(|e| panic!("{e}"));
         expand(&c, RunnerTag::Design).into_iter().map(|j| j.id.0).collect::<Vec<_>>()
     };

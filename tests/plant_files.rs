@@ -1,7 +1,7 @@
 //! The shipped plant library loads, and malformed plant files are rejected with errors that name
 //! the file, the field and what is wrong.
 
-use hinfix::lti::{Plant, PlantErrorKind, MatrixJsonError};
+use hinfix::lti::{MatrixJsonError, Plant, PlantErrorKind};
 use serde_json::{json, Value};
 
 fn plants_dir() -> std::path::PathBuf {
@@ -11,7 +11,8 @@ fn plants_dir() -> std::path::PathBuf {
 #[test]
 fn every_shipped_plant_loads_with_the_papers_order() {
     // (name, n) as the paper's Tables VII and VIII state them.
-    let expected = [("AC8", 9), ("HE1", 4), ("REA2", 4), ("AC10", 55), ("BDT2", 82), ("HF1", 130), ("CM4", 240), ("Enns", 8)];
+    let expected =
+        [("AC8", 9), ("HE1", 4), ("REA2", 4), ("AC10", 55), ("BDT2", 82), ("HF1", 130), ("CM4", 240), ("Enns", 8)];
     for (name, n) in expected {
         let p = Plant::load(plants_dir().join(format!("{name}.json"))).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(p.name, name);
@@ -54,36 +55,149 @@ fn a_valid_file_loads() {
 fn bad_plant_files_each_get_their_own_error() {
     type Check = fn(&PlantErrorKind) -> bool;
     let cases: Vec<(&str, String, Check, &str)> = vec![
-        ("malformed JSON", "{\"name\": \"T\", ".to_string(),
-            |k| matches!(k, PlantErrorKind::Json { line: 1, .. }), "invalid JSON at line 1"),
-        ("not an object", "[1, 2]".to_string(),
-            |k| matches!(k, PlantErrorKind::NotObject), "top level"),
-        ("missing name", with(|o| { o.remove("name"); }),
-            |k| matches!(k, PlantErrorKind::MissingField { field: "name" }), "`name` is missing"),
-        ("missing dims", with(|o| { o.remove("dims"); }),
-            |k| matches!(k, PlantErrorKind::MissingField { field: "dims" }), "`dims` is missing"),
-        ("negative dimension", with(|o| { o["dims"]["m1"] = json!(-1); }),
-            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.m1"), "dims.m1"),
-        ("unknown dims key", with(|o| { o["dims"]["q"] = json!(1); }),
-            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.q"), "unknown key"),
-        ("missing matrix", with(|o| { o.remove("C2"); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "C2", problem: MatrixJsonError::Missing, .. }), "`C2` is missing"),
-        ("wrong row count", with(|o| { o["A"] = json!([[-1.0, 0.0]]); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "A", problem: MatrixJsonError::RowCount { expected: 2, got: 1 }, .. }), "expected 2×2"),
-        ("ragged row", with(|o| { o["B1"] = json!([[1.0], [0.0, 3.0]]); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "B1", problem: MatrixJsonError::RowLength { row: 2, .. }, .. }), "row 2"),
-        ("NaN as a string", with(|o| { o["A"] = json!([[-1.0, "NaN"], [0.0, -2.0]]); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "A", problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. }, .. }), "entry (1, 2)"),
-        ("null entry", with(|o| { o["C1"] = json!([[1.0, null]]); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "C1", problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. }, .. }), "not a number"),
-        ("wrong D22 shape", with(|o| { o["D22"] = json!([[0.0, 0.0]]); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "D22", problem: MatrixJsonError::RowLength { .. }, .. }), "p2×m2"),
-        ("matrix not an array", with(|o| { o["D11"] = json!(0.0); }),
-            |k| matches!(k, PlantErrorKind::Matrix { matrix: "D11", problem: MatrixJsonError::NotArray { .. }, .. }), "array of rows"),
-        ("order disagrees with dims", with(|o| { o.insert("order".into(), json!(3)); }),
-            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "order"), "dims.n is 2"),
-        ("name not a string", with(|o| { o["name"] = json!(7); }),
-            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "name"), "non-empty string"),
+        (
+            "malformed JSON",
+            "{\"name\": \"T\", ".to_string(),
+            |k| matches!(k, PlantErrorKind::Json { line: 1, .. }),
+            "invalid JSON at line 1",
+        ),
+        ("not an object", "[1, 2]".to_string(), |k| matches!(k, PlantErrorKind::NotObject), "top level"),
+        (
+            "missing name",
+            with(|o| {
+                o.remove("name");
+            }),
+            |k| matches!(k, PlantErrorKind::MissingField { field: "name" }),
+            "`name` is missing",
+        ),
+        (
+            "missing dims",
+            with(|o| {
+                o.remove("dims");
+            }),
+            |k| matches!(k, PlantErrorKind::MissingField { field: "dims" }),
+            "`dims` is missing",
+        ),
+        (
+            "negative dimension",
+            with(|o| {
+                o["dims"]["m1"] = json!(-1);
+            }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.m1"),
+            "dims.m1",
+        ),
+        (
+            "unknown dims key",
+            with(|o| {
+                o["dims"]["q"] = json!(1);
+            }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.q"),
+            "unknown key",
+        ),
+        (
+            "missing matrix",
+            with(|o| {
+                o.remove("C2");
+            }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "C2", problem: MatrixJsonError::Missing, .. }),
+            "`C2` is missing",
+        ),
+        (
+            "wrong row count",
+            with(|o| {
+                o["A"] = json!([[-1.0, 0.0]]);
+            }),
+            |k| {
+                matches!(
+                    k,
+                    PlantErrorKind::Matrix {
+                        matrix: "A",
+                        problem: MatrixJsonError::RowCount { expected: 2, got: 1 },
+                        ..
+                    }
+                )
+            },
+            "expected 2×2",
+        ),
+        (
+            "ragged row",
+            with(|o| {
+                o["B1"] = json!([[1.0], [0.0, 3.0]]);
+            }),
+            |k| {
+                matches!(
+                    k,
+                    PlantErrorKind::Matrix { matrix: "B1", problem: MatrixJsonError::RowLength { row: 2, .. }, .. }
+                )
+            },
+            "row 2",
+        ),
+        (
+            "NaN as a string",
+            with(|o| {
+                o["A"] = json!([[-1.0, "NaN"], [0.0, -2.0]]);
+            }),
+            |k| {
+                matches!(
+                    k,
+                    PlantErrorKind::Matrix {
+                        matrix: "A",
+                        problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. },
+                        ..
+                    }
+                )
+            },
+            "entry (1, 2)",
+        ),
+        (
+            "null entry",
+            with(|o| {
+                o["C1"] = json!([[1.0, null]]);
+            }),
+            |k| {
+                matches!(
+                    k,
+                    PlantErrorKind::Matrix {
+                        matrix: "C1",
+                        problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. },
+                        ..
+                    }
+                )
+            },
+            "not a number",
+        ),
+        (
+            "wrong D22 shape",
+            with(|o| {
+                o["D22"] = json!([[0.0, 0.0]]);
+            }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "D22", problem: MatrixJsonError::RowLength { .. }, .. }),
+            "p2×m2",
+        ),
+        (
+            "matrix not an array",
+            with(|o| {
+                o["D11"] = json!(0.0);
+            }),
+            |k| matches!(k, PlantErrorKind::Matrix { matrix: "D11", problem: MatrixJsonError::NotArray { .. }, .. }),
+            "array of rows",
+        ),
+        (
+            "order disagrees with dims",
+            with(|o| {
+                o.insert("order".into(), json!(3));
+            }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "order"),
+            "dims.n is 2",
+        ),
+        (
+            "name not a string",
+            with(|o| {
+                o["name"] = json!(7);
+            }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "name"),
+            "non-empty string",
+        ),
     ];
     for (what, text, check, msg) in cases {
         let e = Plant::from_json_str(&text, "bad/plant.json").expect_err(what);

@@ -28,7 +28,13 @@ fn check_svg(text: &str, what: &str) {
     let doc = roxmltree::Document::parse(text).unwrap_or_else(|e| panic!("{what}: SVG does not parse: {e}"));
     assert_eq!(doc.root_element().tag_name().name(), "svg", "{what}");
     assert!(doc.descendants().any(|n| n.has_tag_name("text")), "{what}: no text");
-    assert!(doc.descendants().filter(|n| n.has_tag_name("polyline") || n.has_tag_name("path") || n.has_tag_name("line")).count() > 5, "{what}: no lines");
+    assert!(
+        doc.descendants()
+            .filter(|n| n.has_tag_name("polyline") || n.has_tag_name("path") || n.has_tag_name("line"))
+            .count()
+            > 5,
+        "{what}: no lines"
+    );
 }
 
 #[test]
@@ -55,13 +61,20 @@ fn every_figure_kind_is_rendered_for_a_small_real_campaign() {
     let listed = String::from_utf8_lossy(&out.stdout).to_string();
     let plots = results.join("p").join("plots");
     let mut expected: Vec<PathBuf> = Vec::new();
-    for stem in ["gamma-vs-order_REA2", "convergence_REA2_nK1", "convergence_REA2_nK2", "sigma_REA2_nK1", "sigma_REA2_nK2"] {
+    for stem in
+        ["gamma-vs-order_REA2", "convergence_REA2_nK1", "convergence_REA2_nK2", "sigma_REA2_nK1", "sigma_REA2_nK2"]
+    {
         for ext in ["png", "svg"] {
             expected.push(plots.join(format!("{stem}.{ext}")));
         }
     }
     for f in &expected {
-        assert!(f.is_file(), "{} missing; plot printed:\n{listed}\n{}", f.display(), String::from_utf8_lossy(&out.stderr));
+        assert!(
+            f.is_file(),
+            "{} missing; plot printed:\n{listed}\n{}",
+            f.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
         assert!(listed.contains(&f.display().to_string()), "{} not listed", f.display());
         let what = f.display().to_string();
         if f.extension().unwrap() == "png" {
@@ -99,7 +112,10 @@ fn convergence_marks_phases_and_restarts_and_renders() {
     check_svg(&svg_text(&fig, p).unwrap(), "convergence");
 
     // No CPU clock (the test runner's traces): drawn against the iteration count.
-    let flat = ConvergenceFigure { title: "flat".into(), iterations: (0..5).map(|i| it("optimisation", 0, i, 1.0, 0.0)).collect() };
+    let flat = ConvergenceFigure {
+        title: "flat".into(),
+        iterations: (0..5).map(|i| it("optimisation", 0, i, 1.0, 0.0)).collect(),
+    };
     assert!(!flat.x_is_cpu());
     check_svg(&svg_text(&flat, p).unwrap(), "flat convergence");
 }
@@ -113,7 +129,12 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
         full_order: Some((1e-6, false)),
     };
     assert!(pa.log_axis());
-    let he1 = GammaOrderFigure { plant: "HE1".into(), ours: vec![(1, 0.124), (2, 0.11)], paper: vec![(1, 0.1235)], full_order: Some((0.0737, false)) };
+    let he1 = GammaOrderFigure {
+        plant: "HE1".into(),
+        ours: vec![(1, 0.124), (2, 0.11)],
+        paper: vec![(1, 0.1235)],
+        full_order: Some((0.0737, false)),
+    };
     assert!(!he1.log_axis());
     let p = Path::new("g.png");
     for fig in [&pa, &he1] {

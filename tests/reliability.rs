@@ -111,7 +111,10 @@ fn item1_non_finite_values_in_every_numeric_field_round_trip_through_the_journal
     }
     let text = std::fs::read_to_string(&path).unwrap();
     // (`warm_from: null` is an absent predecessor, not a number)
-    assert!(!text.replace("\"warm_from\":null", "").contains("null"), "a non-finite number was written as null: {text}");
+    assert!(
+        !text.replace("\"warm_from\":null", "").contains("null"),
+        "a non-finite number was written as null: {text}"
+    );
     let read = read_journal(&path).unwrap();
     assert!(read.torn.is_none());
     assert_eq!(read.records.len(), 4);
@@ -211,17 +214,29 @@ fn item2_huge_counts_are_clear_errors() {
         assert!(e.location.line >= 3, "{problem} → {e}");
         assert!(e.to_string().contains(word), "{problem} → {e}");
     }
-    let e = campaign("name = \"t\"\n[defaults]\nthreads = 100000\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap_err();
+    let e = campaign("name = \"t\"\n[defaults]\nthreads = 100000\n[[problem]]\nplant = \"HE1\"\norders = [1]\n")
+        .unwrap_err();
     assert!(e.to_string().contains("1..=256"), "{e}");
     // 4 orders × 3 ε × 10 000 seeds × 3 problems > 100 000 jobs.
     let p = "[[problem]]\nplant = \"HE1\"\norders = [1, 2, 3, 4]\neps = [1e-1, 1e-2, 1e-3]\nseeds = 10000\n";
-    let e = campaign(&format!("name = \"t\"\n{p}{}{}", p.replace("1e-1", "2e-1"), p.replace("1e-1", "3e-1"))).unwrap_err();
+    let e =
+        campaign(&format!("name = \"t\"\n{p}{}{}", p.replace("1e-1", "2e-1"), p.replace("1e-1", "3e-1"))).unwrap_err();
     assert!(e.to_string().contains("100000 jobs"), "{e}");
 
     for n in ["100000000", "18446744073709551615"] {
         let dir = scratch("nrand");
         let out = dir.join("K.json");
-        let (code, _, err) = output(&mut cli(&["design", "--plant", "HE1", "--order", "1", "--nrand", n, "--out", out.to_str().unwrap()]));
+        let (code, _, err) = output(&mut cli(&[
+            "design",
+            "--plant",
+            "HE1",
+            "--order",
+            "1",
+            "--nrand",
+            n,
+            "--out",
+            out.to_str().unwrap(),
+        ]));
         assert_eq!(code, Some(1), "{err}");
         assert!(err.contains("nrand") && err.contains("1..=10000"), "{err}");
         assert_no_panic(&err);
@@ -254,7 +269,10 @@ fn item3_campaign_check_calls_design_validate_before_any_job() {
     let dir = scratch("validate");
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [9]\n").unwrap();
-    let (code, _, err) = output(cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"]).env(FAKE_RUNNER_ENV, "1"));
+    let (code, _, err) = output(
+        cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
+            .env(FAKE_RUNNER_ENV, "1"),
+    );
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("c.toml:4:10") && err.contains("order"), "{err}");
     assert!(!dir.join("r/t/runs.jsonl").exists());
@@ -290,7 +308,21 @@ fn item4_dev_zero_as_any_input_is_a_clear_error() {
 
 /// A stable random plant of order n (as a JSON file).
 fn big_plant(dir: &Path, n: usize) -> PathBuf {
-    let a: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| if i == j { -1.0 - i as f64 } else if j == i + 1 { 0.1 } else { 0.0 }).collect()).collect();
+    let a: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    if i == j {
+                        -1.0 - i as f64
+                    } else if j == i + 1 {
+                        0.1
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect();
     let col = |k: usize| -> Vec<Vec<f64>> { (0..n).map(|i| vec![((i + k) % 3) as f64; 1]).collect() };
     let row = |k: usize| -> Vec<Vec<f64>> { vec![(0..n).map(|i| ((i + k) % 2) as f64).collect()] };
     let doc = serde_json::json!({
@@ -317,7 +349,8 @@ fn item4_full_order_gamma_is_skipped_above_the_documented_n() {
 
 fn slow_campaign(dir: &Path) -> PathBuf {
     let f = dir.join("c.toml");
-    std::fs::write(&f, "name = \"t\"\n[defaults]\nseeds = 40\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n").unwrap();
+    std::fs::write(&f, "name = \"t\"\n[defaults]\nseeds = 40\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n")
+        .unwrap();
     f
 }
 
@@ -403,7 +436,10 @@ fn item6_hostile_names_reach_no_output_raw() {
     std::fs::write(dir.join("evil.json"), doc.to_string()).unwrap();
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"evil.json\"\norders = [1]\n").unwrap();
-    let (code, out, err) = output(cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"]).env(FAKE_RUNNER_ENV, "1"));
+    let (code, out, err) = output(
+        cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
+            .env(FAKE_RUNNER_ENV, "1"),
+    );
     assert_eq!(code, Some(0), "{err}");
     for (what, s) in [("stdout", out.as_str()), ("stderr", err.as_str())] {
         assert!(!s.contains('\u{1b}') && !s.contains('\u{0}'), "{what}: {s:?}");
@@ -438,15 +474,38 @@ fn item7_design_and_check_exit_4_when_not_stabilised() {
     let p = dir.join("u.json");
     std::fs::write(&p, plant).unwrap();
     let k = dir.join("K.json");
-    let (code, out, err) = output(&mut cli(&["design", "--plant", p.to_str().unwrap(), "--order", "0", "--cpumax", "2", "--nrand", "1", "--out", k.to_str().unwrap()]));
+    let (code, out, err) = output(&mut cli(&[
+        "design",
+        "--plant",
+        p.to_str().unwrap(),
+        "--order",
+        "0",
+        "--cpumax",
+        "2",
+        "--nrand",
+        "1",
+        "--out",
+        k.to_str().unwrap(),
+    ]));
     assert_eq!(code, Some(4), "{out}{err}");
     assert!(out.contains("NOT STABILISED"), "{out}");
-    let (code, out, err) = output(&mut cli(&["check", "--plant", p.to_str().unwrap(), "--controller", k.to_str().unwrap()]));
+    let (code, out, err) =
+        output(&mut cli(&["check", "--plant", p.to_str().unwrap(), "--controller", k.to_str().unwrap()]));
     assert_eq!(code, Some(4), "{out}{err}");
     assert!(out.contains("UNSTABLE"), "{out}");
     // a stabilising controller: exit 0
     let good = dir.join("G.json");
-    let (code, _, err) = output(&mut cli(&["design", "--plant", "REA2", "--order", "0", "--cpumax", "5", "--out", good.to_str().unwrap()]));
+    let (code, _, err) = output(&mut cli(&[
+        "design",
+        "--plant",
+        "REA2",
+        "--order",
+        "0",
+        "--cpumax",
+        "5",
+        "--out",
+        good.to_str().unwrap(),
+    ]));
     assert_eq!(code, Some(0), "{err}");
     let (code, _, err) = output(&mut cli(&["check", "--plant", "REA2", "--controller", good.to_str().unwrap()]));
     assert_eq!(code, Some(0), "{err}");
@@ -479,7 +538,8 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
     // A real run: the status says whether the certificate was met.
     let p = Plant::load(format!("{PLANTS}/REA2.json")).unwrap();
     for maxit in [2, 1000] {
-        let opts = DesignOptions { order: 1, seed: 1, cpumax: 20.0, maxit, gradient_sampling: false, ..Default::default() };
+        let opts =
+            DesignOptions { order: 1, seed: 1, cpumax: 20.0, maxit, gradient_sampling: false, ..Default::default() };
         let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
         match o.status {
             DesignStatus::Converged => assert!(o.dnorm.unwrap() <= opts.normtol, "{o:?}"),
@@ -505,7 +565,21 @@ fn item7_controller_norm_term_is_flagged() {
     }
     let dir = scratch("normflag");
     let k = dir.join("K.json");
-    let (code, out, err) = output(&mut cli(&["design", "--plant", "REA2", "--order", "0", "--eps", "1e3", "--cpumax", "5", "--nrand", "1", "--out", k.to_str().unwrap()]));
+    let (code, out, err) = output(&mut cli(&[
+        "design",
+        "--plant",
+        "REA2",
+        "--order",
+        "0",
+        "--eps",
+        "1e3",
+        "--cpumax",
+        "5",
+        "--nrand",
+        "1",
+        "--out",
+        k.to_str().unwrap(),
+    ]));
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("controller-norm penalty"), "{out}");
 }
@@ -551,14 +625,25 @@ fn item9_error_texts() {
     assert!(!err.contains(":0:0") && err.contains("/no/such/c.toml: cannot read"), "{err}");
     // --out <directory> fails before the design, leaving nothing
     let t = Instant::now();
-    let (code, _, err) = output(&mut cli(&["design", "--plant", "HE1", "--order", "1", "--cpumax", "30", "--out", dir.to_str().unwrap()]));
+    let (code, _, err) = output(&mut cli(&[
+        "design",
+        "--plant",
+        "HE1",
+        "--order",
+        "1",
+        "--cpumax",
+        "30",
+        "--out",
+        dir.to_str().unwrap(),
+    ]));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("is a directory"), "{err}");
     assert!(t.elapsed() < Duration::from_secs(5), "the design ran first: {:?}", t.elapsed());
     assert!(std::fs::read_dir(&dir).unwrap().next().is_none(), "left files behind");
     // --eps -1 is a number, and ε must be > 0
     let k = dir.join("K.json");
-    let (code, _, err) = output(&mut cli(&["design", "--plant", "HE1", "--order", "1", "--eps", "-1", "--out", k.to_str().unwrap()]));
+    let (code, _, err) =
+        output(&mut cli(&["design", "--plant", "HE1", "--order", "1", "--eps", "-1", "--out", k.to_str().unwrap()]));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("ε must be finite and positive (> 0), got -1"), "{err}");
     // did you mean
@@ -566,7 +651,21 @@ fn item9_error_texts() {
     assert_eq!(code, Some(1));
     assert!(err.contains("did you mean `HE1`?"), "{err}");
     // a huge ε prints numbers in scientific notation
-    let (code, out, err) = output(&mut cli(&["design", "--plant", "REA2", "--order", "0", "--eps", "1e300", "--cpumax", "2", "--nrand", "1", "--out", k.to_str().unwrap()]));
+    let (code, out, err) = output(&mut cli(&[
+        "design",
+        "--plant",
+        "REA2",
+        "--order",
+        "0",
+        "--eps",
+        "1e300",
+        "--cpumax",
+        "2",
+        "--nrand",
+        "1",
+        "--out",
+        k.to_str().unwrap(),
+    ]));
     assert!(code == Some(0) || code == Some(4), "{err}");
     let longest = out.split_whitespace().map(str::len).max().unwrap_or(0);
     assert!(longest < 40, "a {longest}-character word in: {out}");

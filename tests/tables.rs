@@ -12,7 +12,19 @@ use hinfix::campaign::{load_reference, REFERENCE_CSV};
 mod common;
 
 fn row(plant: &str, order: usize, gamma: f64) -> BestRow {
-    BestRow { plant: plant.into(), plant_fingerprint: format!("fp-{plant}"), order, gamma, job_id: Some("j".into()), eps: Some(1e-3), seed: Some(0), runs: 2, verified: 1, failed: 1, unverified: 0 }
+    BestRow {
+        plant: plant.into(),
+        plant_fingerprint: format!("fp-{plant}"),
+        order,
+        gamma,
+        job_id: Some("j".into()),
+        eps: Some(1e-3),
+        seed: Some(0),
+        runs: 2,
+        verified: 1,
+        failed: 1,
+        unverified: 0,
+    }
 }
 
 #[test]
@@ -31,14 +43,21 @@ fn four_significant_figures_not_four_decimals() {
 #[test]
 fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_used() {
     let reference = load_reference(&Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE_CSV)).unwrap();
-    let best = vec![row("PA", 1, 0.000351), row("PA", 2, 0.0003498), row("ZerenOzbay", 3, 35.0), row("ZerenOzbay", 5, 34.9), row("My_Plant", 1, 2.5)];
+    let best = vec![
+        row("PA", 1, 0.000351),
+        row("PA", 2, 0.0003498),
+        row("ZerenOzbay", 3, 35.0),
+        row("ZerenOzbay", 5, 34.9),
+        row("My_Plant", 1, 2.5),
+    ];
     let full = vec![
         FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: false },
         FullOrderRow { plant: "ZerenOzbay".into(), gamma: 34.24, from_paper: false },
     ];
     let tex = tables_tex(&best, &full, &reference);
     let block = |p: &str| {
-        let start = tex.find(&format!("\\label{{tab:hinfix-{p}}}")).unwrap_or_else(|| panic!("no label for {p}:\n{tex}"));
+        let start =
+            tex.find(&format!("\\label{{tab:hinfix-{p}}}")).unwrap_or_else(|| panic!("no label for {p}:\n{tex}"));
         let end = start + tex[start..].find("\\end{table}").unwrap();
         tex[start..end].to_string()
     };

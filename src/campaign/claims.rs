@@ -153,7 +153,8 @@ impl ClaimDir {
         // A few rounds at most: each retry means a finishing owner unlinked the file in between
         // (or we broke an overdue claim).
         for _ in 0..16 {
-            let mut file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).map_err(err)?;
+            let mut file =
+                OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).map_err(err)?;
             match file.try_lock() {
                 Ok(()) => {}
                 Err(std::fs::TryLockError::WouldBlock) => {
@@ -200,7 +201,8 @@ impl ClaimDir {
             let p = p.to_path_buf();
             move |source| ClaimError { path: p, source }
         };
-        let lock = OpenOptions::new().write(true).create(true).truncate(false).open(&lock_path).map_err(err(&lock_path))?;
+        let lock =
+            OpenOptions::new().write(true).create(true).truncate(false).open(&lock_path).map_err(err(&lock_path))?;
         lock.lock().map_err(err(&lock_path))?;
         // Under the break lock, look again: another process may have broken it already.
         let mut again = match File::open(&path) {
@@ -312,7 +314,9 @@ mod tests {
         let claims = ClaimDir::new(dir.path());
         let id = JobId("ef".repeat(32));
         let old = unix_now() - overdue_after(10.0) - 1.0;
-        for (host, since, broken) in [("elsewhere", old, true), ("elsewhere", unix_now(), false), (owner().host.as_str(), old, false)] {
+        for (host, since, broken) in
+            [("elsewhere", old, true), ("elsewhere", unix_now(), false), (owner().host.as_str(), old, false)]
+        {
             let ghost = ClaimOwner { host: host.to_string(), since_unix_s: since, ..owner() };
             let TryClaim::Claimed(g) = claims.try_claim(&id, 10.0, &ghost).unwrap() else { panic!() };
             match claims.try_claim(&id, 10.0, &owner()).unwrap() {

@@ -15,7 +15,10 @@ use sha2::{Digest, Sha256};
 
 use super::jobs::{Job, RunnerTag};
 use super::scheduler::JobRunner;
-use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats, SearchStop, SearchSummary};
+use crate::design::{
+    DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats, SearchStop,
+    SearchSummary,
+};
 use crate::lti::Controller;
 
 /// The hidden variable that selects the fake runner; its value is the pause between fake
@@ -61,7 +64,12 @@ fn unit(parts: &[&[u8]]) -> f64 {
 }
 
 impl JobRunner for FakeRunner {
-    fn run(&self, job: &Job, init: Option<&Controller>, obs: &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> {
+    fn run(
+        &self,
+        job: &Job,
+        init: Option<&Controller>,
+        obs: &mut dyn DesignObserver,
+    ) -> Result<DesignOutcome, DesignError> {
         let init_text = init.map(|k| k.to_json().to_string()).unwrap_or_default();
         let seed = unit(&[job.id.0.as_bytes(), init_text.as_bytes()]);
         // warm starts improve on the predecessor, as a real chain tends to
@@ -115,7 +123,13 @@ impl JobRunner for FakeRunner {
             iters,
             evals: iters,
             cpu_s: 0.0,
-            search: SearchSummary { starts: 1, best_start: 0, cpu_to_best_s: 0.0, evals_to_best: iters, stop: SearchStop::Starts },
+            search: SearchSummary {
+                starts: 1,
+                best_start: 0,
+                cpu_to_best_s: 0.0,
+                evals_to_best: iters,
+                stop: SearchStop::Starts,
+            },
         })
     }
 }

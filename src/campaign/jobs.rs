@@ -82,7 +82,13 @@ pub struct Job {
 impl Job {
     /// `HE1 n_K=2 ε=1e-3 seed=4`.
     pub fn label(&self) -> String {
-        format!("{} n_K={} ε={:e} seed={}", super::sanitise::for_terminal(&self.plant_name), self.options.order, self.options.eps, self.options.seed)
+        format!(
+            "{} n_K={} ε={:e} seed={}",
+            super::sanitise::for_terminal(&self.plant_name),
+            self.options.order,
+            self.options.eps,
+            self.options.seed
+        )
     }
 }
 

@@ -141,20 +141,31 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
             None => (bytes.len(), false),
         };
         let raw = &bytes[offset..end];
-        let torn = |reason: String| TornTail { line: line_no, offset: offset as u64, len: bytes.len() - offset, reason };
+        let torn =
+            |reason: String| TornTail { line: line_no, offset: offset as u64, len: bytes.len() - offset, reason };
         if !complete {
             out.torn = Some(torn("no trailing newline (the write was cut short)".into()));
             break;
         }
         let text = match std::str::from_utf8(raw) {
             Ok(t) => t.trim(),
-            Err(e) => return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, message: format!("not UTF-8: {e}") }),
+            Err(e) => {
+                return Err(JournalError::Corrupt {
+                    path: path.to_path_buf(),
+                    line: line_no,
+                    message: format!("not UTF-8: {e}"),
+                })
+            }
         };
         if !text.is_empty() {
             match parse_line(text) {
                 Ok(r) => out.records.push(r),
-                Err(Err(found)) => return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found }),
-                Err(Ok(message)) => return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, message }),
+                Err(Err(found)) => {
+                    return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found })
+                }
+                Err(Ok(message)) => {
+                    return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, message })
+                }
             }
         }
         offset = end + 1;
@@ -318,8 +329,12 @@ impl Follower {
                 Err(e) => return Err(io_err(&path)(e)),
             }
             let read = parse_journal(&bytes, &path).map_err(|e| match e {
-                JournalError::Corrupt { path, line, message } => JournalError::Corrupt { path, line: line + tail.lines, message },
-                JournalError::NewerSchema { path, line, found } => JournalError::NewerSchema { path, line: line + tail.lines, found },
+                JournalError::Corrupt { path, line, message } => {
+                    JournalError::Corrupt { path, line: line + tail.lines, message }
+                }
+                JournalError::NewerSchema { path, line, found } => {
+                    JournalError::NewerSchema { path, line: line + tail.lines, found }
+                }
                 e => e,
             })?;
             let consumed = read.torn.as_ref().map_or(bytes.len(), |t| t.offset as usize);

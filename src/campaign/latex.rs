@@ -29,7 +29,11 @@ pub fn escape(s: &str) -> String {
 
 /// γ to 4 decimals, `--` when not finite.
 pub fn num(x: f64) -> String {
-    if x.is_finite() { format!("{x:.4}") } else { "--".into() }
+    if x.is_finite() {
+        format!("{x:.4}")
+    } else {
+        "--".into()
+    }
 }
 
 /// `x` rounded to `n` significant figures, in fixed notation (`0.0003500`, `34.81`, `1.000`):
@@ -79,10 +83,19 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
         let refs = |m: RefMethod| reference.iter().filter(move |r| r.plant == p && r.method == m);
         let literature: Vec<&ReferenceRow> = refs(RefMethod::Literature).collect();
         let has_lit = !literature.is_empty();
-        let paper_at = |k: usize| refs(RefMethod::Hifoo).filter(|r| r.order == k).map(|r| r.gamma).fold(f64::NAN, f64::min);
+        let paper_at =
+            |k: usize| refs(RefMethod::Hifoo).filter(|r| r.order == k).map(|r| r.gamma).fold(f64::NAN, f64::min);
         let lit_at = |k: usize| {
-            let cells: Vec<String> = literature.iter().filter(|r| r.order == k).map(|r| format!("{} ({})", sig4(r.gamma), escape(&r.source))).collect();
-            if cells.is_empty() { "--".to_string() } else { cells.join("; ") }
+            let cells: Vec<String> = literature
+                .iter()
+                .filter(|r| r.order == k)
+                .map(|r| format!("{} ({})", sig4(r.gamma), escape(&r.source)))
+                .collect();
+            if cells.is_empty() {
+                "--".to_string()
+            } else {
+                cells.join("; ")
+            }
         };
         let f = full.iter().find(|f| f.plant == p);
         let dagger = f.is_some_and(|f| f.from_paper);
@@ -95,7 +108,10 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
         );
         let _ = writeln!(s, "\\label{{tab:hinfix-{}}}", label_key(p));
         let (cols, head) = if has_lit { ("lrrrl", " & literature") } else { ("lrrr", "") };
-        let _ = writeln!(s, "\\begin{{tabular}}{{{cols}}}\n\\toprule\n$n_K$ & ours & paper (HIFOO) & ours/paper{head} \\\\\n\\midrule");
+        let _ = writeln!(
+            s,
+            "\\begin{{tabular}}{{{cols}}}\n\\toprule\n$n_K$ & ours & paper (HIFOO) & ours/paper{head} \\\\\n\\midrule"
+        );
         if let Some(f) = f {
             let stab = match paper_full {
                 Some(r) if r.controller_stable => ", stable $K$",
@@ -126,7 +142,9 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
         }
         s.push_str("\\bottomrule\n\\end{tabular}\n");
         if dagger {
-            s.push_str("\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > 60$).\n");
+            s.push_str(
+                "\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > 60$).\n",
+            );
         }
         s.push_str("\\end{table}\n\n");
     }
@@ -137,7 +155,8 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
 pub fn compare_tex(rows: &[CompareRow]) -> String {
     let mut s = String::from("% hinfix vs Gumussoy, Millstone & Overton (2008)\n\\begin{tabular}{lrrrlrr}\n\\toprule\nplant & $n_K$ & ours & paper & literature & full order & ours/paper \\\\\n\\midrule\n");
     for r in rows {
-        let lit = r.literature.iter().map(|(src, g)| format!("{} {}", escape(src), num(*g))).collect::<Vec<_>>().join("; ");
+        let lit =
+            r.literature.iter().map(|(src, g)| format!("{} {}", escape(src), num(*g))).collect::<Vec<_>>().join("; ");
         let _ = writeln!(
             s,
             "{} & {} & {} & {} & {} & {} & {} \\\\",

@@ -28,5 +28,8 @@ pub use jobs::{expand, job_id, Job, JobId, RunnerTag};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
 pub use reference::{load_default_reference, load_reference, RefMethod, ReferenceError, ReferenceRow, REFERENCE_CSV};
 pub use report::{write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary};
-pub use spec::{Campaign, Location, Problem, SpecError, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER, MAX_SEEDS, MAX_THREADS};
+pub use spec::{
+    Campaign, Location, Problem, SpecError, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER, MAX_SEEDS,
+    MAX_THREADS,
+};
 pub use trace::{summarise, trace_observers, TraceError, TraceSummary, TraceWriter};

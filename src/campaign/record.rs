@@ -5,7 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use super::jobs::{Job, JobId, RunnerTag};
 use super::provenance::Provenance;
-use crate::design::{serde_f64_or_string, serde_opt_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats, SearchSummary};
+use crate::design::{
+    serde_f64_or_string, serde_opt_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats, SearchSummary,
+};
 
 /// Version of the journal line format. Readers refuse newer versions.
 pub const SCHEMA_VERSION: u32 = 1;

@@ -32,7 +32,8 @@ pub fn plant_labels<'a>(plants: impl IntoIterator<Item = (&'a str, &'a str)>) ->
     pairs
         .iter()
         .map(|(fp, name)| {
-            let label = if per_name[name] > 1 { format!("{name}@{}", &fp[..fp.len().min(8)]) } else { name.to_string() };
+            let label =
+                if per_name[name] > 1 { format!("{name}@{}", &fp[..fp.len().min(8)]) } else { name.to_string() };
             (fp.to_string(), label)
         })
         .collect()

@@ -79,7 +79,9 @@ mod stable_word {
         match String::deserialize(d)?.as_str() {
             "stable" => Ok(true),
             "unstable" => Ok(false),
-            other => Err(serde::de::Error::custom(format!("controller must be `stable` or `unstable`, found `{other}`"))),
+            other => {
+                Err(serde::de::Error::custom(format!("controller must be `stable` or `unstable`, found `{other}`")))
+            }
         }
     }
 }
@@ -105,14 +107,17 @@ pub fn parse_reference(input: impl std::io::Read, path: &Path) -> Result<Vec<Ref
             row_err(line, e.to_string())
         })?;
         if !(row.gamma.is_finite() && row.gamma > 0.0) {
-            return Err(row_err(rows.len() as u64 + 2, format!("gamma must be a positive number, found {}", row.gamma)));
+            return Err(row_err(
+                rows.len() as u64 + 2,
+                format!("gamma must be a positive number, found {}", row.gamma),
+            ));
         }
         rows.push(row);
     }
     Ok(rows)
 }
 
-/// The paper's reference table as built into the program ([`REFERENCE_TEXT`]); it does not
+/// The paper's reference table as built into the program (`REFERENCE_TEXT`); it does not
 /// depend on the plant library folder or the working directory.
 pub fn load_default_reference() -> Result<Vec<ReferenceRow>, ReferenceError> {
     parse_reference(REFERENCE_TEXT.as_bytes(), Path::new(REFERENCE_CSV))
@@ -143,7 +148,11 @@ mod tests {
     fn bad_rows_name_the_line() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("r.csv");
-        std::fs::write(&p, "table,plant,method,source,order,gamma,controller\nI,X,hifoo,s,1,0.5,stable\nI,X,guess,s,1,0.5,stable\n").unwrap();
+        std::fs::write(
+            &p,
+            "table,plant,method,source,order,gamma,controller\nI,X,hifoo,s,1,0.5,stable\nI,X,guess,s,1,0.5,stable\n",
+        )
+        .unwrap();
         let e = load_reference(&p).unwrap_err().to_string();
         assert!(e.contains("line 3") && e.contains("guess"), "{e}");
         std::fs::write(&p, "table,plant,method,source,order,gamma,controller\nI,X,hifoo,s,1,-2,stable\n").unwrap();

@@ -11,10 +11,10 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::latex;
-use super::sanitise::{for_csv, for_terminal};
 use super::record::JobRecord;
 use super::reduce::{best_per_order, BestRow, PlantMap};
 use super::reference::{RefMethod, ReferenceRow};
+use super::sanitise::{for_csv, for_terminal};
 use crate::lti::full_order_gamma;
 
 /// Largest plant order for which the full-order bound is computed here.
@@ -91,7 +91,16 @@ impl fmt::Display for ReportSummary {
         for r in &self.compare {
             let b = self.best.iter().find(|b| b.plant == r.plant && b.order == r.order);
             let v = b.map(|b| format!("{}/{}", b.verified, b.runs)).unwrap_or_default();
-            writeln!(f, "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}", for_terminal(&r.plant), r.order, latex::num(r.ours), latex::num(r.paper), latex::num(r.ratio), v)?;
+            writeln!(
+                f,
+                "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}",
+                for_terminal(&r.plant),
+                r.order,
+                latex::num(r.ours),
+                latex::num(r.paper),
+                latex::num(r.ratio),
+                v
+            )?;
         }
         Ok(())
     }
@@ -103,10 +112,7 @@ pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[Referen
     seen.dedup();
     seen.into_iter()
         .map(|(name, fp)| {
-            let paper = reference
-                .iter()
-                .find(|r| r.plant == name && r.method == RefMethod::FullOrder)
-                .map(|r| r.gamma);
+            let paper = reference.iter().find(|r| r.plant == name && r.method == RefMethod::FullOrder).map(|r| r.gamma);
             let computed = plants
                 .get(fp)
                 .filter(|p| p.dims.n <= FULL_ORDER_MAX_N)
@@ -114,7 +120,9 @@ pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[Referen
                 .map(|g| g.gamma);
             match computed {
                 Some(g) => FullOrderRow { plant: name.into(), gamma: g, from_paper: false },
-                None => FullOrderRow { plant: name.into(), gamma: paper.unwrap_or(f64::NAN), from_paper: paper.is_some() },
+                None => {
+                    FullOrderRow { plant: name.into(), gamma: paper.unwrap_or(f64::NAN), from_paper: paper.is_some() }
+                }
             }
         })
         .collect()
@@ -124,11 +132,21 @@ pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[Referen
 pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[ReferenceRow]) -> Vec<CompareRow> {
     best.iter()
         .map(|b| {
-            let at = |m: RefMethod| reference.iter().filter(move |r| r.plant == b.plant && r.order == b.order && r.method == m);
+            let at = |m: RefMethod| {
+                reference.iter().filter(move |r| r.plant == b.plant && r.order == b.order && r.method == m)
+            };
             let paper = at(RefMethod::Hifoo).map(|r| r.gamma).fold(f64::NAN, f64::min);
             let literature = at(RefMethod::Literature).map(|r| (r.source.clone(), r.gamma)).collect();
             let full_order = full.iter().find(|f| f.plant == b.plant).map_or(f64::NAN, |f| f.gamma);
-            CompareRow { plant: b.plant.clone(), order: b.order, ours: b.gamma, paper, literature, full_order, ratio: b.gamma / paper }
+            CompareRow {
+                plant: b.plant.clone(),
+                order: b.order,
+                ours: b.gamma,
+                paper,
+                literature,
+                full_order,
+                ratio: b.gamma / paper,
+            }
         })
         .collect()
 }
@@ -160,7 +178,11 @@ struct CompareCsv {
 }
 
 fn csv_num(x: f64) -> String {
-    if x.is_finite() { format!("{x}") } else { String::new() }
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        String::new()
+    }
 }
 
 /// Reduces `records` and writes the four report files into `out_dir` (created if needed).

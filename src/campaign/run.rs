@@ -20,7 +20,9 @@ use super::claims::{ClaimDir, ClaimError, ClaimGuard, ClaimOwner, TryClaim};
 use super::jobs::{Job, JobId};
 use super::journal::{journals_in, Follower, JournalError, JournalWriter, TornTail, JOURNAL_FILE};
 use super::record::JobRecord;
-use super::scheduler::{self, CampaignEvent, Claim, Coordinator, ExecuteError, ExecuteOptions, JobRunner, ObserverFactory, RunStats};
+use super::scheduler::{
+    self, CampaignEvent, Claim, Coordinator, ExecuteError, ExecuteOptions, JobRunner, ObserverFactory, RunStats,
+};
 
 /// The results folder of campaign `name` under `results_root` (`results/<name>/`).
 pub fn campaign_dir(results_root: &Path, name: &str) -> PathBuf {

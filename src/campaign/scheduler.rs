@@ -38,14 +38,24 @@ use crate::optim::thread_cpu_time;
 /// Runs one job. Production: [`DesignRunner`]; tests: closures.
 pub trait JobRunner: Sync {
     /// Runs `job` from `init` (warm start) or from scratch, reporting iterations to `obs`.
-    fn run(&self, job: &Job, init: Option<&Controller>, obs: &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError>;
+    fn run(
+        &self,
+        job: &Job,
+        init: Option<&Controller>,
+        obs: &mut dyn DesignObserver,
+    ) -> Result<DesignOutcome, DesignError>;
 }
 
 impl<F> JobRunner for F
 where
     F: Fn(&Job, Option<&Controller>, &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> + Sync,
 {
-    fn run(&self, job: &Job, init: Option<&Controller>, obs: &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> {
+    fn run(
+        &self,
+        job: &Job,
+        init: Option<&Controller>,
+        obs: &mut dyn DesignObserver,
+    ) -> Result<DesignOutcome, DesignError> {
         self(job, init, obs)
     }
 }
@@ -54,7 +64,12 @@ where
 pub struct DesignRunner;
 
 impl JobRunner for DesignRunner {
-    fn run(&self, job: &Job, init: Option<&Controller>, obs: &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> {
+    fn run(
+        &self,
+        job: &Job,
+        init: Option<&Controller>,
+        obs: &mut dyn DesignObserver,
+    ) -> Result<DesignOutcome, DesignError> {
         crate::design::run(&job.plant, &job.options, init, obs)
     }
 }
@@ -302,11 +317,7 @@ pub fn execute<E>(
     let mut finished: HashMap<JobId, Option<serde_json::Value>> =
         done.iter().map(|(id, r)| (id.clone(), r.controller.clone())).collect();
     let mut pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
-    let mut stats = RunStats {
-        total: jobs.len(),
-        already_done: jobs.len() - pending.len(),
-        ..RunStats::default()
-    };
+    let mut stats = RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() };
     let mut first_err: Option<E> = None;
     // Hands an event to the callback (Ok) or takes a coordinator error (Err); the first error
     // of either kind cancels the run.
@@ -323,7 +334,12 @@ pub fn execute<E>(
         }
     };
     emit(
-        Ok(CampaignEvent::Started { total: stats.total, already_done: stats.already_done, to_run: pending.len(), threads: opts.threads }),
+        Ok(CampaignEvent::Started {
+            total: stats.total,
+            already_done: stats.already_done,
+            to_run: pending.len(),
+            threads: opts.threads,
+        }),
         &mut first_err,
         &mut stats,
     );
@@ -412,7 +428,10 @@ pub fn execute<E>(
                         Err(e) => emit(
                             Ok(CampaignEvent::Warning {
                                 index: Some(index),
-                                message: format!("{}: predecessor's controller unusable ({e}); starting cold", job.label()),
+                                message: format!(
+                                    "{}: predecessor's controller unusable ({e}); starting cold",
+                                    job.label()
+                                ),
                             }),
                             &mut first_err,
                             &mut stats,
@@ -422,7 +441,9 @@ pub fn execute<E>(
                 running += 1;
                 emit(Ok(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }), &mut first_err, &mut stats);
                 let tx = tx.clone();
-                scope.spawn(move |_| run_one(campaign, provenance, job, index, worker, init, runner, observers, cancel, interval, tx));
+                scope.spawn(move |_| {
+                    run_one(campaign, provenance, job, index, worker, init, runner, observers, cancel, interval, tx)
+                });
             }
         }
         if running == 0 {
@@ -443,10 +464,14 @@ pub fn execute<E>(
             Err(mpsc::RecvTimeoutError::Disconnected) => unreachable!("the scheduler holds a sender"),
         };
         match msg {
-            WorkerMsg::Progress { index, worker, phase, iter, f, gamma } => {
-                emit(Ok(CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma }), &mut first_err, &mut stats)
+            WorkerMsg::Progress { index, worker, phase, iter, f, gamma } => emit(
+                Ok(CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma }),
+                &mut first_err,
+                &mut stats,
+            ),
+            WorkerMsg::Warning { index, message } => {
+                emit(Ok(CampaignEvent::Warning { index: Some(index), message }), &mut first_err, &mut stats)
             }
-            WorkerMsg::Warning { index, message } => emit(Ok(CampaignEvent::Warning { index: Some(index), message }), &mut first_err, &mut stats),
             WorkerMsg::Finished { index, worker, record } => {
                 running -= 1;
                 free.push(worker);

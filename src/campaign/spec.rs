@@ -57,7 +57,11 @@ impl Location {
 }
 
 fn location_suffix(l: &Location) -> String {
-    if l.line == 0 { String::new() } else { format!(":{}:{}", l.line, l.column) }
+    if l.line == 0 {
+        String::new()
+    } else {
+        format!(":{}:{}", l.line, l.column)
+    }
 }
 
 fn floor_char_boundary(s: &str, mut i: usize) -> usize {
@@ -318,11 +322,14 @@ impl<'de> Deserialize<'de> for EpsList {
 impl Campaign {
     /// Reads and validates a campaign file.
     pub fn load(path: &Path) -> Result<Campaign, SpecError> {
-        let text = crate::input::read_capped_string(path, crate::input::MAX_CAMPAIGN_BYTES, "campaign file").map_err(|e| SpecError {
-            file: path.to_path_buf(),
-            location: Location { line: 0, column: 0 },
-            message: format!("cannot read the campaign file: {e}"),
-        })?;
+        let text =
+            crate::input::read_capped_string(path, crate::input::MAX_CAMPAIGN_BYTES, "campaign file").map_err(|e| {
+                SpecError {
+                    file: path.to_path_buf(),
+                    location: Location { line: 0, column: 0 },
+                    message: format!("cannot read the campaign file: {e}"),
+                }
+            })?;
         Campaign::from_toml_str(&text, path)
     }
 
@@ -334,13 +341,17 @@ impl Campaign {
             location: Location::of_offset(text, span.start),
             message,
         };
-        let raw: RawCampaign = toml::from_str(text).map_err(|e| at(e.span().unwrap_or(0..0), e.message().trim().to_string()))?;
+        let raw: RawCampaign =
+            toml::from_str(text).map_err(|e| at(e.span().unwrap_or(0..0), e.message().trim().to_string()))?;
 
         let name = raw.name.get_ref().clone();
         if name.chars().count() > MAX_NAME_CHARS {
             return Err(at(raw.name.span(), format!("campaign name is longer than {MAX_NAME_CHARS} characters")));
         }
-        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) || name.starts_with('.') {
+        if name.is_empty()
+            || !name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+            || name.starts_with('.')
+        {
             return Err(at(
                 raw.name.span(),
                 format!("campaign name {name:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)"),
@@ -408,15 +419,24 @@ impl Campaign {
             let mut base = DesignOptions::default();
             // Values are only collected here; `design::validate` below judges them (one rule
             // for `campaign design` and campaign files).
-            let pick = |v: &Option<Spanned<f64>>, dv: &Option<Spanned<f64>>| v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()));
-            let pick_n = |v: &Option<Spanned<usize>>, dv: &Option<Spanned<usize>>| v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()));
+            let pick = |v: &Option<Spanned<f64>>, dv: &Option<Spanned<f64>>| {
+                v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()))
+            };
+            let pick_n = |v: &Option<Spanned<usize>>, dv: &Option<Spanned<usize>>| {
+                v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()))
+            };
             let cpumax = pick(&p.cpumax, &d.cpumax);
             let normtol = pick(&p.normtol, &d.normtol);
             let evaldist = pick(&p.evaldist, &d.evaldist);
             let hinf_tol = pick(&p.hinf_tol, &d.hinf_tol);
             let nrand = pick_n(&p.nrand, &d.nrand);
             let maxit = pick_n(&p.maxit, &d.maxit);
-            for (slot, v) in [(&mut base.cpumax, &cpumax), (&mut base.normtol, &normtol), (&mut base.evaldist, &evaldist), (&mut base.hinf_tol, &hinf_tol)] {
+            for (slot, v) in [
+                (&mut base.cpumax, &cpumax),
+                (&mut base.normtol, &normtol),
+                (&mut base.evaldist, &evaldist),
+                (&mut base.hinf_tol, &hinf_tol),
+            ] {
                 if let Some((x, _)) = v {
                     *slot = *x;
                 }
@@ -524,7 +544,11 @@ impl Campaign {
                     location: p.location,
                     message: format!(
                         "this problem repeats a job of the problem at line {} (plant {}, order {}, ε {}, seed {})",
-                        campaign.problems[first].location.line, p.plant.name, j.options.order, j.options.eps, j.options.seed
+                        campaign.problems[first].location.line,
+                        p.plant.name,
+                        j.options.order,
+                        j.options.eps,
+                        j.options.seed
                     ),
                 });
             }
@@ -673,7 +697,9 @@ objective = "plain"
 
     #[test]
     fn repeated_jobs_are_refused() {
-        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n[[problem]]\nplant = \"HE1\"\norders = [2]\n");
+        let e = err(
+            "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n[[problem]]\nplant = \"HE1\"\norders = [2]\n",
+        );
         assert_eq!(e.location.line, 6, "{e}");
         assert!(e.message.contains("repeats"), "{e}");
     }

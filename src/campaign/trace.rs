@@ -108,7 +108,8 @@ pub fn iter_message(rec: &DesignIterRecord) -> Value {
 
 /// JSON Schema of an [`ITER_TOPIC`] message.
 pub fn iter_schema() -> Value {
-    let float = json!({"type": ["number", "string", "null"], "description": "finite number, or \"inf\"/\"-inf\"/\"nan\""});
+    let float =
+        json!({"type": ["number", "string", "null"], "description": "finite number, or \"inf\"/\"-inf\"/\"nan\""});
     json!({
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "hinfix.Iteration",
@@ -163,7 +164,8 @@ impl TraceWriter {
         let io = |source| TraceError::Io { path: tmp.clone(), source };
         std::fs::create_dir_all(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?;
         let stale = format!("{job_id}.mcap.");
-        for e in std::fs::read_dir(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?.flatten() {
+        for e in std::fs::read_dir(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?.flatten()
+        {
             let name = e.file_name().to_string_lossy().to_string();
             if name.starts_with(&stale) && name.ends_with(".tmp") {
                 let _ = std::fs::remove_file(e.path());
@@ -177,8 +179,10 @@ impl TraceWriter {
             .library(concat!("hinfix ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::new(file))
             .map_err(mc)?;
-        let s_iter = w.add_schema("hinfix.Iteration", "jsonschema", iter_schema().to_string().as_bytes()).map_err(mc)?;
-        let s_res = w.add_schema("hinfix.JobRecord", "jsonschema", result_schema().to_string().as_bytes()).map_err(mc)?;
+        let s_iter =
+            w.add_schema("hinfix.Iteration", "jsonschema", iter_schema().to_string().as_bytes()).map_err(mc)?;
+        let s_res =
+            w.add_schema("hinfix.JobRecord", "jsonschema", result_schema().to_string().as_bytes()).map_err(mc)?;
         let meta = BTreeMap::new();
         let iter_channel = w.add_channel(s_iter, ITER_TOPIC, "json", &meta).map_err(mc)?;
         let result_channel = w.add_channel(s_res, RESULT_TOPIC, "json", &meta).map_err(mc)?;
@@ -204,7 +208,8 @@ impl TraceWriter {
     fn write(&mut self, channel: u16, data: &Value) -> Result<(), TraceError> {
         let Some(w) = self.writer.as_mut() else { return Ok(()) };
         let t = self.started.elapsed().as_nanos() as u64;
-        let header = mcap::records::MessageHeader { channel_id: channel, sequence: self.seq, log_time: t, publish_time: t };
+        let header =
+            mcap::records::MessageHeader { channel_id: channel, sequence: self.seq, log_time: t, publish_time: t };
         self.seq += 1;
         let bytes = data.to_string();
         w.write_to_known_channel(&header, bytes.as_bytes())
@@ -252,7 +257,8 @@ impl TraceWriter {
         let io = |source| TraceError::Io { path: self.tmp.clone(), source };
         let file = buf.into_inner().map_err(|e| io(e.into_error()))?;
         file.sync_all().map_err(io)?;
-        std::fs::rename(&self.tmp, &self.target).map_err(|source| TraceError::Io { path: self.target.clone(), source })?;
+        std::fs::rename(&self.tmp, &self.target)
+            .map_err(|source| TraceError::Io { path: self.target.clone(), source })?;
         Ok(self.target.clone())
     }
 
@@ -288,9 +294,7 @@ impl JobObserver for TraceWriter {
 pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, String> + Sync {
     let dir = traces_dir.to_path_buf();
     move |job: &Job| {
-        TraceWriter::create(&dir, &job.id.0)
-            .map(|w| Box::new(w) as Box<dyn JobObserver>)
-            .map_err(|e| e.to_string())
+        TraceWriter::create(&dir, &job.id.0).map(|w| Box::new(w) as Box<dyn JobObserver>).map_err(|e| e.to_string())
     }
 }
 
@@ -338,8 +342,10 @@ pub struct TraceSummary {
 
 /// Calls `f(topic, message)` for every message of the trace at `path`, in file order.
 fn each_message(path: &Path, mut f: impl FnMut(&str, Value)) -> Result<(), TraceError> {
-    let bytes = crate::input::read_capped(path, crate::input::MAX_TRACE_BYTES, "trace file").map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
-    let stream = mcap::MessageStream::new(&bytes).map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
+    let bytes = crate::input::read_capped(path, crate::input::MAX_TRACE_BYTES, "trace file")
+        .map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
+    let stream =
+        mcap::MessageStream::new(&bytes).map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
     for (index, msg) in stream.enumerate() {
         let msg = msg.map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
         let topic = msg.channel.topic.clone();

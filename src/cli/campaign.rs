@@ -246,8 +246,11 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     }
     let claims = ClaimDir::new(&l.dir).list()?;
     let index: HashMap<_, _> = l.jobs.iter().map(|j| (&j.id, j)).collect();
-    let running: HashMap<_, _> =
-        claims.iter().filter(|c| c.held && !done.contains_key(&c.job)).filter_map(|c| index.get(&c.job).map(|j| (&j.id, c))).collect();
+    let running: HashMap<_, _> = claims
+        .iter()
+        .filter(|c| c.held && !done.contains_key(&c.job))
+        .filter_map(|c| index.get(&c.job).map(|j| (&j.id, c)))
+        .collect();
     let labels = plant_labels(l.jobs.iter().map(|j| (j.plant_fingerprint.as_str(), j.plant_name.as_str())));
     // plant → (jobs, done, running, failed), in campaign order; plants by fingerprint.
     let mut rows: Vec<(&str, usize, usize, usize, usize)> = Vec::new();
@@ -269,7 +272,12 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         }
     }
     let names: Vec<String> = journals.iter().map(|p| p.display().to_string()).collect();
-    println!("campaign {} ({} journal(s): {})", for_terminal(&l.campaign.name), names.len(), for_terminal(&names.join(", ")));
+    println!(
+        "campaign {} ({} journal(s): {})",
+        for_terminal(&l.campaign.name),
+        names.len(),
+        for_terminal(&names.join(", "))
+    );
     println!("{:<16} {:>6} {:>6} {:>8} {:>9} {:>7}", "plant", "jobs", "done", "running", "remaining", "failed");
     for (p, n, d, r, f) in &rows {
         println!("{:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", for_terminal(p), n - d - r);
@@ -292,7 +300,10 @@ pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     }
     let dups = duplicate_ids(&records);
     if !dups.is_empty() {
-        println!("{} job(s) have more than one record; reports count each once, by its best verified record:", dups.len());
+        println!(
+            "{} job(s) have more than one record; reports count each once, by its best verified record:",
+            dups.len()
+        );
         for (id, n) in &dups {
             let label = index.get(id).map_or_else(String::new, |j| j.label());
             println!("  {}  {}  {n} records", id.short(), for_terminal(&label));
@@ -329,7 +340,13 @@ fn print_shards(l: &Loaded, n: usize, threads: usize) {
         println!("{:>8} {:>6} {:>10.0} s {:>12.0} s", format!("{}/{n}", k + 1), mine.len(), cpu, wall);
     }
     let limit = (worst * 1.25 + 600.0).ceil() as u64;
-    println!("slurm time per task: {}-{:02}:{:02}:{:02}", limit / 86400, limit % 86400 / 3600, limit % 3600 / 60, limit % 60);
+    println!(
+        "slurm time per task: {}-{:02}:{:02}:{:02}",
+        limit / 86400,
+        limit % 86400 / 3600,
+        limit % 3600 / 60,
+        limit % 60
+    );
 }
 
 /// `campaign report FILE`.
@@ -337,7 +354,11 @@ pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
     let (records, journals) = journaled(&l, &a.extra)?;
     if records.is_empty() {
-        anyhow::bail!("{}: no finished jobs of this campaign in {} journal(s) (run it first)", l.dir.display(), journals.len());
+        anyhow::bail!(
+            "{}: no finished jobs of this campaign in {} journal(s) (run it first)",
+            l.dir.display(),
+            journals.len()
+        );
     }
     report_into(&l.dir, &l.campaign, &records)?;
     Ok(ExitCode::SUCCESS)
@@ -348,7 +369,11 @@ pub fn plot(a: PlotArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
     let (records, journals) = journaled(&l, &a.extra)?;
     if records.is_empty() {
-        anyhow::bail!("{}: no finished jobs of this campaign in {} journal(s) (run it first)", l.dir.display(), journals.len());
+        anyhow::bail!(
+            "{}: no finished jobs of this campaign in {} journal(s) (run it first)",
+            l.dir.display(),
+            journals.len()
+        );
     }
     let reference = load_default_reference().context("reading the paper's reference table")?;
     let s = hinfix::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;

@@ -136,7 +136,8 @@ mod tests {
         assert_eq!(v["closed_loop_stable"], json!(false));
         assert_eq!(v["controller_stable"], json!(true));
         assert!(!serde_json::to_string(&v).unwrap().contains("Infinity"));
-        let r = CheckReport { alpha_cl: -0.3, alpha_k: Some(-1.0), hinf_cl: 2.0, peak_freq: f64::INFINITY, hinf_k: 1.5 };
+        let r =
+            CheckReport { alpha_cl: -0.3, alpha_k: Some(-1.0), hinf_cl: 2.0, peak_freq: f64::INFINITY, hinf_k: 1.5 };
         assert_eq!(to_json(&r)["closed_loop_peak_freq"], json!("inf"));
     }
 }

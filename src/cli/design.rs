@@ -177,9 +177,21 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
         ObjectiveKind::Plain => "plain H∞".to_string(),
     };
-    let mut s = format!("{} (n = {}), order {}, {}, seed {}\n", for_terminal(&plant.name), plant.dims.n, opts.order, mode, opts.seed);
+    let mut s = format!(
+        "{} (n = {}), order {}, {}, seed {}\n",
+        for_terminal(&plant.name),
+        plant.dims.n,
+        opts.order,
+        mode,
+        opts.seed
+    );
     s += &format!("status:   {}\n", status_text(&o.status));
-    s += &format!("‖Tzw‖∞ = {}   ‖K‖∞ = {}   objective = {}\n", fmt_num(o.gamma, 6), fmt_num(o.k_hinf, 6), fmt_num(o.objective, 6));
+    s += &format!(
+        "‖Tzw‖∞ = {}   ‖K‖∞ = {}   objective = {}\n",
+        fmt_num(o.gamma, 6),
+        fmt_num(o.k_hinf, 6),
+        fmt_num(o.objective, 6)
+    );
     if o.controller_norm_active {
         s += &format!(
             "note:     ε‖K‖∞ = {} ≥ ‖Tzw‖∞: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets γ go lower)\n",
@@ -192,7 +204,13 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
         None => s += "   (static gain)\n",
     }
     let per_eval = if o.evals > 0 { o.cpu_s / o.evals as f64 } else { f64::NAN };
-    s += &format!("CPU {:.2} s, {} iterations, {} evaluations ({:.3} ms/eval)\n", o.cpu_s, o.iters, o.evals, 1e3 * per_eval);
+    s += &format!(
+        "CPU {:.2} s, {} iterations, {} evaluations ({:.3} ms/eval)\n",
+        o.cpu_s,
+        o.iters,
+        o.evals,
+        1e3 * per_eval
+    );
     let sr = &o.search;
     s += &format!(
         "search: {} local searches, best from start {}, reached after {:.2} CPU s ({} evaluations), stopped: {}\n",

@@ -69,9 +69,24 @@ pub fn list(a: PlantsArgs) -> anyhow::Result<ExitCode> {
     for r in &rows {
         let d = r.plant.dims;
         let stab = if r.stable() { "stable" } else { "unstable" };
-        println!("{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} {}", term(&r.name), d.n, d.m1, d.m2, d.p1, d.p2, stab, term(&short(&r.plant.citation, 70)));
+        println!(
+            "{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} {}",
+            term(&r.name),
+            d.n,
+            d.m1,
+            d.m2,
+            d.p1,
+            d.p2,
+            stab,
+            term(&short(&r.plant.citation, 70))
+        );
     }
-    println!("\n{} plants in {}; problems without public data: {}", rows.len(), dir.display(), dir.join("MISSING.md").display());
+    println!(
+        "\n{} plants in {}; problems without public data: {}",
+        rows.len(),
+        dir.display(),
+        dir.join("MISSING.md").display()
+    );
     Ok(ExitCode::SUCCESS)
 }
 
@@ -96,10 +111,13 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
         o.insert("open_loop_stable".into(), s.stable().into());
         o.insert("open_loop_spectral_abscissa".into(), hinfix::design::f64_to_json(s.alpha));
         o.insert("d22_zero".into(), s.plant.d22_is_zero().into());
-        o.insert("full_order_gamma".into(), match &full {
-            Ok(f) => json!({"gamma": f.gamma, "regularisation": f.regularisation, "method": f.describe()}),
-            Err(e) => json!({"error": e}),
-        });
+        o.insert(
+            "full_order_gamma".into(),
+            match &full {
+                Ok(f) => json!({"gamma": f.gamma, "regularisation": f.regularisation, "method": f.describe()}),
+                Err(e) => json!({"error": e}),
+            },
+        );
         o.insert("paper_full_order_gamma".into(), paper_full.into());
         println!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(ExitCode::SUCCESS);

@@ -148,7 +148,12 @@ impl<'p> DesignObjective<'p> {
         let mut c = Components::UNKNOWN;
         let nk = k.order();
         // α(Ak) is cheap (nk × nk); its gradient is needed only when it is in the objective.
-        let (alpha_k, g_k) = if nk > 0 { let (a, g) = controller_abscissa_grad(k); (a, Some(g)) } else { (f64::NAN, None) };
+        let (alpha_k, g_k) = if nk > 0 {
+            let (a, g) = controller_abscissa_grad(k);
+            (a, Some(g))
+        } else {
+            (f64::NAN, None)
+        };
         c.alpha_k = alpha_k;
         let (alpha_cl, g_cl) = match closed_loop_abscissa_grad(self.plant, k) {
             Ok((a, g)) => (a, Some(g)),

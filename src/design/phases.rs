@@ -26,4 +26,3 @@ pub(crate) fn optim_error(e: OptimError) -> DesignError {
         other => DesignError::Numerical(other.to_string()),
     }
 }
-

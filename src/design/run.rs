@@ -7,9 +7,7 @@ use std::rc::Rc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL,
-};
+use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL};
 use crate::optim::RunControl;
 
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
@@ -28,7 +26,7 @@ use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_s
 /// relative perturbations of itself. Without `init`, `opts.nrand` standard-normal starts are drawn
 /// from a ChaCha8 generator seeded with `opts.seed`. After these starts the search goes on
 /// (basin hopping and fresh random starts) until a budget or the stall rule ends it
-/// ([`super::search`]).
+/// (`design::search`).
 ///
 /// Failing to stabilise is an outcome ([`DesignStatus::NotStabilised`]), not an error; `Err` is
 /// for invalid options or an initial controller that does not fit. γ, ‖K‖∞ and the abscissas of
@@ -87,8 +85,16 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     if let Some(bad) = opts.hop_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
         return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
     }
-    if opts.stall_starts > 0 && !opts.cpumax.is_finite() && opts.maxevals.is_none() && opts.max_starts.is_none() && opts.stall_rtol == 0.0 {
-        return Err(opt_err("stall_rtol", "must be > 0 when no budget (cpumax, maxevals, max_starts) bounds the search"));
+    if opts.stall_starts > 0
+        && !opts.cpumax.is_finite()
+        && opts.maxevals.is_none()
+        && opts.max_starts.is_none()
+        && opts.stall_rtol == 0.0
+    {
+        return Err(opt_err(
+            "stall_rtol",
+            "must be > 0 when no budget (cpumax, maxevals, max_starts) bounds the search",
+        ));
     }
     if opts.order > plant.dims.n {
         return Err(opt_err(
@@ -103,7 +109,10 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
         return Err(opt_err("maxit", format!("must be in 1..={MAX_ITERATIONS}, got {}", opts.maxit)));
     }
     if opts.gradsamp_maxit > MAX_ITERATIONS {
-        return Err(opt_err("gradsamp_maxit", format!("must be at most {MAX_ITERATIONS}, got {}", opts.gradsamp_maxit)));
+        return Err(opt_err(
+            "gradsamp_maxit",
+            format!("must be at most {MAX_ITERATIONS}, got {}", opts.gradsamp_maxit),
+        ));
     }
     for (field, v) in [("normtol", opts.normtol), ("evaldist", opts.evaldist)] {
         if !(v.is_finite() && v >= 0.0) {
@@ -192,12 +201,21 @@ fn run_validated(
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let first = starting_points(plant, opts, init, shape, &mut rng);
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
-    let mut stab_obj =
-        DesignObjective::new(plant, shape, ObjectivePhase::Stabilisation, strong, opts.eps, opts.hinf_tol, Rc::clone(&cache));
-    let mut perf_obj = DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
+    let mut stab_obj = DesignObjective::new(
+        plant,
+        shape,
+        ObjectivePhase::Stabilisation,
+        strong,
+        opts.eps,
+        opts.hinf_tol,
+        Rc::clone(&cache),
+    );
+    let mut perf_obj =
+        DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
-    let res = Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
-        .run(opts, &first, shape.nvar())?;
+    let res =
+        Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
+            .run(opts, &first, shape.nvar())?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
 
     let (final_x, certificate) = match &res.perf {

@@ -177,7 +177,13 @@ pub(crate) struct Search<'r, 'o, 'a> {
 impl Search<'_, '_, '_> {
     /// One local search from `x0` (module docs). Returns the stop reason if a budget or an
     /// interrupt ended it, and whether it improved the incumbent (stall sense).
-    fn local(&mut self, st: &mut State<'_>, x0: &[f64], k: usize, ctl: &RunControl) -> Result<(Option<SearchStop>, bool), DesignError> {
+    fn local(
+        &mut self,
+        st: &mut State<'_>,
+        x0: &[f64],
+        k: usize,
+        ctl: &RunControl,
+    ) -> Result<(Option<SearchStop>, bool), DesignError> {
         let opts = st.opts;
         self.adapter.switch(self.stab_obj, Phase::Stabilisation);
         self.adapter.set_evals_base(st.evals());
@@ -207,7 +213,13 @@ impl Search<'_, '_, '_> {
     }
 
     /// BFGS on f_h from the stable point `xs`.
-    fn optimise_from(&mut self, st: &mut State<'_>, xs: &[f64], k: usize, ctl: &RunControl) -> Result<(Option<SearchStop>, bool), DesignError> {
+    fn optimise_from(
+        &mut self,
+        st: &mut State<'_>,
+        xs: &[f64],
+        k: usize,
+        ctl: &RunControl,
+    ) -> Result<(Option<SearchStop>, bool), DesignError> {
         let opts = st.opts;
         self.adapter.switch(self.perf_obj, Phase::Optimisation);
         self.adapter.set_evals_base(st.evals());
@@ -230,7 +242,12 @@ impl Search<'_, '_, '_> {
 
     /// HIFOO's fallback when no first start was stabilised: gradient sampling on f_s from the
     /// best f_s point, then f_h from its end point if stable.
-    fn gs_stabilise(&mut self, st: &mut State<'_>, k: usize, ctl: &RunControl) -> Result<(Option<SearchStop>, bool), DesignError> {
+    fn gs_stabilise(
+        &mut self,
+        st: &mut State<'_>,
+        k: usize,
+        ctl: &RunControl,
+    ) -> Result<(Option<SearchStop>, bool), DesignError> {
         let opts = st.opts;
         let Some(x0) = st.stab.as_ref().filter(|b| b.f.is_finite()).map(|b| b.x.clone()) else {
             return Ok((None, false));
@@ -270,7 +287,12 @@ impl Search<'_, '_, '_> {
     }
 
     /// Runs the whole search from the first starts `first` (module docs).
-    pub(crate) fn run(&mut self, opts: &DesignOptions, first: &[Vec<f64>], nvar: usize) -> Result<SearchResult, DesignError> {
+    pub(crate) fn run(
+        &mut self,
+        opts: &DesignOptions,
+        first: &[Vec<f64>],
+        nvar: usize,
+    ) -> Result<SearchResult, DesignError> {
         let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
         let search_ctl = self.ctl.sub_budget(reserve, reserve);
         let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };

@@ -188,9 +188,7 @@ pub(crate) fn mul(m: MatRef<'_, f64>, x: &[c64]) -> Vec<c64> {
 
 /// Mᵀ x for real M and complex x.
 pub(crate) fn mul_t(m: MatRef<'_, f64>, x: &[c64]) -> Vec<c64> {
-    (0..m.ncols())
-        .map(|j| (0..m.nrows()).fold(c64::new(0.0, 0.0), |s, i| s + x[i] * m[(i, j)]))
-        .collect()
+    (0..m.ncols()).map(|j| (0..m.nrows()).fold(c64::new(0.0, 0.0), |s, i| s + x[i] * m[(i, j)])).collect()
 }
 
 fn add_to(y: &mut [c64], x: &[c64]) {

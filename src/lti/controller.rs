@@ -131,11 +131,11 @@ impl Controller {
     pub fn from_json_value(doc: &Value) -> Result<Controller, ControllerErrorKind> {
         let obj = doc.as_object().ok_or(ControllerErrorKind::NotObject)?;
         let mat = |key: &'static str, r: usize, c: usize| {
-            matrix_from_json(obj.get(key), r, c)
-                .map_err(|problem| ControllerErrorKind::Matrix { matrix: key, problem })
+            matrix_from_json(obj.get(key), r, c).map_err(|problem| ControllerErrorKind::Matrix { matrix: key, problem })
         };
         let shape = |key: &'static str| -> Result<(usize, usize), ControllerErrorKind> {
-            let v = obj.get(key).ok_or(ControllerErrorKind::Matrix { matrix: key, problem: MatrixJsonError::Missing })?;
+            let v =
+                obj.get(key).ok_or(ControllerErrorKind::Matrix { matrix: key, problem: MatrixJsonError::Missing })?;
             let problem = match v.as_array() {
                 None => Some(MatrixJsonError::NotArray { found: json_type(v) }),
                 Some(rows) => rows
@@ -151,7 +151,10 @@ impl Controller {
         let (m, p) = shape("DK")?;
         let nk = shape("AK")?.0;
         if m == 0 || p == 0 {
-            return Err(ControllerErrorKind::Matrix { matrix: "DK", problem: MatrixJsonError::Empty { rows: m, cols: p } });
+            return Err(ControllerErrorKind::Matrix {
+                matrix: "DK",
+                problem: MatrixJsonError::Empty { rows: m, cols: p },
+            });
         }
         Ok(Controller { ak: mat("AK", nk, nk)?, bk: mat("BK", nk, p)?, ck: mat("CK", m, nk)?, dk: mat("DK", m, p)? })
     }
@@ -217,7 +220,8 @@ mod tests {
     #[test]
     fn flat_dk_is_named_as_such() {
         // issue 15: `DK: [1.0, 2.0]` was reported as "has 0 rows".
-        let e = Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [[]], "DK": [1.0, 2.0]}"#, "k.json").unwrap_err();
+        let e =
+            Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [[]], "DK": [1.0, 2.0]}"#, "k.json").unwrap_err();
         let s = e.to_string();
         assert!(s.contains("`DK` row 1 must be an array") && s.contains("a number"), "{s}");
         let e = Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [], "DK": []}"#, "k.json").unwrap_err();

@@ -60,7 +60,9 @@ pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String
     let mut s = String::new();
     match target {
         ExportTarget::Matlab => {
-            s += &format!("% hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n");
+            s += &format!(
+                "% hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
+            );
             s += "% Sign convention: POSITIVE feedback u = K y (xk' = AK xk + BK y, u = CK xk + DK y).\n";
             s += "% Closed loop with the plant P = ss(A, [B1 B2], [C1; C2], [D11 D12; D21 D22]):\n";
             s += "%   Tzw = lft(P, K);                 % lft keeps u = K y\n";
@@ -71,11 +73,14 @@ pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String
             s += "K = ss(AK, BK, CK, DK);\n";
         }
         ExportTarget::Python => {
-            s += &format!("# hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n");
+            s += &format!(
+                "# hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
+            );
             s += "# Sign convention: POSITIVE feedback u = K y (xk' = AK xk + BK y, u = CK xk + DK y).\n";
             s += "# Closed loop with P = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]), np.block([[D11, D12], [D21, D22]])):\n";
             s += "#   Tzw = P.lft(K)                          # lower LFT, keeps u = K y\n";
-            s += "#   L = control.feedback(P22, K, sign=1)    # feedback() is negative by default: use sign=1 (or -K)\n";
+            s +=
+                "#   L = control.feedback(P22, K, sign=1)    # feedback() is negative by default: use sign=1 (or -K)\n";
             s += "import numpy as np\nimport control\n\n";
             for (name, mat) in mats {
                 s += &format!("{name} = {}\n", python_matrix(mat));
@@ -96,9 +101,17 @@ mod tests {
         for x in [0.1, -1.0 / 3.0, 1e-300, 123456789.0, -0.0] {
             assert_eq!(number(x).parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x}");
         }
-        let k = Controller { ak: Mat::zeros(0, 0), bk: Mat::zeros(0, 2), ck: Mat::zeros(1, 0), dk: Mat::from_fn(1, 2, |_, j| j as f64 + 0.5) };
+        let k = Controller {
+            ak: Mat::zeros(0, 0),
+            bk: Mat::zeros(0, 2),
+            ck: Mat::zeros(1, 0),
+            dk: Mat::from_fn(1, 2, |_, j| j as f64 + 0.5),
+        };
         let m = export_code(&k, ExportTarget::Matlab, "k.json");
-        assert!(m.contains("BK = zeros(0, 2);") && m.contains("CK = zeros(1, 0);") && m.contains("DK = [0.5, 1.5];"), "{m}");
+        assert!(
+            m.contains("BK = zeros(0, 2);") && m.contains("CK = zeros(1, 0);") && m.contains("DK = [0.5, 1.5];"),
+            "{m}"
+        );
         assert!(m.contains("K = ss(AK, BK, CK, DK);") && m.contains("u = K y"));
         let p = export_code(&k, ExportTarget::Python, "k.json");
         assert!(p.contains("BK = np.zeros((0, 2))") && p.contains("DK = np.array([[0.5, 1.5]])"), "{p}");

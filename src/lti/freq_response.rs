@@ -44,7 +44,11 @@ impl FreqResponse {
             let mut hh = Mat::<f64>::zeros(bs, n - 1);
             let req = StackReq::any_of(&[
                 hessenberg::hessenberg_in_place_scratch::<f64>(n, bs, par, Default::default()),
-                householder::apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(n - 1, bs, m),
+                householder::apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(
+                    n - 1,
+                    bs,
+                    m,
+                ),
                 householder::apply_block_householder_sequence_on_the_right_in_place_scratch::<f64>(n - 1, bs, p),
             ]);
             let mut mem = MemBuffer::new(req);
@@ -114,8 +118,8 @@ impl FreqResponse {
             }
             t[i * n + i].im += w;
         }
-        for k in 0..n * m {
-            x[k] = c64::new(self.bt[k], 0.0);
+        for (xk, &b) in x[..n * m].iter_mut().zip(&self.bt[..n * m]) {
+            *xk = c64::new(b, 0.0);
         }
         // Elimination with adjacent-row pivoting: after step k rows k+1.. are Hessenberg again.
         for k in 0..n.saturating_sub(1) {
@@ -230,9 +234,7 @@ mod tests {
 
     fn direct(sys: &StateSpace, w: f64) -> Mat<c64> {
         let n = sys.order();
-        let z = Mat::<c64>::from_fn(n, n, |i, j| {
-            c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 })
-        });
+        let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
         let b = Mat::<c64>::from_fn(n, sys.inputs(), |i, j| c64::new(sys.b[(i, j)], 0.0));
         let x = z.partial_piv_lu().solve(&b);
         Mat::from_fn(sys.outputs(), sys.inputs(), |i, j| {

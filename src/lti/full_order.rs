@@ -367,7 +367,15 @@ impl Problem {
         let (mut d11, mut d12, mut d21) = (plant.d11.clone(), plant.d12.clone(), plant.d21.clone());
         if reg12 {
             let p1 = c1.nrows();
-            c1 = Mat::from_fn(p1 + n + m2, n, |i, j| if i < p1 { c1[(i, j)] } else if i - p1 == j { eps } else { 0.0 });
+            c1 = Mat::from_fn(p1 + n + m2, n, |i, j| {
+                if i < p1 {
+                    c1[(i, j)]
+                } else if i - p1 == j {
+                    eps
+                } else {
+                    0.0
+                }
+            });
             d12 = Mat::from_fn(p1 + n + m2, m2, |i, j| {
                 if i < p1 {
                     d12[(i, j)]
@@ -381,7 +389,15 @@ impl Problem {
         }
         if reg21 {
             let m1 = b1.ncols();
-            b1 = Mat::from_fn(n, m1 + n + p2, |i, j| if j < m1 { b1[(i, j)] } else if j - m1 == i { eps } else { 0.0 });
+            b1 = Mat::from_fn(n, m1 + n + p2, |i, j| {
+                if j < m1 {
+                    b1[(i, j)]
+                } else if j - m1 == i {
+                    eps
+                } else {
+                    0.0
+                }
+            });
             d21 = Mat::from_fn(p2, m1 + n + p2, |i, j| {
                 if j < m1 {
                     d21[(i, j)]
@@ -452,9 +468,7 @@ impl Problem {
         let ay = self.a.transpose() - self.c.transpose() * rt_db;
         let gy = self.c.transpose() * rt_c;
         let qy = &self.b1_b1t - self.dd1_b1t.transpose() * rt_db;
-        let y = solve_care(ay.as_ref(), gy.as_ref(), qy.as_ref())
-            .map_err(|e| (Binding::Filter, format!("Y: {e}")))?
-            .x;
+        let y = solve_care(ay.as_ref(), gy.as_ref(), qy.as_ref()).map_err(|e| (Binding::Filter, format!("Y: {e}")))?.x;
         let (yl, _) = sym_eig(y.as_ref()).ok_or((Binding::Filter, "eig(Y) failed".to_string()))?;
         psd_check(&yl).map_err(|s| (Binding::Filter, format!("Y: {s}")))?;
 

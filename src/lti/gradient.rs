@@ -78,7 +78,12 @@ pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGr
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
-    let g = Controller { ak: outer(&pv.a, &pv.b), bk: outer(&pv.a, &pv.v), ck: outer(&pv.u, &pv.b), dk: outer(&pv.u, &pv.v) };
+    let g = Controller {
+        ak: outer(&pv.a, &pv.b),
+        bk: outer(&pv.a, &pv.v),
+        ck: outer(&pv.u, &pv.b),
+        dk: outer(&pv.u, &pv.v),
+    };
     (norm, g)
 }
 
@@ -118,9 +123,7 @@ pub(crate) fn peak_vectors(sys: &StateSpace, w: f64) -> Option<PeakVectors> {
         let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
         let lu = z.partial_piv_lu();
         let x = lu.solve(Mat::<c64>::from_fn(n, m, |i, j| cz(sys.b[(i, j)]))); // Z⁻¹B
-        let g = Mat::<c64>::from_fn(p, m, |i, j| {
-            (0..n).fold(cz(sys.d[(i, j)]), |s, k| s + x[(k, j)] * sys.c[(i, k)])
-        });
+        let g = Mat::<c64>::from_fn(p, m, |i, j| (0..n).fold(cz(sys.d[(i, j)]), |s, k| s + x[(k, j)] * sys.c[(i, k)]));
         (g, Some((lu, x)))
     } else {
         (Mat::<c64>::from_fn(p, m, |i, j| cz(sys.d[(i, j)])), None)

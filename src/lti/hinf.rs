@@ -241,7 +241,11 @@ fn refine(fr: &mut FreqResponse, best: &mut Best, tested: &[f64]) {
     let mut f = |x: f64, best: &mut Best| {
         let s = fr.sigma_max(x.exp());
         best.offer(x.exp(), s);
-        if s.is_nan() { f64::NEG_INFINITY } else { -s }
+        if s.is_nan() {
+            f64::NEG_INFINITY
+        } else {
+            -s
+        }
     };
     const C: f64 = 0.381_966_011_250_105_1; // (3 − √5)/2
     let (mut a, mut b) = (lo.ln(), hi.ln());
@@ -281,7 +285,13 @@ fn refine(fr: &mut FreqResponse, best: &mut Best, tested: &[f64]) {
             e = if x < m { b - x } else { a - x };
             d = C * e;
         }
-        let u = if d.abs() >= tol { x + d } else if d > 0.0 { x + tol } else { x - tol };
+        let u = if d.abs() >= tol {
+            x + d
+        } else if d > 0.0 {
+            x + tol
+        } else {
+            x - tol
+        };
         let fu = f(u, best);
         if fu <= fx {
             if u < x {
@@ -324,7 +334,11 @@ struct Hamiltonian<'s> {
 
 impl<'s> Hamiltonian<'s> {
     fn new(sys: &'s StateSpace, sigma_d: f64, poles: &[c64]) -> Self {
-        let (lo, hi) = poles.iter().map(|l| l.norm()).filter(|&r| r > 0.0).fold((f64::INFINITY, 0.0f64), |(a, b), r| (a.min(r), b.max(r)));
+        let (lo, hi) = poles
+            .iter()
+            .map(|l| l.norm())
+            .filter(|&r| r > 0.0)
+            .fold((f64::INFINITY, 0.0f64), |(a, b), r| (a.min(r), b.max(r)));
         let freq_scale = if hi > 0.0 { (lo * hi).sqrt() } else { 1.0 };
         let (p, m) = (sys.outputs(), sys.inputs());
         let (d_u, d_s, d_v) = match sys.d.svd() {
@@ -365,11 +379,13 @@ impl<'s> Hamiltonian<'s> {
             1.0 / (g2 - sk * sk)
         };
         // −R⁻¹ = V W_m Vᵀ, −S⁻¹ = U W_p Uᵀ
-        let rinv_neg = Mat::from_fn(m, m, |i, j| (0..m).map(|k| self.d_v[(i, k)] * wt(k) * self.d_v[(j, k)]).sum::<f64>());
-        let sinv_neg = Mat::from_fn(p, p, |i, j| (0..p).map(|k| self.d_u[(i, k)] * wt(k) * self.d_u[(j, k)]).sum::<f64>());
+        let rinv_neg =
+            Mat::from_fn(m, m, |i, j| (0..m).map(|k| self.d_v[(i, k)] * wt(k) * self.d_v[(j, k)]).sum::<f64>());
+        let sinv_neg =
+            Mat::from_fn(p, p, |i, j| (0..p).map(|k| self.d_u[(i, k)] * wt(k) * self.d_u[(j, k)]).sum::<f64>());
         let br = &s.b * &rinv_neg; // −B R⁻¹
         let dtc = s.d.transpose() * &s.c; // DᵀC
-        // H11 = A − B R⁻¹ DᵀC = A + (−BR⁻¹) DᵀC; H22 = −Aᵀ + Cᵀ D R⁻¹ Bᵀ = −H11ᵀ
+                                          // H11 = A − B R⁻¹ DᵀC = A + (−BR⁻¹) DᵀC; H22 = −Aᵀ + Cᵀ D R⁻¹ Bᵀ = −H11ᵀ
         let h11 = &s.a + &br * &dtc;
         // H12 = −γ B R⁻¹ Bᵀ
         let h12 = (&br * s.b.transpose()) * faer::Scale(gamma);

@@ -70,7 +70,11 @@ pub(crate) fn pencil_crossings(sys: &StateSpace, gamma: f64, scale: f64) -> Opti
             .filter(|th| ((th.re - c).hypot(th.im) - r).abs() <= tol && th.im <= 0.0)
             .map(|th| {
                 let inv = th.inv();
-                if inv.im.is_finite() { inv.im.abs() } else { f64::INFINITY }
+                if inv.im.is_finite() {
+                    inv.im.abs()
+                } else {
+                    f64::INFINITY
+                }
             })
             .collect();
         if cond <= MAX_SHIFT_CONDITION {

@@ -271,7 +271,9 @@ fn infer(vars: &BTreeMap<String, MatVar>, dim: &str) -> usize {
 
 /// A variable as a JSON array of rows.
 fn var_to_json(v: &MatVar) -> Value {
-    Value::Array((0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect())).collect())
+    Value::Array(
+        (0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect())).collect(),
+    )
 }
 
 fn json_number(x: f64) -> Value {
@@ -281,7 +283,11 @@ fn json_number(x: f64) -> Value {
 fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind> {
     let bad = |i: usize| {
         let (row, col) = (i % v.rows + 1, i / v.rows + 1);
-        PlantErrorKind::Matrix { matrix: name, problem: MatrixJsonError::NotFinite { row, col, value: v.data[i] }, hint: String::new() }
+        PlantErrorKind::Matrix {
+            matrix: name,
+            problem: MatrixJsonError::NotFinite { row, col, value: v.data[i] },
+            hint: String::new(),
+        }
     };
     match v.data.iter().position(|x| !x.is_finite()) {
         Some(i) => Err(bad(i)),
@@ -296,7 +302,11 @@ fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
     for (key, _, _) in PLANT_VARS {
         match vars.get(key) {
             None => {
-                return Err(PlantErrorKind::Matrix { matrix: key, problem: MatrixJsonError::Missing, hint: PLANT_HINT.into() })
+                return Err(PlantErrorKind::Matrix {
+                    matrix: key,
+                    problem: MatrixJsonError::Missing,
+                    hint: PLANT_HINT.into(),
+                })
             }
             Some(v) => first_non_finite(key, v)?,
         }

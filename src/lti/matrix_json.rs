@@ -70,7 +70,7 @@ pub enum MatrixJsonError {
         /// Columns found.
         cols: usize,
     },
-    /// The expected shape exceeds [`MAX_MATRIX_DIM`].
+    /// The expected shape exceeds `MAX_MATRIX_DIM`.
     #[error("would be {rows}×{cols}, larger than the limit of {MAX_MATRIX_DIM} rows or columns")]
     TooLarge {
         /// Expected rows.
@@ -102,15 +102,9 @@ pub(crate) fn json_type(v: &Value) -> &'static str {
 }
 
 /// Reads a matrix of the expected shape from `value` (None when the key was absent).
-pub fn matrix_from_json(
-    value: Option<&Value>,
-    rows: usize,
-    cols: usize,
-) -> Result<Mat<f64>, MatrixJsonError> {
+pub fn matrix_from_json(value: Option<&Value>, rows: usize, cols: usize) -> Result<Mat<f64>, MatrixJsonError> {
     let value = value.ok_or(MatrixJsonError::Missing)?;
-    let arr = value
-        .as_array()
-        .ok_or(MatrixJsonError::NotArray { found: json_type(value) })?;
+    let arr = value.as_array().ok_or(MatrixJsonError::NotArray { found: json_type(value) })?;
     if rows > MAX_MATRIX_DIM || cols > MAX_MATRIX_DIM {
         return Err(MatrixJsonError::TooLarge { rows, cols });
     }
@@ -125,9 +119,7 @@ pub fn matrix_from_json(
     // file's `dims`, and a huge dimension must be an error, not a rows × cols allocation.
     let mut entries = Vec::with_capacity(rows);
     for (i, row) in arr.iter().enumerate() {
-        let r = row
-            .as_array()
-            .ok_or(MatrixJsonError::RowNotArray { row: i + 1, found: json_type(row) })?;
+        let r = row.as_array().ok_or(MatrixJsonError::RowNotArray { row: i + 1, found: json_type(row) })?;
         if r.len() != cols {
             return Err(MatrixJsonError::RowLength { row: i + 1, expected: cols, got: r.len() });
         }
@@ -152,11 +144,7 @@ pub fn matrix_from_json(
 
 /// Writes a matrix as a JSON array of rows.
 pub fn matrix_to_json(m: faer::MatRef<'_, f64>) -> Value {
-    Value::Array(
-        (0..m.nrows())
-            .map(|i| Value::Array((0..m.ncols()).map(|j| number(m[(i, j)])).collect()))
-            .collect(),
-    )
+    Value::Array((0..m.nrows()).map(|i| Value::Array((0..m.ncols()).map(|j| number(m[(i, j)])).collect())).collect())
 }
 
 /// A finite f64 as a JSON number; non-finite values (which valid matrices never hold) as strings.

@@ -24,19 +24,22 @@ mod state_space;
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use controller::{Controller, ControllerError, ControllerErrorKind};
 pub use error::LtiError;
+pub use full_order::{
+    full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions, Regularisation,
+    FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_EPS,
+};
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
     ControllerGradient,
 };
-pub use hinf::{hinf_lower_bound, hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL};
+pub use hinf::{
+    hinf_lower_bound, hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS,
+    MIN_HINF_TOL,
+};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
+pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
+pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
 pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;
-pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
-pub use full_order::{
-    full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions,
-    Regularisation, FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_EPS,
-};
-pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};

@@ -189,9 +189,8 @@ impl Plant {
     /// Parses and validates a plant from JSON text; `file` names it in errors.
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let err = |kind| PlantError { file: file.as_ref().to_path_buf(), kind };
-        let doc: Value = serde_json::from_str(text).map_err(|e| {
-            err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() })
-        })?;
+        let doc: Value = serde_json::from_str(text)
+            .map_err(|e| err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() }))?;
         Self::from_json_value(&doc).map_err(err)
     }
 

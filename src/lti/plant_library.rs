@@ -28,7 +28,11 @@ pub fn plants_dir() -> PathBuf {
 /// `<plants_dir>/NAME.json`. An unknown name is an error that lists the shipped plants.
 pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
     let as_path = Path::new(name_or_path);
-    if as_path.is_file() || name_or_path.ends_with(".json") || name_or_path.ends_with(".mat") || name_or_path.contains('/') {
+    if as_path.is_file()
+        || name_or_path.ends_with(".json")
+        || name_or_path.ends_with(".mat")
+        || name_or_path.contains('/')
+    {
         return Ok(as_path.to_path_buf());
     }
     let file = plants_dir().join(format!("{name_or_path}.json"));

@@ -140,11 +140,7 @@ pub enum RiccatiError {
 
 /// Stabilising solution of `AᵀX + XA − XGX + Q = 0` (G, Q symmetric; only their symmetric parts
 /// are used). See the module docs for the method and the checks.
-pub fn solve_care(
-    a: MatRef<'_, f64>,
-    g: MatRef<'_, f64>,
-    q: MatRef<'_, f64>,
-) -> Result<CareSolution, RiccatiError> {
+pub fn solve_care(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<CareSolution, RiccatiError> {
     let n = a.nrows();
     if a.ncols() != n || g.nrows() != n || g.ncols() != n || q.nrows() != n || q.ncols() != n {
         return Err(RiccatiError::Shape {

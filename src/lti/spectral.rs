@@ -199,7 +199,15 @@ mod tests {
     #[test]
     fn defective_gradient_is_finite() {
         // Jordan block: uᴴv = 0 exactly in exact arithmetic.
-        let a = Mat::from_fn(3, 3, |i, j| if i == j { -1.0 } else if j == i + 1 { 1.0 } else { 0.0 });
+        let a = Mat::from_fn(3, 3, |i, j| {
+            if i == j {
+                -1.0
+            } else if j == i + 1 {
+                1.0
+            } else {
+                0.0
+            }
+        });
         let (alpha, g) = spectral_abscissa_grad(a.as_ref()).unwrap();
         assert!((alpha + 1.0).abs() < 1e-4);
         assert!((0..3).all(|i| (0..3).all(|j| g[(i, j)].is_finite())));

@@ -43,7 +43,11 @@ const ERROR_FACTOR: f64 = 100.0;
 
 /// λ(H)² for the real Hamiltonian H = [F G; K −Fᵀ] (G, K symmetric, all n×n); `None` if the
 /// data are not finite or the QR fails.
-pub(crate) fn hamiltonian_squared_eigenvalues(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<SquaredSpectrum> {
+pub(crate) fn hamiltonian_squared_eigenvalues(
+    f: MatRef<'_, f64>,
+    g: MatRef<'_, f64>,
+    k: MatRef<'_, f64>,
+) -> Option<SquaredSpectrum> {
     let n = f.nrows();
     // M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], and GFᵀ = (FG)ᵀ, FᵀK = (KF)ᵀ.
     let m11 = f * f + g * k;
@@ -55,7 +59,11 @@ pub(crate) fn hamiltonian_squared_eigenvalues(f: MatRef<'_, f64>, g: MatRef<'_, 
     if !norm.is_finite() {
         return None;
     }
-    let mut blocks = SkewHamiltonian { a: ColMajor::from(m11.as_ref()), g: ColMajor::from(m12.as_ref()), q: ColMajor::from(m21.as_ref()) };
+    let mut blocks = SkewHamiltonian {
+        a: ColMajor::from(m11.as_ref()),
+        g: ColMajor::from(m12.as_ref()),
+        q: ColMajor::from(m21.as_ref()),
+    };
     blocks.pvl_reduce();
     let w = Mat::from_fn(n, n, |i, j| if i <= j + 1 { blocks.a.at(i, j) } else { 0.0 });
     let mu = eigenvalues(w.as_ref())?;
@@ -287,7 +295,8 @@ mod tests {
             }
             assert!(off <= 1e-13 * scale, "n={n}: residual {off:e} vs ‖M‖ {scale:e}");
             // Similarity: the Frobenius norm of [A G; 0 Aᵀ] equals that of M.
-            let fro = (2.0 * s.a.data.iter().map(|x| x * x).sum::<f64>() + s.g.data.iter().map(|x| x * x).sum::<f64>()).sqrt();
+            let fro = (2.0 * s.a.data.iter().map(|x| x * x).sum::<f64>() + s.g.data.iter().map(|x| x * x).sum::<f64>())
+                .sqrt();
             assert!((fro - scale).abs() <= 1e-12 * scale, "n={n}: ‖·‖_F {fro} vs {scale}");
         }
     }
@@ -303,7 +312,11 @@ mod tests {
             // the unstructured solver's own rounding).
             for mu in &sq.mu {
                 let best = full.iter().map(|l| (l * l - mu).norm()).fold(f64::INFINITY, f64::min);
-                assert!(best <= 10.0 * sq.abs_error.max(1e-14), "n={n}: μ = {mu}, off by {best:e} (bound {:e})", sq.abs_error);
+                assert!(
+                    best <= 10.0 * sq.abs_error.max(1e-14),
+                    "n={n}: μ = {mu}, off by {best:e} (bound {:e})",
+                    sq.abs_error
+                );
             }
         }
     }

@@ -34,7 +34,6 @@ use super::solver::{run, Limits, OptimResult, Solver, SolverState};
 use super::termination::Termination;
 use crate::numeric::dot;
 
-
 /// The state of a BFGS run.
 #[derive(Debug, Clone)]
 pub struct BfgsState {
@@ -148,7 +147,18 @@ impl Solver for Bfgs<'_> {
         }
         let bundle = GradBundle::new(self.opts.ngrad_for(n), x0, &g);
         let dnorm = dot(&g, &g).sqrt();
-        Ok(BfgsState { x: x0.to_vec(), f, g, h, dnorm, t: 0.0, iter: 0, ls: LsStatus::Success, bundle, skipped_updates: 0 })
+        Ok(BfgsState {
+            x: x0.to_vec(),
+            f,
+            g,
+            h,
+            dnorm,
+            t: 0.0,
+            iter: 0,
+            ls: LsStatus::Success,
+            bundle,
+            skipped_updates: 0,
+        })
     }
 
     fn step(&mut self, ev: &mut Evaluator<'_>, s: &mut BfgsState) -> Result<f64, Termination> {

@@ -43,9 +43,7 @@ pub struct HansoResult {
 
 /// `count` standard-normal starting points in ℝ^nvar (HANSO's default x0 = randn(nvar, count)).
 pub fn random_starts(nvar: usize, count: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
-    (0..count)
-        .map(|_| (0..nvar).map(|_| StandardNormal.sample(&mut *rng)).collect())
-        .collect()
+    (0..count).map(|_| (0..nvar).map(|_| StandardNormal.sample(&mut *rng)).collect()).collect()
 }
 
 /// HANSO-style driver: BFGS from every start (shared budget; a start whose f is not finite is

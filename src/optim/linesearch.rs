@@ -74,14 +74,7 @@ fn limit(v: f64, min: f64) -> usize {
 }
 
 /// Weak-Wolfe search along `d` from (x0, f0, g0); requires g0ᵀd < 0 (checked by the caller).
-pub(crate) fn weak_wolfe(
-    ev: &mut Evaluator<'_>,
-    x0: &[f64],
-    f0: f64,
-    g0: &[f64],
-    d: &[f64],
-    p: LsParams,
-) -> LsOutcome {
+pub(crate) fn weak_wolfe(ev: &mut Evaluator<'_>, x0: &[f64], f0: f64, g0: &[f64], d: &[f64], p: LsParams) -> LsOutcome {
     let n = x0.len();
     let dnorm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     let nbisect_max = limit((LS_LIMIT_SCALE * dnorm).log2(), LS_MIN_BISECT);

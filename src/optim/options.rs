@@ -165,9 +165,19 @@ impl GradSampOptions {
         let pos = |v: f64| v.is_finite() && v > 0.0;
         check(pos(self.samprad0), "samprad0", self.samprad0, "finite and > 0")?;
         check(pos(self.target0), "target0", self.target0, "finite and > 0")?;
-        check(self.samprad_opt.is_finite() && self.samprad_opt >= 0.0, "samprad_opt", self.samprad_opt, "finite and >= 0")?;
+        check(
+            self.samprad_opt.is_finite() && self.samprad_opt >= 0.0,
+            "samprad_opt",
+            self.samprad_opt,
+            "finite and >= 0",
+        )?;
         check(self.target_opt.is_finite() && self.target_opt >= 0.0, "target_opt", self.target_opt, "finite and >= 0")?;
-        check(self.samprad_factor > 0.0 && self.samprad_factor < 1.0, "samprad_factor", self.samprad_factor, "in (0, 1)")?;
+        check(
+            self.samprad_factor > 0.0 && self.samprad_factor < 1.0,
+            "samprad_factor",
+            self.samprad_factor,
+            "in (0, 1)",
+        )?;
         check(self.target_factor > 0.0 && self.target_factor < 1.0, "target_factor", self.target_factor, "in (0, 1)")?;
         if let Some(k) = self.ngrad {
             check(k >= 1, "ngrad", k as f64, ">= 1")?;

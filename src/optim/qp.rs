@@ -19,11 +19,9 @@
 //! solvers agree.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
-use faer::{Mat, Side};
+use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
 
 use crate::numeric::dot;
 
@@ -155,9 +153,7 @@ fn dense_ip(q: &[f64], m: usize) -> Option<(Vec<f64>, usize)> {
         }
         // Factor M = Q + diag(z/w) + reg·I, growing reg on failure.
         let llt = loop {
-            let mm = Mat::from_fn(m, m, |i, j| {
-                q[i * m + j] + if i == j { z[i] / w[i] + reg } else { 0.0 }
-            });
+            let mm = Mat::from_fn(m, m, |i, j| q[i * m + j] + if i == j { z[i] / w[i] + reg } else { 0.0 });
             match mm.llt(Side::Lower) {
                 Ok(l) => break l,
                 Err(_) => {
@@ -200,15 +196,10 @@ fn dense_ip(q: &[f64], m: usize) -> Option<(Vec<f64>, usize)> {
         let rc_aff: Vec<f64> = (0..m).map(|i| -w[i] * z[i]).collect();
         let (dw_a, _, dz_a) = direction(&rc_aff);
         let a_aff = max_step(&dw_a, &dz_a);
-        let mu_aff = (0..m)
-            .map(|i| (w[i] + a_aff * dw_a[i]) * (z[i] + a_aff * dz_a[i]))
-            .sum::<f64>()
-            / m as f64;
+        let mu_aff = (0..m).map(|i| (w[i] + a_aff * dw_a[i]) * (z[i] + a_aff * dz_a[i])).sum::<f64>() / m as f64;
         let sigma = (mu_aff / mu).clamp(0.0, 1.0).powi(3);
         // Corrector with centring.
-        let rc: Vec<f64> = (0..m)
-            .map(|i| -w[i] * z[i] + sigma * mu - dw_a[i] * dz_a[i])
-            .collect();
+        let rc: Vec<f64> = (0..m).map(|i| -w[i] * z[i] + sigma * mu - dw_a[i] * dz_a[i]).collect();
         let (dw, dl, dz) = direction(&rc);
         let a = (QP_STEP_DAMPING * max_step(&dw, &dz)).min(1.0);
         if !(a > 0.0) || dw.iter().chain(&dz).any(|v| !v.is_finite()) {
@@ -368,15 +359,15 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     fn random_cols(rng: &mut ChaCha8Rng, n: usize, m: usize, shift: f64) -> Vec<Vec<f64>> {
-        (0..m)
-            .map(|_| (0..n).map(|_| rng.random::<f64>() - 0.5 + shift).collect())
-            .collect()
+        (0..m).map(|_| (0..n).map(|_| rng.random::<f64>() - 0.5 + shift).collect()).collect()
     }
 
     #[test]
     fn dense_and_clarabel_agree() {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
-        for &(n, m, shift) in &[(3, 5, 0.0), (10, 3, 0.3), (20, 30, 0.0), (20, 30, 0.4), (60, 100, 0.1), (5, 40, 0.0), (300, 100, 0.05)] {
+        for &(n, m, shift) in
+            &[(3, 5, 0.0), (10, 3, 0.3), (20, 30, 0.0), (20, 30, 0.4), (60, 100, 0.1), (5, 40, 0.0), (300, 100, 0.05)]
+        {
             let cols = random_cols(&mut rng, n, m, shift);
             let refs: Vec<&[f64]> = cols.iter().map(|c| c.as_slice()).collect();
             let dense = min_norm_dense(&refs).expect("dense solved");

@@ -41,7 +41,9 @@ impl Termination {
     /// One line for logs and reports.
     pub fn text(self) -> &'static str {
         match self {
-            Termination::Certified => "certified: smallest vector in the convex hull of nearby gradients is below normtol",
+            Termination::Certified => {
+                "certified: smallest vector in the convex hull of nearby gradients is below normtol"
+            }
             Termination::MaxIters => "maximum number of iterations reached",
             Termination::TargetReached => "f dropped below fvalquit",
             Termination::XNormExceeded => "norm of x exceeded xnormquit",

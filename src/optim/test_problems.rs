@@ -135,9 +135,8 @@ pub struct L1Norm {
 impl L1Norm {
     /// Random M = I + (U[−½, ½])/2.
     pub fn random(n: usize, rng: &mut dyn RngCore) -> Self {
-        let m = (0..n * n)
-            .map(|k| if k / n == k % n { 1.0 } else { 0.0 } + 0.5 * (rng.random::<f64>() - 0.5))
-            .collect();
+        let m =
+            (0..n * n).map(|k| if k / n == k % n { 1.0 } else { 0.0 } + 0.5 * (rng.random::<f64>() - 0.5)).collect();
         L1Norm { n, m }
     }
 }
@@ -154,8 +153,8 @@ impl Objective for L1Norm {
             let r: f64 = (0..n).map(|j| self.m[i * n + j] * x[j]).sum();
             f += r.abs();
             let s = sgn(r);
-            for j in 0..n {
-                g[j] += s * self.m[i * n + j];
+            for (gj, &mij) in g.iter_mut().zip(&self.m[i * n..(i + 1) * n]) {
+                *gj += s * mij;
             }
         }
         f

@@ -26,13 +26,20 @@ fn run_hanso(obj: &mut dyn Objective, nstarts: usize, opts: &HansoOptions, seed:
 }
 
 fn show(name: &str, r: &OptimResult) {
-    println!("{name}: f={:.3e} dnorm={:.2e} evaldist={:.2e} {:?} iters {} evals {}", r.f, r.dnorm, r.evaldist, r.termination, r.iters, r.evals);
+    println!(
+        "{name}: f={:.3e} dnorm={:.2e} evaldist={:.2e} {:?} iters {} evals {}",
+        r.f, r.dnorm, r.evaldist, r.termination, r.iters, r.evals
+    );
 }
 
 /// Certificate sanity: finite, and dnorm really is the min-norm of gradients near x.
 fn assert_certificate(r: &OptimResult, dnorm_max: f64, evaldist_max: f64) {
     assert!(r.dnorm.is_finite() && r.dnorm >= 0.0 && r.dnorm <= dnorm_max, "dnorm {:e} > {dnorm_max:e}", r.dnorm);
-    assert!(r.evaldist.is_finite() && r.evaldist >= 0.0 && r.evaldist <= evaldist_max, "evaldist {:e} > {evaldist_max:e}", r.evaldist);
+    assert!(
+        r.evaldist.is_finite() && r.evaldist >= 0.0 && r.evaldist <= evaldist_max,
+        "evaldist {:e} > {evaldist_max:e}",
+        r.evaldist
+    );
 }
 
 #[test]
@@ -71,7 +78,11 @@ fn chebyshev_rosenbrock_n4_needs_the_h_floor() {
     show("chebyshev-rosenbrock n=4, no floor", &r.best);
     assert!(r.best.f > 1e-6, "f = {:e}", r.best.f);
     for s in r.starts.iter().map(|s| s.as_ref().unwrap()) {
-        assert!(matches!(s.termination, Termination::NotDescent | Termination::LineSearchFailed), "{:?}", s.termination);
+        assert!(
+            matches!(s.termination, Termination::NotDescent | Termination::LineSearchFailed),
+            "{:?}",
+            s.termination
+        );
         assert!(s.iters < 50_000, "{} iterations", s.iters);
     }
 }
@@ -223,7 +234,8 @@ fn observer_break_interrupts() {
     // hanso: the break ends the whole run; later starts are NotRun.
     let starts = vec![vec![-1.2, 1.0, -1.2, 1.0]; 3];
     let mut rng = ChaCha8Rng::seed_from_u64(0);
-    let mut ob = FnObserver(|r: &IterRecord<'_>| if r.iter == 3 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) });
+    let mut ob =
+        FnObserver(|r: &IterRecord<'_>| if r.iter == 3 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) });
     let h = hanso(&mut obj, &starts, &hanso_opts(1e-6, 1e-4, 100, true), &mut rng, &ctl, &mut ob).unwrap();
     assert_eq!(h.best.termination, Termination::Interrupted);
     assert!(matches!(h.starts[1], Err(OptimError::NotRun { reason: Termination::Interrupted })));

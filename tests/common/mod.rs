@@ -96,7 +96,8 @@ pub fn latex_structure(tex: &str) -> Result<(), String> {
             } else {
                 let skip = rest.chars().next().map_or(1, char::len_utf8);
                 let tail = &rest[skip..];
-                let next = tail.find("\\begin{").into_iter().chain(tail.find("\\end{")).min().map_or(rest.len(), |i| i + skip);
+                let next =
+                    tail.find("\\begin{").into_iter().chain(tail.find("\\end{")).min().map_or(rest.len(), |i| i + skip);
                 if let Some((name, _, rows)) = envs.last_mut() {
                     if name == "tabular" {
                         rows.push(rest[..next].to_string());
@@ -152,7 +153,8 @@ fn check_tabular(cols: usize, rows: &[String]) -> Result<(), String> {
         return Err("tabular without booktabs \\toprule/\\bottomrule".into());
     }
     for row in body.split("\\\\").map(str::trim) {
-        let row = ["\\toprule", "\\midrule", "\\bottomrule"].iter().fold(row.to_string(), |r, rule| r.replace(rule, ""));
+        let row =
+            ["\\toprule", "\\midrule", "\\bottomrule"].iter().fold(row.to_string(), |r, rule| r.replace(rule, ""));
         if row.trim().is_empty() {
             continue;
         }
@@ -161,7 +163,9 @@ fn check_tabular(cols: usize, rows: &[String]) -> Result<(), String> {
         let spans: usize = row
             .split("\\multicolumn{")
             .skip(1)
-            .map(|m| m.split('}').next().and_then(|k| k.trim().parse::<usize>().ok()).map_or(0, |k| k.saturating_sub(1)))
+            .map(|m| {
+                m.split('}').next().and_then(|k| k.trim().parse::<usize>().ok()).map_or(0, |k| k.saturating_sub(1))
+            })
             .sum();
         if amps + 1 + spans != cols {
             return Err(format!("row `{}` has {} cells, the tabular has {cols} columns", row.trim(), amps + 1 + spans));
@@ -169,4 +173,3 @@ fn check_tabular(cols: usize, rows: &[String]) -> Result<(), String> {
     }
     Ok(())
 }
-

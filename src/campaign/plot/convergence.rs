@@ -84,7 +84,13 @@ impl ConvergenceFigure {
         (0.0, if hi > 0.0 { hi * 1.02 } else { 1.0 })
     }
 
-    fn panel<DB: DrawingBackend, Y>(&self, area: &DrawingArea<DB, Shift>, stab: bool, caption: Option<&str>, y: Y) -> Result<(), String>
+    fn panel<DB: DrawingBackend, Y>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        stab: bool,
+        caption: Option<&str>,
+        y: Y,
+    ) -> Result<(), String>
     where
         Y: AsRangedCoord<Value = f64>,
         Y::CoordDescType: ValueFormatter<f64>,
@@ -121,11 +127,22 @@ impl ConvergenceFigure {
             let style = ShapeStyle::from(&colour::MARK).stroke_width(2);
             chart.draw_series(DashedLineSeries::new(vec![(m.x, ylo), (m.x, yhi)], 8, 5, style)).map_err(msg)?;
             chart
-                .draw_series(std::iter::once(Text::new(format!(" {}", m.label), (m.x, yhi), (FONT_FAMILY, 15).into_font().color(&colour::MARK))))
+                .draw_series(std::iter::once(Text::new(
+                    format!(" {}", m.label),
+                    (m.x, yhi),
+                    (FONT_FAMILY, 15).into_font().color(&colour::MARK),
+                )))
                 .map_err(msg)?;
         }
         for m in self.restart_markers().into_iter().filter(|m| m.x <= x1) {
-            chart.draw_series(DashedLineSeries::new(vec![(m.x, ylo), (m.x, yhi)], 2, 4, ShapeStyle::from(&colour::MARK.mix(0.6)))).map_err(msg)?;
+            chart
+                .draw_series(DashedLineSeries::new(
+                    vec![(m.x, ylo), (m.x, yhi)],
+                    2,
+                    4,
+                    ShapeStyle::from(&colour::MARK.mix(0.6)),
+                ))
+                .map_err(msg)?;
         }
         if stab {
             chart.draw_series(LineSeries::new(vec![(x0, 0.0), (x1, 0.0)], &BLACK.mix(0.4))).map_err(msg)?;
@@ -139,7 +156,8 @@ impl ConvergenceFigure {
             if (it.phase == STABILISATION) != stab || !it.f.is_finite() {
                 continue;
             }
-            let key_changed = prev.is_none_or(|p| self.iterations[p].phase != it.phase || self.iterations[p].start != it.start);
+            let key_changed =
+                prev.is_none_or(|p| self.iterations[p].phase != it.phase || self.iterations[p].start != it.start);
             if key_changed {
                 let restart = prev.is_some_and(|p| self.iterations[p].phase == it.phase);
                 runs.push((restart, Vec::new()));
@@ -152,7 +170,8 @@ impl ConvergenceFigure {
             let s = chart.draw_series(LineSeries::new(run.clone(), line_colour.stroke_width(2))).map_err(msg)?;
             if n == 0 {
                 let label = if stab { "stabilisation objective" } else { "objective (BFGS, gradient sampling)" };
-                s.label(label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], line_colour.stroke_width(2)));
+                s.label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], line_colour.stroke_width(2)));
             }
             // restart marker at the first point of a new start within the same phase
             if *restart {
@@ -161,7 +180,8 @@ impl ConvergenceFigure {
             }
         }
         if !stab {
-            if let Some(best) = pts.iter().map(|p| p.1).fold(None, |b: Option<f64>, v| Some(b.map_or(v, |b| b.min(v)))) {
+            if let Some(best) = pts.iter().map(|p| p.1).fold(None, |b: Option<f64>, v| Some(b.map_or(v, |b| b.min(v))))
+            {
                 let style = ShapeStyle::from(&colour::BOUND).stroke_width(1);
                 chart
                     .draw_series(DashedLineSeries::new(vec![(x0, best), (x1, best)], 6, 6, style))
@@ -178,7 +198,12 @@ impl ConvergenceFigure {
         draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 
-    fn panel_auto<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, stab: bool, caption: Option<&str>) -> Result<(), String> {
+    fn panel_auto<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        stab: bool,
+        caption: Option<&str>,
+    ) -> Result<(), String> {
         let ys: Vec<f64> = self.points(stab).iter().map(|p| p.1).collect();
         let (lo, hi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };

@@ -54,7 +54,13 @@ impl GammaOrderFigure {
             .x_desc("controller order n_K")
             .y_desc("γ = ‖T_zw‖∞")
             .x_labels(kmax - kmin + 3)
-            .x_label_formatter(&|v| if (v - v.round()).abs() < 1e-9 && *v >= 0.0 { format!("{}", v.round()) } else { String::new() })
+            .x_label_formatter(&|v| {
+                if (v - v.round()).abs() < 1e-9 && *v >= 0.0 {
+                    format!("{}", v.round())
+                } else {
+                    String::new()
+                }
+            })
             .y_label_formatter(&|v| tick(*v))
             .max_light_lines(2)
             .label_style((FONT_FAMILY, 16))

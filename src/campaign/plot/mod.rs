@@ -86,9 +86,13 @@ pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[Ref
     names
         .into_iter()
         .map(|p| {
-            let ours = best.iter().filter(|r| r.plant == p && r.gamma.is_finite()).map(|r| (r.order, r.gamma)).collect();
-            let mut paper: Vec<(usize, f64)> =
-                reference.iter().filter(|r| r.plant == p && r.method == RefMethod::Hifoo).map(|r| (r.order, r.gamma)).collect();
+            let ours =
+                best.iter().filter(|r| r.plant == p && r.gamma.is_finite()).map(|r| (r.order, r.gamma)).collect();
+            let mut paper: Vec<(usize, f64)> = reference
+                .iter()
+                .filter(|r| r.plant == p && r.method == RefMethod::Hifoo)
+                .map(|r| (r.order, r.gamma))
+                .collect();
             paper.sort_by_key(|x| x.0);
             let full_order = full.iter().find(|f| f.plant == p && f.gamma.is_finite()).map(|f| (f.gamma, f.from_paper));
             GammaOrderFigure { plant: p.to_string(), ours, paper, full_order }
@@ -118,7 +122,13 @@ pub fn write_plots(
             out.skipped.push(format!("{} n_K = {}: no verified controller", row.plant, row.order));
             continue;
         };
-        let title = format!("{}, n_K = {} (ε = {}, seed {})", row.plant, row.order, row.eps.unwrap_or(f64::NAN), row.seed.unwrap_or(0));
+        let title = format!(
+            "{}, n_K = {} (ε = {}, seed {})",
+            row.plant,
+            row.order,
+            row.eps.unwrap_or(f64::NAN),
+            row.seed.unwrap_or(0)
+        );
         let trace = campaign_dir.join("traces").join(format!("{job}.mcap"));
         if trace.is_file() {
             match read_iterations(&trace) {
@@ -132,7 +142,10 @@ pub fn write_plots(
         } else {
             out.skipped.push(format!("convergence of {tag}: no trace {}", trace.display()));
         }
-        let (Some(plant), Some(rec)) = (plants.get(&row.plant_fingerprint), records.iter().find(|r| r.job_id.0 == job)) else { continue };
+        let (Some(plant), Some(rec)) = (plants.get(&row.plant_fingerprint), records.iter().find(|r| r.job_id.0 == job))
+        else {
+            continue;
+        };
         let Some(k) = rec.controller.as_ref().and_then(|c| Controller::from_json_value(c).ok()) else { continue };
         let fig = sigma_figure(plant, &k, format!("σ-plot: {title}"))?;
         out.files.extend(write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}")))?);

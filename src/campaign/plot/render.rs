@@ -132,7 +132,11 @@ pub fn tick(x: f64) -> String {
     }
     if (1e-3..1e5).contains(&x.abs()) {
         let s = crate::campaign::latex::sig_figs(x, 4);
-        if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
     } else {
         format!("{x:.1e}")
     }

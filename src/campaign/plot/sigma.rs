@@ -31,7 +31,12 @@ pub struct SigmaFigure {
 
 /// |λ| of the nonzero eigenvalues of `a`.
 fn mode_magnitudes(a: faer::MatRef<'_, f64>) -> Vec<f64> {
-    crate::lti::eigenvalues_of(a).unwrap_or_default().into_iter().map(|l| l.norm()).filter(|m| *m > 0.0 && m.is_finite()).collect()
+    crate::lti::eigenvalues_of(a)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|l| l.norm())
+        .filter(|m| *m > 0.0 && m.is_finite())
+        .collect()
 }
 
 impl SigmaFigure {
@@ -52,7 +57,8 @@ impl SigmaFigure {
             hi = hi.max(h.peak_freq);
         }
         let (l0, l1) = ((lo / 10.0).log10().floor(), (hi * 10.0).log10().ceil());
-        let mut grid: Vec<f64> = (0..GRID_POINTS).map(|i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (GRID_POINTS - 1) as f64)).collect();
+        let mut grid: Vec<f64> =
+            (0..GRID_POINTS).map(|i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (GRID_POINTS - 1) as f64)).collect();
         if h.peak_freq.is_finite() && h.peak_freq > 0.0 {
             grid.push(h.peak_freq);
             grid.sort_by(f64::total_cmp);
@@ -81,7 +87,10 @@ impl SigmaFigure {
 
 impl Figure for SigmaFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let ys = Self::positive(&self.closed_loop).chain(Self::positive(&self.controller)).map(|p| p.1).chain(self.peak_point().map(|p| p.1));
+        let ys = Self::positive(&self.closed_loop)
+            .chain(Self::positive(&self.controller))
+            .map(|p| p.1)
+            .chain(self.peak_point().map(|p| p.1));
         let (lo, hi) = ys.fold((f64::INFINITY, 0f64), |(l, h), v| (l.min(v), h.max(v)));
         let (lo, hi) = if lo <= hi { (lo / 2.0, hi * 2.0) } else { (0.1, 10.0) };
         let (w0, w1) = match (self.closed_loop.first(), self.closed_loop.last()) {
@@ -119,7 +128,13 @@ impl Figure for SigmaFigure {
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], k_style));
         if let Some(p) = self.peak_point() {
             let (g, w) = self.peak;
-            let at = if w.is_infinite() { "ω → ∞".to_string() } else if w == 0.0 { "ω = 0".to_string() } else { format!("ω = {} rad/s", tick(w)) };
+            let at = if w.is_infinite() {
+                "ω → ∞".to_string()
+            } else if w == 0.0 {
+                "ω = 0".to_string()
+            } else {
+                format!("ω = {} rad/s", tick(w))
+            };
             let text = format!("peak ‖T_zw‖∞ = {} at {at}", tick(g));
             chart
                 .draw_series(std::iter::once(Circle::new(p, 7, colour::PAPER.filled())))
