@@ -349,10 +349,9 @@ fn print_shards(l: &Loaded, n: usize, threads: usize) {
     );
 }
 
-/// `campaign report FILE`.
-pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
-    let l = load(&a.campaign)?;
-    let (records, journals) = journaled(&l, &a.extra)?;
+/// The journaled records of this campaign's jobs ([`journaled`]); an error if there are none.
+fn finished_records(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<Vec<JobRecord>> {
+    let (records, journals) = journaled(l, extra)?;
     if records.is_empty() {
         anyhow::bail!(
             "{}: no finished jobs of this campaign in {} journal(s) (run it first)",
@@ -360,6 +359,13 @@ pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
             journals.len()
         );
     }
+    Ok(records)
+}
+
+/// `campaign report FILE`.
+pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
+    let l = load(&a.campaign)?;
+    let records = finished_records(&l, &a.extra)?;
     report_into(&l.dir, &l.campaign, &records)?;
     Ok(ExitCode::SUCCESS)
 }
@@ -367,14 +373,7 @@ pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
 /// `campaign plot FILE`: figures of the journaled jobs into `<results>/<name>/plots/`.
 pub fn plot(a: PlotArgs) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign)?;
-    let (records, journals) = journaled(&l, &a.extra)?;
-    if records.is_empty() {
-        anyhow::bail!(
-            "{}: no finished jobs of this campaign in {} journal(s) (run it first)",
-            l.dir.display(),
-            journals.len()
-        );
-    }
+    let records = finished_records(&l, &a.extra)?;
     let reference = load_default_reference().context("reading the paper's reference table")?;
     let s = hinfix::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;
     for f in &s.files {
