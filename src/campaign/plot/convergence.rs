@@ -123,9 +123,17 @@ impl ConvergenceFigure {
             let r = chart.plotting_area().get_y_range();
             (r.start, r.end)
         };
+        // A multi-start search changes phase at every start: label a boundary only where its
+        // text does not run into the previous label (the dashed line is always drawn).
+        let min_gap = 0.12 * (x1 - x0);
+        let mut last_label: Option<f64> = None;
         for m in self.phase_markers().into_iter().filter(|m| m.x <= x1) {
             let style = ShapeStyle::from(&colour::MARK).stroke_width(2);
             chart.draw_series(DashedLineSeries::new(vec![(m.x, ylo), (m.x, yhi)], 8, 5, style)).map_err(msg)?;
+            if last_label.is_some_and(|x| m.x - x < min_gap) {
+                continue;
+            }
+            last_label = Some(m.x);
             chart
                 .draw_series(std::iter::once(Text::new(
                     format!(" {}", m.label),
