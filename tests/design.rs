@@ -1,5 +1,4 @@
-//! Seeded end-to-end checks of `design::run` on the shipped plants (plants/ is part of the crate,
-//! not ../shared). Each run takes well under a second in the test profile: runs that do not test
+//! Seeded end-to-end checks of `design::run` on the shipped plants (plants/ is part of the crate). Each run takes well under a second in the test profile: runs that do not test
 //! the continued search use HIFOO's (`stall_starts: 0`), the others an evaluation budget.
 
 use std::ops::ControlFlow;

@@ -3,27 +3,13 @@
 
 use std::path::PathBuf;
 
-use faer::{c64, Mat};
-use hinfix::lti::{closed_loop, closed_loop_hinf_grad, hinf_norm, Controller, Plant, StateSpace, DEFAULT_HINF_TOL};
+use hinfix::lti::{closed_loop, closed_loop_hinf_grad, hinf_norm, Controller, Plant, DEFAULT_HINF_TOL};
+
+mod common;
+use common::sigma_direct;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/hinf-regression").join(name)
-}
-
-/// σmax(C (iωI − A)⁻¹ B + D) by a dense complex LU (not the library's Hessenberg path).
-fn sigma_direct(sys: &StateSpace, w: f64) -> f64 {
-    use faer::linalg::solvers::Solve;
-    let n = sys.order();
-    if !w.is_finite() || n == 0 {
-        return sys.d.singular_values().unwrap().into_iter().fold(0.0, f64::max);
-    }
-    let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
-    let b = Mat::<c64>::from_fn(n, sys.inputs(), |i, j| c64::new(sys.b[(i, j)], 0.0));
-    let x = z.partial_piv_lu().solve(&b);
-    let g = Mat::<c64>::from_fn(sys.outputs(), sys.inputs(), |i, j| {
-        (0..n).fold(c64::new(sys.d[(i, j)], 0.0), |s, k| s + x[(k, j)] * sys.c[(i, k)])
-    });
-    g.singular_values().unwrap().into_iter().fold(0.0, f64::max)
 }
 
 /// Plant "my3" with a second-order controller (issue 13): σmax(D_cl) = 1.8446145 lies 4.2e-6

@@ -11,6 +11,9 @@ use hinfix::lti::{
 };
 use serde_json::Value;
 
+mod common;
+use common::sigma_direct;
+
 /// Relative agreement required on values.
 const REL_TOL: f64 = 1e-8;
 
@@ -26,23 +29,6 @@ const ORACLE_ERRATA_CONTROLLER_HINF: &[(&str, f64, f64)] = &[
     ("REA2_nk2_0", 0.12180401397282756, 1.310629684248824),
     ("REA2_nk3_0", 0.05350497202407391, 16.534840121711554),
 ];
-
-/// σmax(C (iωI − A)⁻¹ B + D) by a dense complex LU (independent of the library's Hessenberg path).
-fn sigma_direct(sys: &StateSpace, w: f64) -> f64 {
-    use faer::c64;
-    use faer::linalg::solvers::Solve;
-    let n = sys.order();
-    if !w.is_finite() || n == 0 {
-        return sys.d.singular_values().unwrap().into_iter().fold(0.0, f64::max);
-    }
-    let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
-    let b = Mat::<c64>::from_fn(n, sys.inputs(), |i, j| c64::new(sys.b[(i, j)], 0.0));
-    let x = z.partial_piv_lu().solve(&b);
-    let g = Mat::<c64>::from_fn(sys.outputs(), sys.inputs(), |i, j| {
-        (0..n).fold(c64::new(sys.d[(i, j)], 0.0), |s, k| s + x[(k, j)] * sys.c[(i, k)])
-    });
-    g.singular_values().unwrap().into_iter().fold(0.0, f64::max)
-}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -173,3 +173,22 @@ fn check_tabular(cols: usize, rows: &[String]) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// σmax(C (iωI − A)⁻¹ B + D) by a dense complex LU (independent of the library's Hessenberg
+/// path); σmax(D) at ω = ∞ or for a static system.
+pub fn sigma_direct(sys: &hinfix::lti::StateSpace, w: f64) -> f64 {
+    use faer::c64;
+    use faer::linalg::solvers::Solve;
+    use faer::Mat;
+    let n = sys.order();
+    if !w.is_finite() || n == 0 {
+        return sys.d.singular_values().unwrap().into_iter().fold(0.0, f64::max);
+    }
+    let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
+    let b = Mat::<c64>::from_fn(n, sys.inputs(), |i, j| c64::new(sys.b[(i, j)], 0.0));
+    let x = z.partial_piv_lu().solve(&b);
+    let g = Mat::<c64>::from_fn(sys.outputs(), sys.inputs(), |i, j| {
+        (0..n).fold(c64::new(sys.d[(i, j)], 0.0), |s, k| s + x[(k, j)] * sys.c[(i, k)])
+    });
+    g.singular_values().unwrap().into_iter().fold(0.0, f64::max)
+}
