@@ -21,7 +21,7 @@ use std::sync::Arc;
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
-use super::spec::Campaign;
+use super::model::Campaign;
 use crate::design::DesignOptions;
 use crate::lti::Plant;
 

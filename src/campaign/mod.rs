@@ -6,10 +6,12 @@
 //! ([`run`]), the trace writer ([`trace`]), the progress reporter ([`progress`]) and the report
 //! writers ([`report`]) each consume what they need.
 pub mod claims;
+pub mod compare;
 pub mod fake;
 pub mod jobs;
 pub mod journal;
 pub mod latex;
+pub mod model;
 pub mod plot;
 pub mod progress;
 pub mod provenance;
