@@ -52,7 +52,8 @@ impl fmt::Display for JobId {
 pub enum RunnerTag {
     /// `design::run` (production).
     Design,
-    /// The deterministic fake runner of the test hook (`HINFIX_FAKE_RUNNER`).
+    /// The deterministic fake runner of the test hook (`HINFIX_FAKE_RUNNER`; only in builds with
+    /// the test-only `test-fake-runner` feature).
     Fake,
 }
 

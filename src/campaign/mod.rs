@@ -7,6 +7,7 @@
 //! writers ([`report`]) each consume what they need.
 pub mod claims;
 pub mod compare;
+#[cfg(feature = "test-fake-runner")]
 pub mod fake;
 pub mod jobs;
 pub mod journal;
