@@ -2,8 +2,9 @@
 //! `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`. Pure functions of journal records,
 //! the plants and the paper's reference rows, so `campaign report` reruns without jobs.
 //!
-//! The rows themselves (ours against the paper's, the full-order bound) are computed in
-//! [`super::compare`]; the LaTeX rendering is [`super::latex`].
+//! The rows themselves (ours against the paper's, the full-order bound) are computed by
+//! [`compare_rows`] and [`full_order_rows`] (module `compare`, re-exported here); the LaTeX
+//! rendering is [`super::latex`].
 
 use std::collections::BTreeMap;
 use std::fmt;
