@@ -17,6 +17,7 @@
 // `!(x > 0.0)` is this crate's NaN-aware comparison (true when x is NaN, which must count as a
 // failure); clippy's suggested `partial_cmp` form would hide that intent.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![warn(missing_docs)]
 
 pub mod campaign;
 pub mod design;

@@ -143,7 +143,7 @@ fn item1_non_finite_values_in_every_numeric_field_round_trip_through_the_journal
             assert!(same(v, x), "{name}: wrote {x}, read {v}");
         }
         match &r.status {
-            JobStatus::NotStabilised { best_alpha } => assert!(same(*best_alpha, x)),
+            JobStatus::Design(DesignStatus::NotStabilised { best_alpha }) => assert!(same(*best_alpha, x)),
             s => panic!("{s:?}"),
         }
     }
@@ -531,7 +531,7 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
     assert_eq!(v["status"]["kind"], "converged");
     v["status"]["kind"] = Value::from("optimised");
     let old: JobRecord = serde_json::from_value(v).unwrap();
-    assert_eq!(old.status, JobStatus::Stopped);
+    assert_eq!(old.status, JobStatus::Design(DesignStatus::Stopped));
     let d: DesignStatus = serde_json::from_str(r#"{"kind": "optimised"}"#).unwrap();
     assert_eq!(d, DesignStatus::Stopped);
 

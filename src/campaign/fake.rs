@@ -1,7 +1,10 @@
 //! A deterministic stand-in for `design::run`, for testing the campaign machinery (scheduling,
-//! journal, resume after kill -9) quickly. The command line selects it only through the hidden
-//! environment variable [`FAKE_RUNNER_ENV`]; jobs made for it carry [`RunnerTag::Fake`] in their
-//! id and `"runner": "fake"` in their record, so its results can never pass for real ones.
+//! journal, resume after kill -9) quickly. It exists only in builds with the test-only cargo
+//! feature `test-fake-runner` (which `cargo test` turns on through the crate's dev-dependency on
+//! itself; `cargo build --release` never does), so a production binary cannot be switched to
+//! fake results. In such a build the command line selects it through the hidden environment
+//! variable [`FAKE_RUNNER_ENV`]; jobs made for it carry [`RunnerTag::Fake`] in their id and
+//! `"runner": "fake"` in their record, so its results can never pass for real ones.
 //!
 //! A fake job takes [`FAKE_ITERS`] "iterations", sleeping `pause` between them and reporting each
 //! to the observer (so cancellation works exactly as with the real runner), and returns figures

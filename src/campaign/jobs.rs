@@ -21,7 +21,7 @@ use std::sync::Arc;
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
-use super::spec::Campaign;
+use super::model::Campaign;
 use crate::design::DesignOptions;
 use crate::lti::Plant;
 
@@ -52,7 +52,8 @@ impl fmt::Display for JobId {
 pub enum RunnerTag {
     /// `design::run` (production).
     Design,
-    /// The deterministic fake runner of the test hook (`HINFIX_FAKE_RUNNER`).
+    /// The deterministic fake runner of the test hook (`HINFIX_FAKE_RUNNER`; only in builds with
+    /// the test-only `test-fake-runner` feature).
     Fake,
 }
 

@@ -3,29 +3,13 @@
 
 use std::fmt::Write as _;
 
+use super::compare::{CompareRow, FullOrderRow};
 use super::reduce::BestRow;
 use super::reference::{RefMethod, ReferenceRow};
-use super::report::{CompareRow, FullOrderRow};
 
-/// Escapes LaTeX specials (`\ & % $ # _ { } ~ ^`) and drops control characters (a newline or
-/// NUL in a name must not end a table row or break the file).
-pub fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            c if c.is_control() => {}
-            '\\' => out.push_str("\\textbackslash{}"),
-            '&' | '%' | '$' | '#' | '_' | '{' | '}' => {
-                out.push('\\');
-                out.push(c);
-            }
-            '~' => out.push_str("\\textasciitilde{}"),
-            '^' => out.push_str("\\textasciicircum{}"),
-            _ => out.push(c),
-        }
-    }
-    out
-}
+/// Escapes LaTeX specials and drops control characters: [`super::sanitise::for_latex`], which
+/// every LaTeX table uses (kept under this name too).
+pub use super::sanitise::for_latex as escape;
 
 /// γ to 4 decimals, `--` when not finite.
 pub fn num(x: f64) -> String {

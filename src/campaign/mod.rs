@@ -6,13 +6,16 @@
 //! ([`run`]), the trace writer ([`trace`]), the progress reporter ([`progress`]) and the report
 //! writers ([`report`]) each consume what they need.
 pub mod claims;
+mod compare;
+#[cfg(feature = "test-fake-runner")]
 pub mod fake;
-pub mod jobs;
+mod jobs;
 pub mod journal;
 pub mod latex;
+mod model;
 pub mod plot;
 pub mod progress;
-pub mod provenance;
+mod provenance;
 pub mod record;
 pub mod reduce;
 mod reference;
@@ -21,10 +24,11 @@ pub mod run;
 pub mod sanitise;
 pub mod scheduler;
 pub mod shard;
-pub mod spec;
+mod spec;
 pub mod trace;
 
-pub use jobs::{expand, job_id, Job, JobId, RunnerTag};
+pub use jobs::{expand, job_id, Job, JobId, RunnerTag, JOB_ID_VERSION};
+pub use provenance::Provenance;
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
 pub use reference::{load_default_reference, load_reference, RefMethod, ReferenceError, ReferenceRow, REFERENCE_CSV};
 pub use report::{write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary};

@@ -41,13 +41,13 @@ impl Provenance {
 }
 
 /// This machine's host name (`"unknown"` if it cannot be read).
-pub fn host_name() -> String {
+pub(crate) fn host_name() -> String {
     crate::fs_atomic::host_name()
 }
 
 /// The CPU model from `/proc/cpuinfo` (`model name`, else `Model`/`Hardware`), else the
 /// architecture.
-pub fn cpu_model() -> String {
+pub(crate) fn cpu_model() -> String {
     let text = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     for key in ["model name", "Model", "Hardware", "cpu model"] {
         let found = text.lines().find_map(|l| {

@@ -12,44 +12,65 @@ use crate::design::{
 /// Version of the journal line format. Readers refuse newer versions.
 pub const SCHEMA_VERSION: u32 = 1;
 
-/// How a journaled job ended. (`Interrupted` runs are never journaled: resume reruns them.)
+/// How a journaled job ended: the design run's own [`DesignStatus`] (one definition of the
+/// statuses, their meaning and their journal names), or a failure. Never
+/// `DesignStatus::Interrupted`: interrupted runs are not journaled (resume reruns them), and a
+/// line that says so is refused on reading.
+///
+/// Journal form, as it always was: `{"kind": "converged"}`, `{"kind": "stopped"}`,
+/// `{"kind": "stabilised_only"}`, `{"kind": "not_stabilised", "best_alpha": …}`,
+/// `{"kind": "budget_exhausted"}`, `{"kind": "failed", "error": "…"}`; the kind "optimised" of
+/// older builds reads as `stopped` (an alias of [`DesignStatus::Stopped`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(tag = "kind", rename_all = "snake_case", try_from = "StatusLine")]
 pub enum JobStatus {
-    /// Both phases ran and the optimality certificate was met (see
-    /// [`DesignStatus::Converged`]).
-    Converged,
-    /// Both phases ran, but a limit ended the search before the certificate was met (see
-    /// [`DesignStatus::Stopped`]); journal lines of older builds with kind "optimised" read as
-    /// this.
-    #[serde(alias = "optimised")]
-    Stopped,
-    /// Stabilised, but the optimisation phase made no progress.
-    StabilisedOnly,
-    /// No (strongly) stabilising controller found.
-    NotStabilised {
-        /// Best max(α(A_cl), ε·α(Ak)) reached.
-        #[serde(with = "serde_f64_or_string")]
-        best_alpha: f64,
-    },
-    /// The CPU budget ran out during optimisation; the best controller so far is kept.
-    BudgetExhausted,
     /// `design::run` returned an error (or panicked): no trustworthy result.
     Failed {
         /// The error.
         error: String,
     },
+    /// The design run ended with this status (serialised as the status itself).
+    #[serde(untagged)]
+    Design(DesignStatus),
+}
+
+/// The journal's `status` object as read, before `Interrupted` is refused.
+#[derive(Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum StatusLine {
+    Failed {
+        error: String,
+    },
+    #[serde(untagged)]
+    Design(DesignStatus),
+}
+
+impl TryFrom<StatusLine> for JobStatus {
+    type Error = &'static str;
+    fn try_from(s: StatusLine) -> Result<JobStatus, Self::Error> {
+        match s {
+            StatusLine::Failed { error } => Ok(JobStatus::Failed { error }),
+            StatusLine::Design(DesignStatus::Interrupted) => {
+                Err("status \"interrupted\": interrupted runs are never journaled")
+            }
+            StatusLine::Design(d) => Ok(JobStatus::Design(d)),
+        }
+    }
 }
 
 impl JobStatus {
+    /// The status of a finished design run; `None` for an interrupted one (not journaled).
+    pub fn of_design(status: DesignStatus) -> Option<JobStatus> {
+        match status {
+            DesignStatus::Interrupted => None,
+            s => Some(JobStatus::Design(s)),
+        }
+    }
+
     /// Short name as in the journal's `kind`.
     pub fn kind(&self) -> &'static str {
         match self {
-            JobStatus::Converged => "converged",
-            JobStatus::Stopped => "stopped",
-            JobStatus::StabilisedOnly => "stabilised_only",
-            JobStatus::NotStabilised { .. } => "not_stabilised",
-            JobStatus::BudgetExhausted => "budget_exhausted",
+            JobStatus::Design(s) => s.kind(),
             JobStatus::Failed { .. } => "failed",
         }
     }
@@ -203,14 +224,7 @@ impl JobRecord {
         match result {
             Err(error) => r.status = JobStatus::Failed { error },
             Ok(out) => {
-                r.status = match out.status {
-                    DesignStatus::Interrupted => return None,
-                    DesignStatus::Converged => JobStatus::Converged,
-                    DesignStatus::Stopped => JobStatus::Stopped,
-                    DesignStatus::StabilisedOnly => JobStatus::StabilisedOnly,
-                    DesignStatus::NotStabilised { best_alpha } => JobStatus::NotStabilised { best_alpha },
-                    DesignStatus::BudgetExhausted => JobStatus::BudgetExhausted,
-                };
+                r.status = JobStatus::of_design(out.status)?;
                 r.gamma = out.gamma;
                 r.k_hinf = out.k_hinf;
                 r.alpha_cl = out.alpha_cl;
@@ -257,5 +271,41 @@ impl JobRecord {
     /// Whether the job failed (no trustworthy result).
     pub fn failed(&self) -> bool {
         matches!(self.status, JobStatus::Failed { .. })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The journal's status objects are the ones older builds wrote, and read back.
+    #[test]
+    fn status_lines_keep_their_journal_form() {
+        let cases = [
+            (JobStatus::Design(DesignStatus::Converged), r#"{"kind":"converged"}"#),
+            (JobStatus::Design(DesignStatus::Stopped), r#"{"kind":"stopped"}"#),
+            (JobStatus::Design(DesignStatus::StabilisedOnly), r#"{"kind":"stabilised_only"}"#),
+            (
+                JobStatus::Design(DesignStatus::NotStabilised { best_alpha: 0.25 }),
+                r#"{"kind":"not_stabilised","best_alpha":0.25}"#,
+            ),
+            (
+                JobStatus::Design(DesignStatus::NotStabilised { best_alpha: f64::INFINITY }),
+                r#"{"kind":"not_stabilised","best_alpha":"inf"}"#,
+            ),
+            (JobStatus::Design(DesignStatus::BudgetExhausted), r#"{"kind":"budget_exhausted"}"#),
+            (JobStatus::Failed { error: "boom".into() }, r#"{"kind":"failed","error":"boom"}"#),
+        ];
+        for (status, line) in cases {
+            assert_eq!(serde_json::to_string(&status).unwrap(), line);
+            assert_eq!(serde_json::from_str::<JobStatus>(line).unwrap(), status, "{line}");
+            assert_eq!(status.kind(), serde_json::from_str::<serde_json::Value>(line).unwrap()["kind"]);
+        }
+        let old: JobStatus = serde_json::from_str(r#"{"kind":"optimised"}"#).unwrap();
+        assert_eq!(old, JobStatus::Design(DesignStatus::Stopped));
+        for bad in [r#"{"kind":"interrupted"}"#, r#"{"kind":"exploded"}"#, r#"{"kind":"failed"}"#, "{}"] {
+            assert!(serde_json::from_str::<JobStatus>(bad).is_err(), "{bad} was accepted");
+        }
+        assert_eq!(JobStatus::of_design(DesignStatus::Interrupted), None);
     }
 }

@@ -72,10 +72,10 @@ pub enum ReferenceError {
 
 mod stable_word {
     use serde::{Deserialize, Deserializer, Serializer};
-    pub fn serialize<S: Serializer>(b: &bool, s: S) -> Result<S::Ok, S::Error> {
+    pub(crate) fn serialize<S: Serializer>(b: &bool, s: S) -> Result<S::Ok, S::Error> {
         s.serialize_str(if *b { "stable" } else { "unstable" })
     }
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
+    pub(crate) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
         match String::deserialize(d)?.as_str() {
             "stable" => Ok(true),
             "unstable" => Ok(false),
@@ -88,7 +88,7 @@ mod stable_word {
 
 /// The paper's table, built into the program (a plant library chosen with `HINFIX_PLANTS` need
 /// not, and usually does not, hold a copy).
-pub const REFERENCE_TEXT: &str = include_str!("../../plants/reference/gumussoy-millstone-overton-2008.csv");
+pub(crate) const REFERENCE_TEXT: &str = include_str!("../../plants/reference/gumussoy-millstone-overton-2008.csv");
 
 /// Reads the reference table at `path`; every row is checked (γ finite and positive).
 pub fn load_reference(path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> {
@@ -97,7 +97,7 @@ pub fn load_reference(path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> 
 }
 
 /// Reads reference rows from CSV text (`path` names it in errors).
-pub fn parse_reference(input: impl std::io::Read, path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> {
+pub(crate) fn parse_reference(input: impl std::io::Read, path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> {
     let mut rows = Vec::new();
     let mut reader = csv::Reader::from_reader(input);
     for rec in reader.deserialize::<ReferenceRow>() {

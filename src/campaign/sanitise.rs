@@ -5,8 +5,8 @@
 //! * [`for_csv`]: control characters are escaped the same way, and a field that a spreadsheet
 //!   would take for a formula (it starts with `=`, `+`, `-`, `@`, tab or carriage return) gets a
 //!   leading `'` (OWASP's advice against CSV injection); quoting is left to the CSV writer;
-//! * [`for_latex`]: control characters are dropped and the LaTeX specials are escaped
-//!   ([`super::latex::escape`]).
+//! * [`for_latex`]: control characters are dropped and the LaTeX specials are escaped (every
+//!   LaTeX table goes through it, also as `latex::escape`).
 
 /// Whether `c` must not reach an output raw.
 fn is_control(c: char) -> bool {
@@ -40,10 +40,24 @@ pub fn for_csv(s: &str) -> String {
     }
 }
 
-/// `s` for LaTeX text: control characters dropped, specials escaped (= [`super::latex::escape`],
-/// which every LaTeX table uses).
+/// `s` for LaTeX text: escapes LaTeX specials (`\ & % $ # _ { } ~ ^`) and drops control
+/// characters (a newline or NUL in a name must not end a table row or break the file).
 pub fn for_latex(s: &str) -> String {
-    super::latex::escape(s)
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            c if c.is_control() => {}
+            '\\' => out.push_str("\\textbackslash{}"),
+            '&' | '%' | '$' | '#' | '_' | '{' | '}' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '~' => out.push_str("\\textasciitilde{}"),
+            '^' => out.push_str("\\textasciicircum{}"),
+            _ => out.push(c),
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -19,11 +19,10 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
+pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
 use crate::design::{DesignOptions, ObjectiveKind};
 use crate::lti::Plant;
 
-/// Default number of worker threads (`--threads` and `defaults.threads` override it).
-pub const DEFAULT_THREADS: usize = 2;
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
 pub const MAX_ORDER: usize = 200;
 /// Largest number of seeds of one problem (`seeds = N` or a list).
@@ -35,40 +34,12 @@ pub const MAX_THREADS: usize = 256;
 /// Longest campaign name, in characters (it names the results folder).
 pub const MAX_NAME_CHARS: usize = 100;
 
-/// A position in a campaign file (1-based line and column, columns counted in characters).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Location {
-    /// 1-based line.
-    pub line: usize,
-    /// 1-based column.
-    pub column: usize,
-}
-
-impl Location {
-    /// The position of byte `offset` in `text`.
-    pub fn of_offset(text: &str, offset: usize) -> Location {
-        let offset = offset.min(text.len());
-        let before = &text[..floor_char_boundary(text, offset)];
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        let column = before[line_start..].chars().count() + 1;
-        Location { line, column }
-    }
-}
-
 fn location_suffix(l: &Location) -> String {
     if l.line == 0 {
         String::new()
     } else {
         format!(":{}:{}", l.line, l.column)
     }
-}
-
-fn floor_char_boundary(s: &str, mut i: usize) -> usize {
-    while i > 0 && !s.is_char_boundary(i) {
-        i -= 1;
-    }
-    i
 }
 
 /// A campaign file that cannot be used: where and why.
@@ -85,94 +56,56 @@ pub struct SpecError {
     pub message: String,
 }
 
-/// A validated campaign: every plant loaded, every value checked.
-#[derive(Debug, Clone)]
-pub struct Campaign {
-    /// Name; also the results folder `results/<name>/`.
-    pub name: String,
-    /// Free text.
-    pub description: String,
-    /// The file it was read from.
-    pub file: PathBuf,
-    /// Worker threads asked for in the file (`defaults.threads`), if any.
-    pub threads: Option<usize>,
-    /// Problems in file order.
-    pub problems: Vec<Problem>,
-}
-
-/// One `[[problem]]` entry, resolved.
-#[derive(Debug, Clone)]
-pub struct Problem {
-    /// The `plant` value as written.
-    pub plant_arg: String,
-    /// The plant file it resolved to.
-    pub plant_path: PathBuf,
-    /// The loaded plant.
-    pub plant: Arc<Plant>,
-    /// [`Plant::fingerprint`] (part of every job id).
-    pub fingerprint: String,
-    /// Controller orders, ascending, distinct.
-    pub orders: Vec<usize>,
-    /// Weights ε, in file order, distinct.
-    pub eps: Vec<f64>,
-    /// Seeds, in file order, distinct.
-    pub seeds: Vec<u64>,
-    /// Chain orders: order k of a (plant, ε, seed) chain starts from the controller of the next
-    /// lower order of the same chain.
-    pub warm_start: bool,
-    /// Options common to all this problem's jobs (`order`, `eps`, `seed` are set per job).
-    pub base: DesignOptions,
-    /// Where the problem's `plant` key is (for messages about the problem).
-    pub location: Location,
-}
-
 // ---------------------------------------------------------------------------------------------
 // Raw (serde) form
 
-/// Design settings allowed both in `[defaults]` and in a `[[problem]]`.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawDefaults {
-    eps: Option<Spanned<EpsList>>,
-    seeds: Option<Spanned<Seeds>>,
-    cpumax: Option<Spanned<f64>>,
-    nrand: Option<Spanned<usize>>,
-    objective: Option<ObjectiveKind>,
-    maxit: Option<Spanned<usize>>,
-    normtol: Option<Spanned<f64>>,
-    evaldist: Option<Spanned<f64>>,
-    hinf_tol: Option<Spanned<f64>>,
-    gradient_sampling: Option<bool>,
-    maxevals: Option<Spanned<usize>>,
-    stall_starts: Option<Spanned<usize>>,
-    stall_rtol: Option<Spanned<f64>>,
-    max_starts: Option<Spanned<usize>>,
-    hop_scales: Option<Spanned<Vec<f64>>>,
-    threads: Option<Spanned<usize>>,
+/// Declares a raw (serde) table with the design settings allowed both in `[defaults]` and in a
+/// `[[problem]]`, between the table's own leading and trailing keys: one list of the shared keys,
+/// so the two tables cannot drift apart.
+macro_rules! with_design_settings {
+    ($(#[$attr:meta])* struct $name:ident { $($head:tt)* } { $($tail:tt)* }) => {
+        $(#[$attr])*
+        struct $name {
+            $($head)*
+            eps: Option<Spanned<EpsList>>,
+            seeds: Option<Spanned<Seeds>>,
+            cpumax: Option<Spanned<f64>>,
+            nrand: Option<Spanned<usize>>,
+            objective: Option<ObjectiveKind>,
+            maxit: Option<Spanned<usize>>,
+            normtol: Option<Spanned<f64>>,
+            evaldist: Option<Spanned<f64>>,
+            hinf_tol: Option<Spanned<f64>>,
+            gradient_sampling: Option<bool>,
+            maxevals: Option<Spanned<usize>>,
+            stall_starts: Option<Spanned<usize>>,
+            stall_rtol: Option<Spanned<f64>>,
+            max_starts: Option<Spanned<usize>>,
+            hop_scales: Option<Spanned<Vec<f64>>>,
+            $($tail)*
+        }
+    };
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawProblem {
-    plant: Spanned<String>,
-    orders: Spanned<Orders>,
-    #[serde(default)]
-    warm_start: bool,
-    eps: Option<Spanned<EpsList>>,
-    seeds: Option<Spanned<Seeds>>,
-    cpumax: Option<Spanned<f64>>,
-    nrand: Option<Spanned<usize>>,
-    objective: Option<ObjectiveKind>,
-    maxit: Option<Spanned<usize>>,
-    normtol: Option<Spanned<f64>>,
-    evaldist: Option<Spanned<f64>>,
-    hinf_tol: Option<Spanned<f64>>,
-    gradient_sampling: Option<bool>,
-    maxevals: Option<Spanned<usize>>,
-    stall_starts: Option<Spanned<usize>>,
-    stall_rtol: Option<Spanned<f64>>,
-    max_starts: Option<Spanned<usize>>,
-    hop_scales: Option<Spanned<Vec<f64>>>,
+with_design_settings! {
+    /// `[defaults]`: the design settings, plus the campaign-wide `threads`.
+    #[derive(Debug, Default, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct RawDefaults {} {
+        threads: Option<Spanned<usize>>,
+    }
+}
+
+with_design_settings! {
+    /// One `[[problem]]`: its plant and orders, then the design settings.
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct RawProblem {
+        plant: Spanned<String>,
+        orders: Spanned<Orders>,
+        #[serde(default)]
+        warm_start: bool,
+    } {}
 }
 
 #[derive(Debug, Deserialize)]
@@ -317,7 +250,8 @@ impl<'de> Deserialize<'de> for EpsList {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Loading and validation
+// Loading and validation: `from_toml_str` runs the steps below in order, each a function with
+// one job; every error names the file, line and column of the value at fault.
 
 impl Campaign {
     /// Reads and validates a campaign file.
@@ -336,230 +270,325 @@ impl Campaign {
     /// Parses and validates campaign text; `file` names it in errors and anchors relative plant
     /// paths.
     pub fn from_toml_str(text: &str, file: &Path) -> Result<Campaign, SpecError> {
-        let at = |span: Range<usize>, message: String| SpecError {
-            file: file.to_path_buf(),
-            location: Location::of_offset(text, span.start),
-            message,
-        };
-        let raw: RawCampaign =
-            toml::from_str(text).map_err(|e| at(e.span().unwrap_or(0..0), e.message().trim().to_string()))?;
-
-        let name = raw.name.get_ref().clone();
-        if name.chars().count() > MAX_NAME_CHARS {
-            return Err(at(raw.name.span(), format!("campaign name is longer than {MAX_NAME_CHARS} characters")));
-        }
-        if name.is_empty()
-            || !name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
-            || name.starts_with('.')
-        {
-            return Err(at(
-                raw.name.span(),
-                format!("campaign name {name:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)"),
-            ));
-        }
-        let d = &raw.defaults;
-        let threads = match &d.threads {
-            Some(t) if !(1..=MAX_THREADS).contains(t.get_ref()) => {
-                return Err(at(t.span(), format!("threads must be in 1..={MAX_THREADS}, found {}", t.get_ref())))
-            }
-            Some(t) => Some(*t.get_ref()),
-            None => None,
-        };
+        let src = Source { text, file };
+        let raw = parse(&src)?;
+        let name = check_name(&raw.name, &src)?;
+        let threads = check_threads(raw.defaults.threads.as_ref(), &src)?;
         if raw.problems.is_empty() {
-            return Err(at(0..0, "the campaign has no [[problem]] entries".into()));
+            return Err(src.error(0..0, "the campaign has no [[problem]] entries"));
         }
         let base_dir = file.parent().unwrap_or(Path::new("."));
-        let mut problems = Vec::with_capacity(raw.problems.len());
-        for p in &raw.problems {
-            let layer = |pv: &Option<Spanned<EpsList>>| pv.clone().or_else(|| d.eps.clone());
-            let eps_s = layer(&p.eps);
-            let eps = match &eps_s {
-                Some(s) => {
-                    let v = s.get_ref().0.clone();
-                    if v.is_empty() {
-                        return Err(at(s.span(), "eps must list at least one weight".into()));
-                    }
-                    if has_duplicates(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()) {
-                        return Err(at(s.span(), "eps lists the same weight twice".into()));
-                    }
-                    v
-                }
-                None => vec![DesignOptions::default().eps],
-            };
-            let seeds = match p.seeds.clone().or_else(|| d.seeds.clone()) {
-                Some(s) => {
-                    let Seeds(v, _) = s.get_ref().clone();
-                    if v.is_empty() {
-                        return Err(at(s.span(), "seeds must list at least one seed".into()));
-                    }
-                    if let Some(bad) = v.iter().find(|x| **x < 0) {
-                        return Err(at(s.span(), format!("seeds must be non-negative integers, found {bad}")));
-                    }
-                    if has_duplicates(&v) {
-                        return Err(at(s.span(), "seeds lists the same seed twice".into()));
-                    }
-                    v.into_iter().map(|x| x as u64).collect()
-                }
-                None => vec![0],
-            };
-            let orders_v = &p.orders.get_ref().0;
-            let ospan = p.orders.span();
-            if orders_v.is_empty() {
-                return Err(at(ospan, "orders must list at least one controller order".into()));
-            }
-            if let Some(bad) = orders_v.iter().find(|o| **o < 0 || **o > MAX_ORDER as i64) {
-                return Err(at(ospan, format!("controller orders must be integers in 0..={MAX_ORDER}, found {bad}")));
-            }
-            if has_duplicates(orders_v) {
-                return Err(at(ospan, "orders lists the same order twice".into()));
-            }
-            let mut orders: Vec<usize> = orders_v.iter().map(|o| *o as usize).collect();
-            orders.sort_unstable();
-
-            let mut base = DesignOptions::default();
-            // Values are only collected here; `design::validate` below judges them (one rule
-            // for `campaign design` and campaign files).
-            let pick = |v: &Option<Spanned<f64>>, dv: &Option<Spanned<f64>>| {
-                v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()))
-            };
-            let pick_n = |v: &Option<Spanned<usize>>, dv: &Option<Spanned<usize>>| {
-                v.as_ref().or(dv.as_ref()).map(|s| (*s.get_ref(), s.span()))
-            };
-            let cpumax = pick(&p.cpumax, &d.cpumax);
-            let normtol = pick(&p.normtol, &d.normtol);
-            let evaldist = pick(&p.evaldist, &d.evaldist);
-            let hinf_tol = pick(&p.hinf_tol, &d.hinf_tol);
-            let nrand = pick_n(&p.nrand, &d.nrand);
-            let maxit = pick_n(&p.maxit, &d.maxit);
-            for (slot, v) in [
-                (&mut base.cpumax, &cpumax),
-                (&mut base.normtol, &normtol),
-                (&mut base.evaldist, &evaldist),
-                (&mut base.hinf_tol, &hinf_tol),
-            ] {
-                if let Some((x, _)) = v {
-                    *slot = *x;
-                }
-            }
-            for (slot, v) in [(&mut base.nrand, &nrand), (&mut base.maxit, &maxit)] {
-                if let Some((x, _)) = v {
-                    *slot = *x;
-                }
-            }
-            if let Some(o) = p.objective.or(d.objective) {
-                base.objective = o;
-            }
-            if let Some(g) = p.gradient_sampling.or(d.gradient_sampling) {
-                base.gradient_sampling = g;
-            }
-            let maxevals = pick_n(&p.maxevals, &d.maxevals);
-            let max_starts = pick_n(&p.max_starts, &d.max_starts);
-            let stall_starts = pick_n(&p.stall_starts, &d.stall_starts);
-            let stall_rtol = pick(&p.stall_rtol, &d.stall_rtol);
-            let hop_scales = p.hop_scales.as_ref().or(d.hop_scales.as_ref()).map(|s| (s.get_ref().clone(), s.span()));
-            if let Some((x, _)) = &maxevals {
-                base.maxevals = Some(*x);
-            }
-            if let Some((x, _)) = &max_starts {
-                base.max_starts = Some(*x);
-            }
-            if let Some((x, _)) = &stall_starts {
-                base.stall_starts = *x;
-            }
-            if let Some((x, _)) = &stall_rtol {
-                base.stall_rtol = *x;
-            }
-            if let Some((x, _)) = &hop_scales {
-                base.hop_scales = x.clone();
-            }
-
-            let plant_arg = p.plant.get_ref().clone();
-            let pspan = p.plant.span();
-            let plant_path = resolve_plant_arg(&plant_arg, base_dir).map_err(|m| at(pspan.clone(), m))?;
-            let plant = Plant::load(&plant_path).map_err(|e| at(pspan.clone(), e.to_string()))?;
-
-            // The very check `design` makes, for the largest order (the only option that depends
-            // on the order is order ≤ n) and every ε, before any job starts.
-            let max_order = *orders.last().expect("orders is not empty");
-            for &e in &eps {
-                let opts = DesignOptions { order: max_order, eps: e, ..base.clone() };
-                if let Err(err) = crate::design::validate(&plant, &opts, None) {
-                    let field = match &err {
-                        crate::design::DesignError::Options { field, .. } => *field,
-                        _ => "",
-                    };
-                    let span = match field {
-                        "order" => Some(ospan.clone()),
-                        "eps" => eps_s.as_ref().map(|s| s.span()),
-                        "cpumax" => cpumax.as_ref().map(|c| c.1.clone()),
-                        "normtol" => normtol.as_ref().map(|c| c.1.clone()),
-                        "evaldist" => evaldist.as_ref().map(|c| c.1.clone()),
-                        "hinf_tol" => hinf_tol.as_ref().map(|c| c.1.clone()),
-                        "nrand" => nrand.as_ref().map(|c| c.1.clone()),
-                        "maxit" => maxit.as_ref().map(|c| c.1.clone()),
-                        "maxevals" => maxevals.as_ref().map(|c| c.1.clone()),
-                        "max_starts" => max_starts.as_ref().map(|c| c.1.clone()),
-                        "stall_starts" => stall_starts.as_ref().map(|c| c.1.clone()),
-                        "stall_rtol" => stall_rtol.as_ref().map(|c| c.1.clone()),
-                        "hop_scales" => hop_scales.as_ref().map(|c| c.1.clone()),
-                        _ => None,
-                    };
-                    return Err(at(span.unwrap_or(pspan.clone()), err.to_string()));
-                }
-            }
-            problems.push(Problem {
-                plant_arg,
-                plant_path,
-                fingerprint: plant.fingerprint(),
-                plant: Arc::new(plant),
-                orders,
-                eps,
-                seeds,
-                warm_start: p.warm_start,
-                base,
-                location: Location::of_offset(text, pspan.start),
-            });
-        }
-
-        let mut total: usize = 0;
-        for (p, raw_p) in problems.iter().zip(&raw.problems) {
-            let n = p.orders.len().saturating_mul(p.eps.len()).saturating_mul(p.seeds.len());
-            total = total.saturating_add(n);
-            if total > MAX_JOBS {
-                return Err(at(
-                    raw_p.plant.span(),
-                    format!("the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)"),
-                ));
-            }
-        }
+        let problems = raw
+            .problems
+            .iter()
+            .map(|p| resolve_problem(p, &raw.defaults, base_dir, &src))
+            .collect::<Result<Vec<_>, _>>()?;
+        check_job_count(&problems, &raw.problems, &src)?;
         let campaign = Campaign { name, description: raw.description, file: file.to_path_buf(), threads, problems };
-        // Two problems that produce the same job would run it twice under one id.
-        let jobs = super::jobs::expand(&campaign, super::jobs::RunnerTag::Design);
-        let mut seen = std::collections::HashMap::new();
-        for j in &jobs {
-            if let Some(first) = seen.insert(j.id.clone(), j.problem) {
-                let p = &campaign.problems[j.problem];
-                return Err(SpecError {
-                    file: file.to_path_buf(),
-                    location: p.location,
-                    message: format!(
-                        "this problem repeats a job of the problem at line {} (plant {}, order {}, ε {}, seed {})",
-                        campaign.problems[first].location.line,
-                        p.plant.name,
-                        j.options.order,
-                        j.options.eps,
-                        j.options.seed
-                    ),
-                });
-            }
-        }
+        check_unique_jobs(&campaign)?;
         Ok(campaign)
     }
+}
 
-    /// Worker threads: the command line's, else the file's, else [`DEFAULT_THREADS`].
-    pub fn threads(&self, cli: Option<usize>) -> usize {
-        cli.or(self.threads).unwrap_or(DEFAULT_THREADS).max(1)
+/// The campaign text and its file, for errors at a byte span.
+struct Source<'a> {
+    text: &'a str,
+    file: &'a Path,
+}
+
+impl Source<'_> {
+    /// An error at the start of `span`.
+    fn error(&self, span: Range<usize>, message: impl Into<String>) -> SpecError {
+        SpecError {
+            file: self.file.to_path_buf(),
+            location: Location::of_offset(self.text, span.start),
+            message: message.into(),
+        }
     }
+}
+
+/// Step 1: the TOML into the raw tables (unknown keys and wrong types fail here, at their span).
+fn parse(src: &Source) -> Result<RawCampaign, SpecError> {
+    toml::from_str(src.text).map_err(|e| src.error(e.span().unwrap_or(0..0), e.message().trim()))
+}
+
+/// Step 2a: the campaign name, which names the results folder.
+fn check_name(name: &Spanned<String>, src: &Source) -> Result<String, SpecError> {
+    let text = name.get_ref().clone();
+    if text.chars().count() > MAX_NAME_CHARS {
+        return Err(src.error(name.span(), format!("campaign name is longer than {MAX_NAME_CHARS} characters")));
+    }
+    if text.is_empty() || !text.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) || text.starts_with('.')
+    {
+        return Err(src.error(
+            name.span(),
+            format!("campaign name {text:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)"),
+        ));
+    }
+    Ok(text)
+}
+
+/// Step 2b: `defaults.threads`.
+fn check_threads(threads: Option<&Spanned<usize>>, src: &Source) -> Result<Option<usize>, SpecError> {
+    match threads {
+        Some(t) if !(1..=MAX_THREADS).contains(t.get_ref()) => {
+            Err(src.error(t.span(), format!("threads must be in 1..={MAX_THREADS}, found {}", t.get_ref())))
+        }
+        Some(t) => Ok(Some(*t.get_ref())),
+        None => Ok(None),
+    }
+}
+
+/// Step 3: one `[[problem]]` — its settings layered over `[defaults]`, its lists checked, its
+/// plant loaded and its options judged.
+fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Source) -> Result<Problem, SpecError> {
+    let settings = Layered::new(p, d);
+    let eps = check_eps(settings.eps.as_ref(), src)?;
+    let seeds = check_seeds(settings.seeds.as_ref(), src)?;
+    let orders = check_orders(&p.orders, src)?;
+    let base = settings.options();
+    let (plant_path, plant) = load_plant(&p.plant, base_dir, src)?;
+    check_options(&plant, &base, &orders, &eps, &settings, p, src)?;
+    Ok(Problem {
+        plant_arg: p.plant.get_ref().clone(),
+        plant_path,
+        fingerprint: plant.fingerprint(),
+        plant: Arc::new(plant),
+        orders,
+        eps,
+        seeds,
+        warm_start: p.warm_start,
+        base,
+        location: Location::of_offset(src.text, p.plant.span().start),
+    })
+}
+
+/// A setting's value and the span it was read from.
+type Setting<T> = Option<(T, Range<usize>)>;
+
+/// The problem's value of a key, else the `[defaults]` one.
+fn layer<T: Clone>(problem: &Option<Spanned<T>>, defaults: &Option<Spanned<T>>) -> Setting<T> {
+    problem.as_ref().or(defaults.as_ref()).map(|s| (s.get_ref().clone(), s.span()))
+}
+
+/// Step 3a: the design settings of one problem, each from the `[[problem]]`, else from
+/// `[defaults]` (else, in [`Layered::options`], from [`DesignOptions::default`]), with the span
+/// of the value used.
+struct Layered {
+    eps: Option<Spanned<EpsList>>,
+    seeds: Option<Spanned<Seeds>>,
+    objective: Option<ObjectiveKind>,
+    gradient_sampling: Option<bool>,
+    cpumax: Setting<f64>,
+    normtol: Setting<f64>,
+    evaldist: Setting<f64>,
+    hinf_tol: Setting<f64>,
+    stall_rtol: Setting<f64>,
+    nrand: Setting<usize>,
+    maxit: Setting<usize>,
+    maxevals: Setting<usize>,
+    max_starts: Setting<usize>,
+    stall_starts: Setting<usize>,
+    hop_scales: Setting<Vec<f64>>,
+}
+
+impl Layered {
+    fn new(p: &RawProblem, d: &RawDefaults) -> Layered {
+        Layered {
+            eps: p.eps.clone().or_else(|| d.eps.clone()),
+            seeds: p.seeds.clone().or_else(|| d.seeds.clone()),
+            objective: p.objective.or(d.objective),
+            gradient_sampling: p.gradient_sampling.or(d.gradient_sampling),
+            cpumax: layer(&p.cpumax, &d.cpumax),
+            normtol: layer(&p.normtol, &d.normtol),
+            evaldist: layer(&p.evaldist, &d.evaldist),
+            hinf_tol: layer(&p.hinf_tol, &d.hinf_tol),
+            stall_rtol: layer(&p.stall_rtol, &d.stall_rtol),
+            nrand: layer(&p.nrand, &d.nrand),
+            maxit: layer(&p.maxit, &d.maxit),
+            maxevals: layer(&p.maxevals, &d.maxevals),
+            max_starts: layer(&p.max_starts, &d.max_starts),
+            stall_starts: layer(&p.stall_starts, &d.stall_starts),
+            hop_scales: layer(&p.hop_scales, &d.hop_scales),
+        }
+    }
+
+    /// The options common to the problem's jobs (order, ε and seed are set per job). Values are
+    /// only collected here; `design::validate` judges them ([`check_options`]).
+    fn options(&self) -> DesignOptions {
+        let mut o = DesignOptions::default();
+        let value = |s: &Setting<f64>, default: f64| s.as_ref().map_or(default, |(x, _)| *x);
+        let count = |s: &Setting<usize>, default: usize| s.as_ref().map_or(default, |(x, _)| *x);
+        o.cpumax = value(&self.cpumax, o.cpumax);
+        o.normtol = value(&self.normtol, o.normtol);
+        o.evaldist = value(&self.evaldist, o.evaldist);
+        o.hinf_tol = value(&self.hinf_tol, o.hinf_tol);
+        o.stall_rtol = value(&self.stall_rtol, o.stall_rtol);
+        o.nrand = count(&self.nrand, o.nrand);
+        o.maxit = count(&self.maxit, o.maxit);
+        o.stall_starts = count(&self.stall_starts, o.stall_starts);
+        if let Some((x, _)) = &self.maxevals {
+            o.maxevals = Some(*x);
+        }
+        if let Some((x, _)) = &self.max_starts {
+            o.max_starts = Some(*x);
+        }
+        if let Some((x, _)) = &self.hop_scales {
+            o.hop_scales = x.clone();
+        }
+        if let Some(k) = self.objective {
+            o.objective = k;
+        }
+        if let Some(g) = self.gradient_sampling {
+            o.gradient_sampling = g;
+        }
+        o
+    }
+
+    /// The span of the value behind a `DesignError::Options` field (None: not a setting).
+    fn span_of(&self, field: &str) -> Option<Range<usize>> {
+        fn span<T>(s: &Setting<T>) -> Option<Range<usize>> {
+            s.as_ref().map(|(_, r)| r.clone())
+        }
+        match field {
+            "eps" => self.eps.as_ref().map(|s| s.span()),
+            "cpumax" => span(&self.cpumax),
+            "normtol" => span(&self.normtol),
+            "evaldist" => span(&self.evaldist),
+            "hinf_tol" => span(&self.hinf_tol),
+            "stall_rtol" => span(&self.stall_rtol),
+            "nrand" => span(&self.nrand),
+            "maxit" => span(&self.maxit),
+            "maxevals" => span(&self.maxevals),
+            "max_starts" => span(&self.max_starts),
+            "stall_starts" => span(&self.stall_starts),
+            "hop_scales" => span(&self.hop_scales),
+            _ => None,
+        }
+    }
+}
+
+/// Step 3b: the weights ε (default: [`DesignOptions::default`]'s).
+fn check_eps(eps: Option<&Spanned<EpsList>>, src: &Source) -> Result<Vec<f64>, SpecError> {
+    let Some(s) = eps else { return Ok(vec![DesignOptions::default().eps]) };
+    let v = s.get_ref().0.clone();
+    if v.is_empty() {
+        return Err(src.error(s.span(), "eps must list at least one weight"));
+    }
+    if has_duplicates(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()) {
+        return Err(src.error(s.span(), "eps lists the same weight twice"));
+    }
+    Ok(v)
+}
+
+/// Step 3c: the seeds (default: seed 0).
+fn check_seeds(seeds: Option<&Spanned<Seeds>>, src: &Source) -> Result<Vec<u64>, SpecError> {
+    let Some(s) = seeds else { return Ok(vec![0]) };
+    let Seeds(v, _) = s.get_ref().clone();
+    if v.is_empty() {
+        return Err(src.error(s.span(), "seeds must list at least one seed"));
+    }
+    if let Some(bad) = v.iter().find(|x| **x < 0) {
+        return Err(src.error(s.span(), format!("seeds must be non-negative integers, found {bad}")));
+    }
+    if has_duplicates(&v) {
+        return Err(src.error(s.span(), "seeds lists the same seed twice"));
+    }
+    Ok(v.into_iter().map(|x| x as u64).collect())
+}
+
+/// Step 3d: the controller orders, returned ascending.
+fn check_orders(orders: &Spanned<Orders>, src: &Source) -> Result<Vec<usize>, SpecError> {
+    let (v, span) = (&orders.get_ref().0, orders.span());
+    if v.is_empty() {
+        return Err(src.error(span, "orders must list at least one controller order"));
+    }
+    if let Some(bad) = v.iter().find(|o| **o < 0 || **o > MAX_ORDER as i64) {
+        return Err(src.error(span, format!("controller orders must be integers in 0..={MAX_ORDER}, found {bad}")));
+    }
+    if has_duplicates(v) {
+        return Err(src.error(span, "orders lists the same order twice"));
+    }
+    let mut sorted: Vec<usize> = v.iter().map(|o| *o as usize).collect();
+    sorted.sort_unstable();
+    Ok(sorted)
+}
+
+/// Step 3e: the plant, resolved ([`resolve_plant_arg`]) and loaded; errors point at `plant`.
+fn load_plant(plant: &Spanned<String>, base_dir: &Path, src: &Source) -> Result<(PathBuf, Plant), SpecError> {
+    let path = resolve_plant_arg(plant.get_ref(), base_dir).map_err(|m| src.error(plant.span(), m))?;
+    let loaded = Plant::load(&path).map_err(|e| src.error(plant.span(), e.to_string()))?;
+    Ok((path, loaded))
+}
+
+/// Step 3f: the very check `design` makes, for the largest order (the only option that depends
+/// on the order is order ≤ n) and every ε, before any job starts; the error points at the value
+/// of the field it names, else at `plant`.
+fn check_options(
+    plant: &Plant,
+    base: &DesignOptions,
+    orders: &[usize],
+    eps: &[f64],
+    settings: &Layered,
+    p: &RawProblem,
+    src: &Source,
+) -> Result<(), SpecError> {
+    let max_order = *orders.last().expect("orders is not empty");
+    for &e in eps {
+        let opts = DesignOptions { order: max_order, eps: e, ..base.clone() };
+        if let Err(err) = crate::design::validate(plant, &opts, None) {
+            let span = match &err {
+                crate::design::DesignError::Options { field: "order", .. } => Some(p.orders.span()),
+                crate::design::DesignError::Options { field, .. } => settings.span_of(field),
+                _ => None,
+            };
+            return Err(src.error(span.unwrap_or(p.plant.span()), err.to_string()));
+        }
+    }
+    Ok(())
+}
+
+/// Step 4: at most [`MAX_JOBS`] jobs in all (the error points at the problem that crosses it).
+fn check_job_count(problems: &[Problem], raw: &[RawProblem], src: &Source) -> Result<(), SpecError> {
+    let mut total: usize = 0;
+    for (p, raw_p) in problems.iter().zip(raw) {
+        let n = p.orders.len().saturating_mul(p.eps.len()).saturating_mul(p.seeds.len());
+        total = total.saturating_add(n);
+        if total > MAX_JOBS {
+            return Err(src.error(
+                raw_p.plant.span(),
+                format!(
+                    "the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Step 5: expand the jobs; two problems that produce the same job would run it twice under one
+/// id.
+fn check_unique_jobs(campaign: &Campaign) -> Result<(), SpecError> {
+    let jobs = super::jobs::expand(campaign, super::jobs::RunnerTag::Design);
+    let mut seen = std::collections::HashMap::new();
+    for j in &jobs {
+        if let Some(first) = seen.insert(j.id.clone(), j.problem) {
+            let p = &campaign.problems[j.problem];
+            return Err(SpecError {
+                file: campaign.file.clone(),
+                location: p.location,
+                message: format!(
+                    "this problem repeats a job of the problem at line {} (plant {}, order {}, ε {}, seed {})",
+                    campaign.problems[first].location.line,
+                    p.plant.name,
+                    j.options.order,
+                    j.options.eps,
+                    j.options.seed
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 fn has_duplicates<T: Ord + Clone>(v: &[T]) -> bool {

@@ -7,7 +7,6 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use hinfix::campaign::claims::{unix_now, ClaimDir};
-use hinfix::campaign::fake::FakeRunner;
 use hinfix::campaign::journal::{journals_in, Follower};
 use hinfix::campaign::progress::{Display, Reporter};
 use hinfix::campaign::record::JobRecord;
@@ -113,15 +112,26 @@ struct Loaded {
     campaign: Campaign,
     jobs: Vec<Job>,
     dir: PathBuf,
-    fake: Option<FakeRunner>,
+    fake: Option<Box<dyn JobRunner>>,
+}
+
+/// The hidden fake runner of the machinery tests (`campaign::fake`) when its environment
+/// variable is set, in a build with the test-only `test-fake-runner` feature; always `None` in
+/// a production build.
+fn fake_runner() -> Option<Box<dyn JobRunner>> {
+    #[cfg(feature = "test-fake-runner")]
+    if let Some(f) = hinfix::campaign::fake::FakeRunner::from_env() {
+        return Some(Box::new(f));
+    }
+    None
 }
 
 fn load(a: &CampaignFileArgs) -> anyhow::Result<Loaded> {
     let campaign = Campaign::load(&a.file)?;
     // The hidden fake runner (tests of the machinery) makes jobs with different ids, so its
     // records can never be mistaken for real ones.
-    let fake = FakeRunner::from_env();
-    let tag = fake.as_ref().map_or(RunnerTag::Design, FakeRunner::tag);
+    let fake = fake_runner();
+    let tag = if fake.is_some() { RunnerTag::Fake } else { RunnerTag::Design };
     let jobs = expand(&campaign, tag);
     let dir = campaign_dir(&a.results, &campaign.name);
     Ok(Loaded { campaign, jobs, dir, fake })
@@ -163,7 +173,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     signals::install_into(&cancel).context("installing the signal handlers")?;
 
     let runner: &dyn JobRunner = match &l.fake {
-        Some(f) => f,
+        Some(f) => f.as_ref(),
         None => &DesignRunner,
     };
     let observers = trace_observers(&l.dir.join("traces"));

@@ -78,12 +78,12 @@ pub mod serde_opt_f64_or_string {
 
 /// `#[serde(default, with = "serde_vec_f64_or_string")]` for a `Vec<f64>`: each element as
 /// [`serde_f64_or_string`] writes it (and reads it, `null` as NaN).
-pub mod serde_vec_f64_or_string {
+pub(crate) mod serde_vec_f64_or_string {
     use super::*;
     use serde::ser::SerializeSeq;
 
     /// A JSON array of numbers or "inf" / "-inf" / "nan".
-    pub fn serialize<S: Serializer>(xs: &[f64], s: S) -> Result<S::Ok, S::Error> {
+    pub(crate) fn serialize<S: Serializer>(xs: &[f64], s: S) -> Result<S::Ok, S::Error> {
         let mut seq = s.serialize_seq(Some(xs.len()))?;
         for x in xs {
             seq.serialize_element(&super::f64_to_json(*x))?;
@@ -92,7 +92,7 @@ pub mod serde_vec_f64_or_string {
     }
 
     /// An array whose elements are numbers, one of the strings, or `null` (NaN).
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+    pub(crate) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
         let raw = Vec::<Option<NumOrStr>>::deserialize(d)?;
         raw.into_iter()
             .map(|v| match v {

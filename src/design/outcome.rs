@@ -44,6 +44,20 @@ pub enum DesignStatus {
     Interrupted,
 }
 
+impl DesignStatus {
+    /// The name of the status, as in the `kind` field of its JSON form (journal, CLI output).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            DesignStatus::Converged => "converged",
+            DesignStatus::Stopped => "stopped",
+            DesignStatus::StabilisedOnly => "stabilised_only",
+            DesignStatus::NotStabilised { .. } => "not_stabilised",
+            DesignStatus::BudgetExhausted => "budget_exhausted",
+            DesignStatus::Interrupted => "interrupted",
+        }
+    }
+}
+
 /// Per-phase counters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PhaseStats {

@@ -58,7 +58,7 @@ pub(crate) struct ClosedLoop<'p> {
 
 impl<'p> ClosedLoop<'p> {
     /// Forms the closed loop; checks shapes and well-posedness.
-    pub fn new(plant: &'p Plant, k: &Controller) -> Result<Self, LtiError> {
+    pub(crate) fn new(plant: &'p Plant, k: &Controller) -> Result<Self, LtiError> {
         let dims = plant.dims;
         let (n, m, p) = (dims.n, dims.m2, dims.p2);
         let nk = k.order();
@@ -116,7 +116,7 @@ impl<'p> ClosedLoop<'p> {
     /// G_A = Re(ā bᵀ), G_B = Re(ā vᵀ), G_C = Re(ū bᵀ), G_D = Re(ū vᵀ) (complex vectors
     /// a, b ∈ ℂⁿ⁺ⁿᵏ, u ∈ ℂᵖ¹, v ∈ ℂᵐ¹; pass `None` for u, v when G_B = G_C = G_D = 0).
     /// Then Γ = Re(ℓ rᵀ) with ℓ = B̄ᵀā + D̄12ᵀū and r = C̄ b + D̄21 v (module docs).
-    pub fn chain_rule(&self, a: &[c64], b: &[c64], uv: Option<(&[c64], &[c64])>) -> Controller {
+    pub(crate) fn chain_rule(&self, a: &[c64], b: &[c64], uv: Option<(&[c64], &[c64])>) -> Controller {
         let pl = self.plant;
         let (n, nk) = (pl.dims.n, self.nk);
         let abar: Vec<c64> = a.iter().map(|z| z.conj()).collect();

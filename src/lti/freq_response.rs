@@ -33,7 +33,7 @@ pub(crate) struct FreqResponse {
 
 impl FreqResponse {
     /// Reduces A to Hessenberg form and transforms B, C (entries assumed finite).
-    pub fn new(sys: &StateSpace) -> Self {
+    pub(crate) fn new(sys: &StateSpace) -> Self {
         let (n, m, p) = (sys.order(), sys.inputs(), sys.outputs());
         let mut hm = sys.a.clone();
         let mut bt = sys.b.clone();
@@ -98,7 +98,7 @@ impl FreqResponse {
     }
 
     /// G(iω) (p×m); D for ω = +∞. Entries are +∞ if iωI − H is exactly singular.
-    pub fn eval(&mut self, w: f64) -> MatRef<'_, c64> {
+    pub(crate) fn eval(&mut self, w: f64) -> MatRef<'_, c64> {
         let (n, m, p) = (self.n, self.m, self.p);
         for i in 0..p {
             for j in 0..m {
@@ -172,7 +172,7 @@ impl FreqResponse {
     }
 
     /// σmax(G(iω)) (+∞ if not finite).
-    pub fn sigma_max(&mut self, w: f64) -> f64 {
+    pub(crate) fn sigma_max(&mut self, w: f64) -> f64 {
         let g = self.eval(w);
         let s = sigma_max_c(g);
         if s.is_finite() {

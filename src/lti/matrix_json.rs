@@ -11,7 +11,7 @@ use serde_json::Value;
 
 /// Largest accepted matrix dimension (rows or columns): 1 048 576. Far above any plant this
 /// program can handle; it keeps a typo in `dims` from becoming a huge allocation or loop.
-pub const MAX_MATRIX_DIM: usize = 1 << 20;
+pub(crate) const MAX_MATRIX_DIM: usize = 1 << 20;
 
 /// What is wrong with one matrix in a JSON document (the caller adds file and matrix name).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -153,7 +153,7 @@ fn number(x: f64) -> Value {
 }
 
 /// Shape of a JSON array of rows, if it is one (rows, length of the first row).
-pub fn json_shape(value: &Value) -> Option<(usize, usize)> {
+pub(crate) fn json_shape(value: &Value) -> Option<(usize, usize)> {
     let arr = value.as_array()?;
     let cols = arr.first().and_then(|r| r.as_array()).map_or(0, |r| r.len());
     Some((arr.len(), cols))

@@ -56,22 +56,22 @@ use faer::{Mat, MatRef};
 use crate::numeric::all_finite;
 
 /// Relative change ‖Z_{k+1} − Z_k‖_F / ‖Z_{k+1}‖_F below which the sign iteration has converged.
-pub const SIGN_TOL: f64 = 1e-12;
+pub(crate) const SIGN_TOL: f64 = 1e-12;
 /// Relative change below which determinant scaling is switched off (the iteration is then in its
 /// quadratically convergent regime, where scaling only slows it).
 const SIGN_UNSCALED_BELOW: f64 = 1e-2;
 /// Once the relative change is below this, the iteration is also stopped when the change no longer
 /// shrinks by at least half (rounding-error stagnation of an ill-conditioned but dichotomic
 /// Hamiltonian; the residual test then decides).
-pub const SIGN_STAGNATION_TOL: f64 = 1e-7;
+pub(crate) const SIGN_STAGNATION_TOL: f64 = 1e-7;
 /// Maximum number of sign-function iterations. Well-separated spectra need 8–20; slow convergence
 /// beyond this means eigenvalues (numerically) on the imaginary axis.
-pub const SIGN_MAX_ITER: usize = 60;
+pub(crate) const SIGN_MAX_ITER: usize = 60;
 /// Accepted |trace sign(H)| (exact value 0 for a Hamiltonian without imaginary-axis eigenvalues;
 /// any wrong count changes it by 2).
 const TRACE_TOL: f64 = 0.5;
 /// Maximum relative CARE residual (see the module docs for the normalisation).
-pub const CARE_RESIDUAL_TOL: f64 = 1e-8;
+pub(crate) const CARE_RESIDUAL_TOL: f64 = 1e-8;
 /// Maximum number of sweeps of the symplectic balancing.
 const BALANCE_MAX_SWEEPS: usize = 30;
 /// A balancing step is taken only if it reduces the affected part of ‖H‖²_F below this factor.

@@ -26,13 +26,13 @@ use super::objective::{usable, Evaluator};
 use super::termination::Termination;
 
 /// Minimum number of bisections allowed (HANSO).
-pub const LS_MIN_BISECT: f64 = 30.0;
+pub(crate) const LS_MIN_BISECT: f64 = 30.0;
 /// Minimum number of expansions allowed (HANSO).
-pub const LS_MIN_EXPAND: f64 = 10.0;
+pub(crate) const LS_MIN_EXPAND: f64 = 10.0;
 /// Scale in the bisection/expansion limits log₂(10⁵‖d‖), log₂(10⁵/‖d‖) (HANSO).
-pub const LS_LIMIT_SCALE: f64 = 1e5;
+pub(crate) const LS_LIMIT_SCALE: f64 = 1e5;
 /// Hard cap on either limit (guards ‖d‖ → 0 or ∞, where the HANSO formulas blow up).
-pub const LS_LIMIT_CAP: f64 = 2000.0;
+pub(crate) const LS_LIMIT_CAP: f64 = 2000.0;
 
 /// Parameters of one search.
 #[derive(Debug, Clone, Copy)]

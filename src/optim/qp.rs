@@ -26,29 +26,29 @@ use faer::{Mat, Side};
 use crate::numeric::dot;
 
 /// Maximum interior-point iterations.
-pub const QP_MAXIT: usize = 100;
+pub(crate) const QP_MAXIT: usize = 100;
 /// Fraction of the step to the boundary that is taken (keeps iterates strictly interior).
-pub const QP_STEP_DAMPING: f64 = 0.9995;
+pub(crate) const QP_STEP_DAMPING: f64 = 0.9995;
 /// IP stop: duality gap wᵀz ≤ QP_GAP_REL·wᵀQw + QP_GAP_ABS (on Q scaled to max diagonal 1).
-pub const QP_GAP_REL: f64 = 1e-10;
+pub(crate) const QP_GAP_REL: f64 = 1e-10;
 /// See [`QP_GAP_REL`]; absolute part (relative to the largest ‖gᵢ‖²).
-pub const QP_GAP_ABS: f64 = 1e-18;
+pub(crate) const QP_GAP_ABS: f64 = 1e-18;
 /// IP stop: primal and dual residuals (∞-norm, scaled problem) at most this.
-pub const QP_RES_TOL: f64 = 1e-12;
+pub(crate) const QP_RES_TOL: f64 = 1e-12;
 /// Initial diagonal regularisation of M (relative to max Qᵢᵢ = 1), multiplied by
 /// [`QP_REG_GROWTH`] on each Cholesky failure, up to [`QP_REG_TRIES`] times.
-pub const QP_REG0: f64 = 1e-14;
+pub(crate) const QP_REG0: f64 = 1e-14;
 /// See [`QP_REG0`].
-pub const QP_REG_GROWTH: f64 = 10.0;
+pub(crate) const QP_REG_GROWTH: f64 = 10.0;
 /// See [`QP_REG0`].
-pub const QP_REG_TRIES: usize = 12;
+pub(crate) const QP_REG_TRIES: usize = 12;
 /// KKT acceptance of a solution: Frank–Wolfe gap ≤ KKT_GAP_REL·wᵀQw + KKT_GAP_ABS
 /// (scaled problem; the gap bounds the error in ‖Gw‖²).
-pub const KKT_GAP_REL: f64 = 1e-6;
+pub(crate) const KKT_GAP_REL: f64 = 1e-6;
 /// See [`KKT_GAP_REL`].
-pub const KKT_GAP_ABS: f64 = 1e-14;
+pub(crate) const KKT_GAP_ABS: f64 = 1e-14;
 /// Tolerances handed to clarabel (gap absolute/relative, feasibility).
-pub const CLARABEL_TOL: f64 = 1e-10;
+pub(crate) const CLARABEL_TOL: f64 = 1e-10;
 
 /// Which method produced the weights.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -18,10 +18,11 @@ pub mod sigma;
 
 use std::path::{Path, PathBuf};
 
+use super::compare::full_order_rows;
 use super::record::JobRecord;
 use super::reduce::{best_per_order, BestRow, PlantMap};
 use super::reference::{RefMethod, ReferenceRow};
-use super::report::{full_order_rows, ReportError};
+use super::report::ReportError;
 use super::trace::{read_iterations, TraceError};
 use crate::lti::{Controller, Plant};
 

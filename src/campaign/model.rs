@@ -1,0 +1,87 @@
+//! The validated campaign: what [`super::spec`] builds from a campaign file and
+//! [`super::jobs::expand`] turns into jobs. Below both, so neither imports the other's types.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use crate::design::DesignOptions;
+use crate::lti::Plant;
+
+/// Default number of worker threads (`--threads` and `defaults.threads` override it).
+pub const DEFAULT_THREADS: usize = 2;
+
+/// A position in a campaign file (1-based line and column, columns counted in characters).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Location {
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+}
+
+impl Location {
+    /// The position of byte `offset` in `text`.
+    pub fn of_offset(text: &str, offset: usize) -> Location {
+        let offset = offset.min(text.len());
+        let before = &text[..floor_char_boundary(text, offset)];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let column = before[line_start..].chars().count() + 1;
+        Location { line, column }
+    }
+}
+
+fn floor_char_boundary(s: &str, mut i: usize) -> usize {
+    while i > 0 && !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// A validated campaign: every plant loaded, every value checked.
+#[derive(Debug, Clone)]
+pub struct Campaign {
+    /// Name; also the results folder `results/<name>/`.
+    pub name: String,
+    /// Free text.
+    pub description: String,
+    /// The file it was read from.
+    pub file: PathBuf,
+    /// Worker threads asked for in the file (`defaults.threads`), if any.
+    pub threads: Option<usize>,
+    /// Problems in file order.
+    pub problems: Vec<Problem>,
+}
+
+/// One `[[problem]]` entry, resolved.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// The `plant` value as written.
+    pub plant_arg: String,
+    /// The plant file it resolved to.
+    pub plant_path: PathBuf,
+    /// The loaded plant.
+    pub plant: Arc<Plant>,
+    /// [`Plant::fingerprint`] (part of every job id).
+    pub fingerprint: String,
+    /// Controller orders, ascending, distinct.
+    pub orders: Vec<usize>,
+    /// Weights ε, in file order, distinct.
+    pub eps: Vec<f64>,
+    /// Seeds, in file order, distinct.
+    pub seeds: Vec<u64>,
+    /// Chain orders: order k of a (plant, ε, seed) chain starts from the controller of the next
+    /// lower order of the same chain.
+    pub warm_start: bool,
+    /// Options common to all this problem's jobs (`order`, `eps`, `seed` are set per job).
+    pub base: DesignOptions,
+    /// Where the problem's `plant` key is (for messages about the problem).
+    pub location: Location,
+}
+
+impl Campaign {
+    /// Worker threads: the command line's, else the file's, else [`DEFAULT_THREADS`].
+    pub fn threads(&self, cli: Option<usize>) -> usize {
+        cli.or(self.threads).unwrap_or(DEFAULT_THREADS).max(1)
+    }
+}

@@ -1,0 +1,174 @@
+//! The γ-test: does a stabilising controller with ‖T_zw‖∞ < γ exist? (Glover–Doyle 1988;
+//! Doyle–Glover–Khargonekar–Francis 1989; the general-D form as in Zhou–Doyle–Glover 1996,
+//! ch. 17, and SLICOT SB10PD/SB10QD)
+//!
+//!
+//! With `B = [B1 B2]`, `C = [C1; C2]`, `D1• = [D11 D12]`, `D•1 = [D11; D21]` and
+//!
+//! ```text
+//! R  = D1•ᵀ D1• − diag(γ² I_m1, 0),          R̃ = D•1 D•1ᵀ − diag(γ² I_p1, 0),
+//! X:  (A − B R⁻¹ D1•ᵀ C1)ᵀ X + X (A − B R⁻¹ D1•ᵀ C1) − X B R⁻¹ Bᵀ X + C1ᵀ (I − D1• R⁻¹ D1•ᵀ) C1 = 0,
+//! Y:  (A − B1 D•1ᵀ R̃⁻¹ C) Y + Y (…)ᵀ − Y Cᵀ R̃⁻¹ C Y + B1 (I − D•1ᵀ R̃⁻¹ D•1) B1ᵀ = 0,
+//! ```
+//!
+//! a stabilising controller with ‖T_zw‖∞ < γ exists iff (i) γ > max(σ̄(D12⊥ᵀ D11), σ̄(D11 D21⊥ᵀ))
+//! (the part of D11 no controller can touch), (ii) the X Hamiltonian has no imaginary-axis
+//! eigenvalues and its stabilising solution X ⪰ 0, (iii) the same for Y ⪰ 0, (iv) ρ(XY) < γ².
+//! This "R-form" needs no explicit normalisation of D12, D21: it is invariant under the usual
+//! scalings u → T u, z → U z, y → S y, w → V w that bring D12ᵀD12 = I and D21D21ᵀ = I, so the
+//! standing assumption is only that D12 has full column rank and D21 full row rank (plus the
+//! imaginary-axis rank conditions). D11 ≠ 0 is handled directly (no loop shifting needed). D22
+//! does not affect γ_opt (it is removed by a loop transformation of the controller) and is ignored.
+//! Each Riccati equation is solved by [`solve_care`] (matrix sign function, with
+//! finiteness, residual and stabilising checks); any failure there means "γ infeasible".
+//!
+
+use faer::Mat;
+
+use super::linalg::{concat_cols, concat_rows, feedthrough_bound, solve, sym_eig};
+use super::{Binding, FullOrderError};
+use crate::lti::plant::Plant;
+use crate::lti::riccati::solve_care;
+
+/// X ⪰ 0 test: λmin(X) ≥ −(PSD_RTOL·max|λ(X)| + PSD_ATOL).
+pub(crate) const PSD_RTOL: f64 = 1e-8;
+/// Absolute part of the X ⪰ 0 / Y ⪰ 0 test (accepts rounding noise around X = 0).
+pub(crate) const PSD_ATOL: f64 = 1e-12;
+
+/// The plant's exogenous channels (B1, C1, D11, D12, D21): the plant's own ([`Channels::of`]) or
+/// ε-augmented (`regularisation::augment`). A, B2 and C2 are always the plant's; D22 plays no
+/// part in γ_opt.
+pub(crate) struct Channels {
+    pub(crate) b1: Mat<f64>,
+    pub(crate) c1: Mat<f64>,
+    pub(crate) d11: Mat<f64>,
+    pub(crate) d12: Mat<f64>,
+    pub(crate) d21: Mat<f64>,
+}
+
+impl Channels {
+    /// The plant's channels as they are.
+    pub(crate) fn of(plant: &Plant) -> Channels {
+        Channels {
+            b1: plant.b1.clone(),
+            c1: plant.c1.clone(),
+            d11: plant.d11.clone(),
+            d12: plant.d12.clone(),
+            d21: plant.d21.clone(),
+        }
+    }
+}
+
+/// The (possibly regularised) plant with the γ-independent products precomputed: the input of
+/// [`Problem::test`].
+pub(crate) struct Problem {
+    n: usize,
+    m1: usize,
+    p1: usize,
+    a: Mat<f64>,
+    b: Mat<f64>,
+    c: Mat<f64>,
+    /// D1•ᵀ D1• ((m1+m2)²), D1•ᵀ C1, C1ᵀ C1.
+    d1t_d1: Mat<f64>,
+    d1t_c1: Mat<f64>,
+    c1t_c1: Mat<f64>,
+    /// D•1 D•1ᵀ ((p1+p2)²), D•1 B1ᵀ, B1 B1ᵀ.
+    dd1_dd1t: Mat<f64>,
+    dd1_b1t: Mat<f64>,
+    b1_b1t: Mat<f64>,
+    /// Condition (i) bound.
+    pub(crate) gamma_d: f64,
+}
+
+impl Problem {
+    /// The γ-independent products of `plant` with its exogenous channels replaced by `ch`.
+    pub(crate) fn new(plant: &Plant, ch: Channels) -> Result<Problem, FullOrderError> {
+        let n = plant.dims.n;
+        let Channels { b1, c1, d11, d12, d21 } = ch;
+        let (p1, m1) = (c1.nrows(), b1.ncols());
+        let b = concat_cols(b1.as_ref(), plant.b2.as_ref());
+        let c = concat_rows(c1.as_ref(), plant.c2.as_ref());
+        let d1 = concat_cols(d11.as_ref(), d12.as_ref());
+        let dd1 = concat_rows(d11.as_ref(), d21.as_ref());
+        let gamma_d = feedthrough_bound(d11.as_ref(), d12.as_ref(), d21.as_ref())?;
+        Ok(Problem {
+            n,
+            m1,
+            p1,
+            a: plant.a.clone(),
+            d1t_d1: d1.transpose() * &d1,
+            d1t_c1: d1.transpose() * &c1,
+            c1t_c1: c1.transpose() * &c1,
+            dd1_dd1t: &dd1 * dd1.transpose(),
+            dd1_b1t: &dd1 * b1.transpose(),
+            b1_b1t: &b1 * b1.transpose(),
+            b,
+            c,
+            gamma_d,
+        })
+    }
+
+    /// The γ-test: Ok(ρ(XY)/γ²) if γ is feasible, Err((binding, reason)) otherwise.
+    pub(crate) fn test(&self, gamma: f64) -> Result<f64, (Binding, String)> {
+        let n = self.n;
+        let g2 = gamma * gamma;
+        if gamma <= self.gamma_d {
+            return Err((Binding::Feedthrough, format!("gamma {gamma} <= D11 bound {}", self.gamma_d)));
+        }
+        // X: R = D1ᵀD1 − diag(γ²I, 0); M = R⁻¹ [D1ᵀC1, Bᵀ].
+        let mut r = self.d1t_d1.clone();
+        for i in 0..self.m1 {
+            r[(i, i)] -= g2;
+        }
+        let rhs = concat_cols(self.d1t_c1.as_ref(), self.b.transpose());
+        let m = solve(r.as_ref(), rhs.as_ref()).ok_or((Binding::StateFeedback, "R singular".to_string()))?;
+        let (r_dc, r_bt) = (m.subcols(0, n), m.subcols(n, n));
+        let ax = &self.a - &self.b * r_dc;
+        let gx = &self.b * r_bt;
+        let qx = &self.c1t_c1 - self.d1t_c1.transpose() * r_dc;
+        let x = solve_care(ax.as_ref(), gx.as_ref(), qx.as_ref())
+            .map_err(|e| (Binding::StateFeedback, format!("X: {e}")))?
+            .x;
+        let (xl, xv) = sym_eig(x.as_ref()).ok_or((Binding::StateFeedback, "eig(X) failed".to_string()))?;
+        psd_check(&xl).map_err(|s| (Binding::StateFeedback, format!("X: {s}")))?;
+
+        // Y: R̃ = D•1D•1ᵀ − diag(γ²I, 0); N = R̃⁻¹ [D•1B1ᵀ, C].
+        let mut rt = self.dd1_dd1t.clone();
+        for i in 0..self.p1 {
+            rt[(i, i)] -= g2;
+        }
+        let rhs = concat_cols(self.dd1_b1t.as_ref(), self.c.as_ref());
+        let nn = solve(rt.as_ref(), rhs.as_ref()).ok_or((Binding::Filter, "R~ singular".to_string()))?;
+        let (rt_db, rt_c) = (nn.subcols(0, n), nn.subcols(n, n));
+        // CARE in transposed form: A_yᵀ Y + Y A_y − Y G_y Y + Q_y with A_y = (A − B1 D•1ᵀ R̃⁻¹ C)ᵀ.
+        let ay = self.a.transpose() - self.c.transpose() * rt_db;
+        let gy = self.c.transpose() * rt_c;
+        let qy = &self.b1_b1t - self.dd1_b1t.transpose() * rt_db;
+        let y = solve_care(ay.as_ref(), gy.as_ref(), qy.as_ref()).map_err(|e| (Binding::Filter, format!("Y: {e}")))?.x;
+        let (yl, _) = sym_eig(y.as_ref()).ok_or((Binding::Filter, "eig(Y) failed".to_string()))?;
+        psd_check(&yl).map_err(|s| (Binding::Filter, format!("Y: {s}")))?;
+
+        // ρ(XY) = λmax(X^{1/2} Y X^{1/2}).
+        let sq = Mat::from_fn(n, n, |i, j| xv[(i, j)] * xl[j].max(0.0).sqrt());
+        let xh = &sq * xv.transpose();
+        let mm = &xh * &y * &xh;
+        let (ml, _) = sym_eig(mm.as_ref()).ok_or((Binding::Coupling, "eig(X^1/2 Y X^1/2) failed".to_string()))?;
+        let rho = ml.last().copied().unwrap_or(0.0);
+        if rho < g2 {
+            Ok(rho / g2)
+        } else {
+            Err((Binding::Coupling, format!("rho(XY)/gamma^2 = {:.6}", rho / g2)))
+        }
+    }
+}
+
+/// The X ⪰ 0 / Y ⪰ 0 test on ascending eigenvalues, with [`PSD_RTOL`] and [`PSD_ATOL`].
+fn psd_check(eigs: &[f64]) -> Result<(), String> {
+    let max_abs = eigs.iter().fold(0.0f64, |a, &v| a.max(v.abs()));
+    let lmin = eigs.first().copied().unwrap_or(0.0);
+    if lmin >= -(PSD_RTOL * max_abs + PSD_ATOL) {
+        Ok(())
+    } else {
+        Err(format!("not positive semidefinite (lambda_min = {lmin:.3e}, max |lambda| = {max_abs:.3e})"))
+    }
+}
