@@ -39,8 +39,8 @@ pub struct DesignArgs {
     /// Seed of the random starting points.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// CPU-second budget of the whole design (thread CPU time; a run it ends is not
-    /// reproducible bit for bit).
+    /// Budget of the whole design in CPU seconds (thread CPU time, not wall-clock time; a run
+    /// it ends is not reproducible bit for bit).
     #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub cpumax: f64,
     /// Evaluation budget of the whole design (deterministic: same seed, same controller).

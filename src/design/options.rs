@@ -40,8 +40,9 @@ pub struct DesignOptions {
     pub eps: f64,
     /// Seed of the run's random number generator.
     pub seed: u64,
-    /// CPU-second budget of the whole run (both phases and gradient sampling). Thread CPU time:
-    /// a run stopped by it is not reproducible bit for bit (it depends on the machine's speed).
+    /// Budget of the whole run in **CPU seconds** (both phases and gradient sampling): thread CPU
+    /// time, not wall-clock time. A run stopped by it is not reproducible bit for bit (it depends
+    /// on the machine's speed).
     #[serde(with = "serde_f64_or_string")]
     pub cpumax: f64,
     /// Evaluation budget of the whole run (objective evaluations, both phases and gradient
