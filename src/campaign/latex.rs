@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use super::reduce::BestRow;
 use super::reference::{RefMethod, ReferenceRow};
-use super::report::{CompareRow, FullOrderRow};
+use super::report::{CompareRow, FullOrderRow, FULL_ORDER_MAX_N};
 
 /// Escapes LaTeX specials (`\ & % $ # _ { } ~ ^`) and drops control characters (a newline or
 /// NUL in a name must not end a table row or break the file).
@@ -142,8 +142,9 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
         }
         s.push_str("\\bottomrule\n\\end{tabular}\n");
         if dagger {
-            s.push_str(
-                "\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > 60$).\n",
+            let _ = writeln!(
+                s,
+                "\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > {FULL_ORDER_MAX_N}$)."
             );
         }
         s.push_str("\\end{table}\n\n");
