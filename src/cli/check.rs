@@ -15,7 +15,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use hinfix::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
+    closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
 };
 use serde_json::{json, Value};
 
@@ -48,10 +48,10 @@ struct CheckReport {
 
 impl CheckReport {
     fn closed_loop_stable(&self) -> bool {
-        self.alpha_cl < 0.0
+        is_stable(self.alpha_cl)
     }
     fn controller_stable(&self) -> bool {
-        self.alpha_k.is_none_or(|a| a < 0.0)
+        self.alpha_k.is_none_or(is_stable)
     }
 }
 

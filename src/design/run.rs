@@ -7,7 +7,9 @@ use std::rc::Rc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL};
+use crate::lti::{
+    closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, MIN_HINF_TOL,
+};
 use crate::optim::RunControl;
 
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
@@ -169,7 +171,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
     let (alpha_cl, gamma) = match closed_loop(plant, k) {
         Ok(cl) => {
             let a = spectral_abscissa(cl.a.as_ref());
-            let g = if a < 0.0 { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
+            let g = if is_stable(a) { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
             (a, g)
         }
         Err(_) => (f64::INFINITY, f64::INFINITY),

@@ -193,7 +193,7 @@ pub fn solve_care(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) ->
     }
     let acl = a - &gs * &x;
     let closed_loop_abscissa = abscissa(acl.as_ref());
-    if !(closed_loop_abscissa < 0.0) {
+    if !super::spectral::is_stable(closed_loop_abscissa) {
         return Err(RiccatiError::NotStabilising { abscissa: closed_loop_abscissa });
     }
     Ok(CareSolution { x, iterations, residual, closed_loop_abscissa })
