@@ -31,21 +31,21 @@
 //! Several benchmark plants have D12 without full column rank or D21 without full row rank (HE1,
 //! REA2, HF1, AC10, BDT2: D21 = 0; CM4: D21 is 2×1). As is usual in the field (e.g. the
 //! regularisation used with `hinfsyn`, and the perturbation argument of Stoorvogel 1992 showing
-//! γ_opt(ε) ↓ γ_opt as ε ↓ 0), the singular side is augmented with ε-weighted channels:
+//! γ_opt(δ) ↓ γ_opt as δ ↓ 0), the singular side is augmented with δ-weighted channels:
 //!
 //! * D21 rank-deficient: new disturbances w_x (state noise) and v (sensor noise),
-//!   `B1 → [B1, εI_n, 0]`, `D21 → [D21, 0, εI_p2]`, `D11 → [D11, 0, 0]`;
-//! * D12 rank-deficient: new outputs ε x and ε u,
-//!   `C1 → [C1; εI_n; 0]`, `D12 → [D12; 0; εI_m2]`, `D11 → [D11; 0; 0]`.
+//!   `B1 → [B1, δI_n, 0]`, `D21 → [D21, 0, δI_p2]`, `D11 → [D11, 0, 0]`;
+//! * D12 rank-deficient: new outputs δ x and δ u,
+//!   `C1 → [C1; δI_n; 0]`, `D12 → [D12; 0; δI_m2]`, `D11 → [D11; 0; 0]`.
 //!
 //! The state channels also restore the imaginary-axis rank conditions (BDT2 has integrators not
-//! reached by B1). Augmenting w and z can only increase ‖T_zw‖ for every controller, so γ(ε) is an
-//! upper bound of the singular infimum and decreases to it as ε → 0. ε is absolute (in the plant's
-//! units). It is decreased through [`REGULARISATION_EPS`] (10⁻⁵ … 10⁻⁸) until γ(ε) is flat to
-//! [`FLAT_RTOL`], or until the numerics stop being trustworthy (γ(ε) would increase as ε
-//! decreases, which is impossible in exact arithmetic: the Hamiltonians carry 1/ε² terms), and
-//! the value at the smallest trusted ε is reported, with the whole sequence, in
-//! [`FullOrderGamma::eps_history`]. Very slowly converging plants (BDT2) are reported as such.
+//! reached by B1). Augmenting w and z can only increase ‖T_zw‖ for every controller, so γ(δ) is an
+//! upper bound of the singular infimum and decreases to it as δ → 0. δ is absolute (in the plant's
+//! units). It is decreased through [`REGULARISATION_DELTAS`] (10⁻⁵ … 10⁻⁸) until γ(δ) is flat to
+//! [`FLAT_RTOL`], or until the numerics stop being trustworthy (γ(δ) would increase as δ
+//! decreases, which is impossible in exact arithmetic: the Hamiltonians carry 1/δ² terms), and
+//! the value at the smallest trusted δ is reported, with the whole sequence, in
+//! [`FullOrderGamma::regularisation_history`]. Very slowly converging plants (BDT2) are reported as such.
 
 use std::fmt;
 
@@ -60,8 +60,8 @@ pub const GAMMA_RTOL: f64 = 1e-8;
 /// Relative singular-value threshold for the numerical rank of D12 and D21.
 pub const RANK_TOL: f64 = 1e-10;
 /// Regularisation levels tried in order (absolute), for plants with singular D12 or D21.
-pub const REGULARISATION_EPS: [f64; 4] = [1e-5, 1e-6, 1e-7, 1e-8];
-/// Stop decreasing ε once γ changes relatively by less than this.
+pub const REGULARISATION_DELTAS: [f64; 4] = [1e-5, 1e-6, 1e-7, 1e-8];
+/// Stop decreasing δ once γ changes relatively by less than this.
 pub const FLAT_RTOL: f64 = 1e-6;
 /// X ⪰ 0 test: λmin(X) ≥ −(PSD_RTOL·max|λ(X)| + PSD_ATOL).
 pub const PSD_RTOL: f64 = 1e-8;
@@ -104,31 +104,31 @@ impl Binding {
 /// The full-order optimal H∞ level and how it was obtained.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct FullOrderGamma {
-    /// γ_opt (feasible end of the final bracket; at the reported ε for singular plants).
+    /// γ_opt (feasible end of the final bracket; at the reported δ for singular plants).
     pub gamma: f64,
     /// Infeasible end of the final bracket (γ_opt ∈ (gamma_lower, gamma]).
     pub gamma_lower: f64,
-    /// The regularisation ε at which `gamma` was evaluated; `None` for a regular plant.
+    /// The regularisation δ at which `gamma` was evaluated; `None` for a regular plant.
     pub regularisation: Option<f64>,
     /// Numerical rank of D12 (m2 = full column rank).
     pub d12_rank: usize,
     /// Numerical rank of D21 (p2 = full row rank).
     pub d21_rank: usize,
-    /// D12 was regularised (z augmented with ε x, ε u).
+    /// D12 was regularised (z augmented with δ x, δ u).
     pub d12_regularised: bool,
-    /// D21 was regularised (w augmented with ε state noise, ε sensor noise).
+    /// D21 was regularised (w augmented with δ state noise, δ sensor noise).
     pub d21_regularised: bool,
-    /// γ(ε) for every ε evaluated, in order (empty for a regular plant).
-    pub eps_history: Vec<(f64, f64)>,
-    /// Whether γ(ε) was flat to [`FLAT_RTOL`] at the reported ε (true for a regular plant).
-    pub eps_converged: bool,
+    /// γ(δ) for every δ evaluated, in order (empty for a regular plant).
+    pub regularisation_history: Vec<(f64, f64)>,
+    /// Whether γ(δ) was flat to [`FLAT_RTOL`] at the reported δ (true for a regular plant).
+    pub regularisation_converged: bool,
     /// The condition that fails just below γ_opt.
     pub binding: Binding,
     /// The D11 lower bound (condition (i)).
     pub feedthrough_bound: f64,
     /// Number of γ-tests (pairs of Riccati solves) performed in total.
     pub gamma_tests: usize,
-    /// Remarks (e.g. why ε was not decreased further).
+    /// Remarks (e.g. why δ was not decreased further).
     pub notes: Vec<String>,
 }
 
@@ -150,21 +150,26 @@ impl fmt::Display for FullOrderGamma {
             self.gamma_tests,
             self.binding.text()
         )?;
-        if let Some(eps) = self.regularisation {
+        if let Some(delta) = self.regularisation {
             let mut what = Vec::new();
             if self.d21_regularised {
-                what.push(format!("D21 rank {} (w augmented with eps*I state and sensor noise)", self.d21_rank));
+                what.push(format!("D21 rank {} (w augmented with delta*I state and sensor noise)", self.d21_rank));
             }
             if self.d12_regularised {
-                what.push(format!("D12 rank {} (z augmented with eps*x, eps*u)", self.d12_rank));
+                what.push(format!("D12 rank {} (z augmented with delta*x, delta*u)", self.d12_rank));
             }
-            write!(f, "\n  singular plant: {}; regularised, reported at eps = {eps:.0e}", what.join("; "))?;
-            let hist: Vec<String> = self.eps_history.iter().map(|(e, g)| format!("{e:.0e}: {g:.7}")).collect();
+            write!(f, "\n  singular plant: {}; regularised, reported at delta = {delta:.0e}", what.join("; "))?;
+            let hist: Vec<String> =
+                self.regularisation_history.iter().map(|(e, g)| format!("{e:.0e}: {g:.7}")).collect();
             write!(
                 f,
-                "\n  gamma(eps): {}{}",
+                "\n  gamma(delta): {}{}",
                 hist.join(", "),
-                if self.eps_converged { " (flat)" } else { " (not flat: an upper bound of the eps -> 0 limit)" }
+                if self.regularisation_converged {
+                    " (flat)"
+                } else {
+                    " (not flat: an upper bound of the delta -> 0 limit)"
+                }
             )?;
         }
         for n in &self.notes {
@@ -206,9 +211,9 @@ pub enum FullOrderError {
 /// How singular problems are regularised.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Regularisation {
-    /// Decrease ε through [`REGULARISATION_EPS`] until flat or no longer trustworthy (default).
+    /// Decrease δ through [`REGULARISATION_DELTAS`] until flat or no longer trustworthy (default).
     Auto,
-    /// One fixed ε (used if D12 or D21 is rank-deficient).
+    /// One fixed δ (used if D12 or D21 is rank-deficient).
     Fixed(f64),
 }
 
@@ -261,8 +266,8 @@ pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<F
             d21_rank,
             d12_regularised: false,
             d21_regularised: false,
-            eps_history: Vec::new(),
-            eps_converged: true,
+            regularisation_history: Vec::new(),
+            regularisation_converged: true,
             binding: b.binding,
             feedthrough_bound: prob.gamma_d,
             gamma_tests: tests,
@@ -270,23 +275,23 @@ pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<F
         });
     }
 
-    let eps_list: Vec<f64> = match opts.regularisation {
-        Regularisation::Auto => REGULARISATION_EPS.to_vec(),
+    let delta_list: Vec<f64> = match opts.regularisation {
+        Regularisation::Auto => REGULARISATION_DELTAS.to_vec(),
         Regularisation::Fixed(e) => vec![e],
     };
     let mut history: Vec<(f64, f64)> = Vec::new();
-    let mut best: Option<(f64, Bracket, f64)> = None; // (eps, bracket, gamma_d)
+    let mut best: Option<(f64, Bracket, f64)> = None; // (delta, bracket, gamma_d)
     let mut converged = false;
-    for &eps in &eps_list {
-        let prob = Problem::new(plant, eps, d12_reg, d21_reg)?;
+    for &delta in &delta_list {
+        let prob = Problem::new(plant, delta, d12_reg, d21_reg)?;
         let warm = best.as_ref().map(|(_, b, _)| b.hi);
         if let Some(prev) = warm {
-            // γ(ε) is non-increasing as ε decreases: the previous γ must still be feasible.
+            // γ(δ) is non-increasing as δ decreases: the previous γ must still be feasible.
             tests += 1;
             if let Err(why) = prob.test(prev) {
                 notes.push(format!(
-                    "eps = {eps:.0e} not used: the previous gamma {prev:.7} tested infeasible there ({}), \
-                     i.e. the 1/eps^2-scaled Riccati equations are no longer numerically reliable",
+                    "delta = {delta:.0e} not used: the previous gamma {prev:.7} tested infeasible there ({}), \
+                     i.e. the 1/delta^2-scaled Riccati equations are no longer numerically reliable",
                     why.1
                 ));
                 break;
@@ -295,14 +300,14 @@ pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<F
         let b = match prob.gamma_opt(opts.rtol, warm, &mut tests) {
             Ok(b) => b,
             Err(e) if best.is_some() => {
-                notes.push(format!("eps = {eps:.0e} not used: {e}"));
+                notes.push(format!("delta = {delta:.0e} not used: {e}"));
                 break;
             }
             Err(e) => return Err(e),
         };
-        history.push((eps, b.hi));
+        history.push((delta, b.hi));
         let prev = best.as_ref().map(|(_, pb, _)| pb.hi);
-        best = Some((eps, b, prob.gamma_d));
+        best = Some((delta, b, prob.gamma_d));
         if let Some(p) = prev {
             if (p - history.last().expect("pushed").1).abs() <= FLAT_RTOL * p {
                 converged = true;
@@ -310,21 +315,21 @@ pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<F
             }
         }
     }
-    let (eps, b, gamma_d) = best.expect("the first eps either succeeds or returns an error");
+    let (delta, b, gamma_d) = best.expect("the first delta either succeeds or returns an error");
     if matches!(opts.regularisation, Regularisation::Fixed(_)) {
         converged = false;
-        notes.push("fixed eps requested: no eps -> 0 convergence check".into());
+        notes.push("fixed delta requested: no delta -> 0 convergence check".into());
     }
     Ok(FullOrderGamma {
         gamma: b.hi,
         gamma_lower: b.lo,
-        regularisation: Some(eps),
+        regularisation: Some(delta),
         d12_rank,
         d21_rank,
         d12_regularised: d12_reg,
         d21_regularised: d21_reg,
-        eps_history: history,
-        eps_converged: converged,
+        regularisation_history: history,
+        regularisation_converged: converged,
         binding: b.binding,
         feedthrough_bound: gamma_d,
         gamma_tests: tests,
@@ -361,7 +366,7 @@ struct Problem {
 }
 
 impl Problem {
-    fn new(plant: &Plant, eps: f64, reg12: bool, reg21: bool) -> Result<Problem, FullOrderError> {
+    fn new(plant: &Plant, delta: f64, reg12: bool, reg21: bool) -> Result<Problem, FullOrderError> {
         let (n, m2, p2) = (plant.dims.n, plant.dims.m2, plant.dims.p2);
         let (mut b1, mut c1) = (plant.b1.clone(), plant.c1.clone());
         let (mut d11, mut d12, mut d21) = (plant.d11.clone(), plant.d12.clone(), plant.d21.clone());
@@ -371,7 +376,7 @@ impl Problem {
                 if i < p1 {
                     c1[(i, j)]
                 } else if i - p1 == j {
-                    eps
+                    delta
                 } else {
                     0.0
                 }
@@ -380,7 +385,7 @@ impl Problem {
                 if i < p1 {
                     d12[(i, j)]
                 } else if i >= p1 + n && i - p1 - n == j {
-                    eps
+                    delta
                 } else {
                     0.0
                 }
@@ -393,7 +398,7 @@ impl Problem {
                 if j < m1 {
                     b1[(i, j)]
                 } else if j - m1 == i {
-                    eps
+                    delta
                 } else {
                     0.0
                 }
@@ -402,7 +407,7 @@ impl Problem {
                 if j < m1 {
                     d21[(i, j)]
                 } else if j >= m1 + n && j - m1 - n == i {
-                    eps
+                    delta
                 } else {
                     0.0
                 }
@@ -485,7 +490,7 @@ impl Problem {
         }
     }
 
-    /// Bracket and bisect. `warm`: a γ known feasible (previous ε), searched downwards from.
+    /// Bracket and bisect. `warm`: a γ known feasible (previous δ), searched downwards from.
     fn gamma_opt(&self, rtol: f64, warm: Option<f64>, tests: &mut usize) -> Result<Bracket, FullOrderError> {
         let floor = self.gamma_d;
         let mut lo_binding = Binding::Feedthrough;

@@ -26,7 +26,7 @@ pub use controller::{Controller, ControllerError, ControllerErrorKind};
 pub use error::LtiError;
 pub use full_order::{
     full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions, Regularisation,
-    FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_EPS,
+    FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
