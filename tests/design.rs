@@ -164,8 +164,8 @@ fn observer_sees_components_and_break_interrupts() {
     let opt: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Optimisation).collect();
     assert!(!opt.is_empty());
     for r in &opt {
-        assert!(r.hinf_cl.is_finite() && r.hinf_k.is_finite() && r.alpha_cl < 0.0 && r.alpha_k < 0.0, "{r:?}");
-        assert!((r.f - r.hinf_cl.max(opts.eps * r.hinf_k)).abs() <= 1e-12 * r.f, "{r:?}");
+        assert!(r.gamma.is_finite() && r.k_hinf.is_finite() && r.alpha_cl < 0.0 && r.alpha_k < 0.0, "{r:?}");
+        assert!((r.f - r.gamma.max(opts.eps * r.k_hinf)).abs() <= 1e-12 * r.f, "{r:?}");
     }
     let stab: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Stabilisation).collect();
     for r in &stab {

@@ -528,7 +528,7 @@ impl DesignObserver for WorkerObserver<'_> {
                 phase: rec.phase,
                 iter: rec.iter,
                 f: rec.f,
-                gamma: rec.hinf_cl,
+                gamma: rec.gamma,
             });
         }
         if self.cancel.load(Ordering::Relaxed) {

@@ -166,9 +166,9 @@ pub struct DesignIterRecord {
     /// Objective value.
     pub f: f64,
     /// ‖Tzw‖∞ at the iterate (+∞ if unstable; NaN if not computed in this phase).
-    pub hinf_cl: f64,
+    pub gamma: f64,
     /// ‖K‖∞ at the iterate (NaN if not computed).
-    pub hinf_k: f64,
+    pub k_hinf: f64,
     /// α(A_cl).
     pub alpha_cl: f64,
     /// α(Ak) (NaN for order 0).
