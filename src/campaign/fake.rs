@@ -110,7 +110,7 @@ impl JobRunner for FakeRunner {
         }
         Ok(DesignOutcome {
             status,
-            controller: k.to_json(),
+            controller: k,
             gamma,
             k_hinf: 1.0 + seed,
             alpha_cl: -1.0,

@@ -31,7 +31,7 @@ use serde_json::{json, Value};
 
 use super::jobs::Job;
 use super::record::JobRecord;
-use super::scheduler::JobObserver;
+use super::scheduler::{JobObserver, ObserverError};
 use crate::design::{DesignIterRecord, Phase};
 
 /// Topic of the per-iteration channel.
@@ -296,8 +296,8 @@ impl JobObserver for TraceWriter {
         ControlFlow::Continue(())
     }
 
-    fn finish(self: Box<Self>, record: &JobRecord) -> Result<(), String> {
-        self.complete(record).map(|_| ()).map_err(|e| e.to_string())
+    fn finish(self: Box<Self>, record: &JobRecord) -> Result<(), ObserverError> {
+        self.complete(record).map(|_| ()).map_err(ObserverError::failed)
     }
 
     fn abandon(self: Box<Self>) {
@@ -306,10 +306,10 @@ impl JobObserver for TraceWriter {
 }
 
 /// The observer factory for `scheduler::execute`: one [`TraceWriter`] per job in `traces_dir`.
-pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, String> + Sync {
+pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, ObserverError> + Sync {
     let dir = traces_dir.to_path_buf();
     move |job: &Job| {
-        TraceWriter::create(&dir, &job.id.0).map(|w| Box::new(w) as Box<dyn JobObserver>).map_err(|e| e.to_string())
+        TraceWriter::create(&dir, &job.id.0).map(|w| Box::new(w) as Box<dyn JobObserver>).map_err(ObserverError::failed)
     }
 }
 

@@ -110,8 +110,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
     if hinfix::lti::mat_file::is_mat_path(&a.out) {
-        let k = Controller::from_json_value(&outcome.controller).context("the designed controller")?;
-        k.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+        outcome.controller.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
     } else {
         let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
         write_atomic(&a.out, text.as_bytes()).with_context(|| format!("writing {}", a.out.display()))?;

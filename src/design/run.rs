@@ -14,7 +14,7 @@ use crate::optim::RunControl;
 
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
-use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase, SearchStop};
+use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop};
 use super::params::{controller_to_x, ControllerShape};
 use super::search::Search;
 use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
@@ -122,16 +122,12 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
         }
     }
     if let Some(k) = init {
-        k.check_fits(plant).map_err(|e| DesignError::Init(e.to_string()))?;
+        k.check_fits(plant).map_err(|e| DesignError::Init(InitError::Shape(e)))?;
         if k.order() > opts.order {
-            return Err(DesignError::Init(format!(
-                "its order {} exceeds the target order {} (warm starts only grow the order)",
-                k.order(),
-                opts.order
-            )));
+            return Err(DesignError::Init(InitError::OrderTooHigh { order: k.order(), target: opts.order }));
         }
         if !k.is_finite() {
-            return Err(DesignError::Init("has a non-finite entry".into()));
+            return Err(DesignError::Init(InitError::NonFinite));
         }
     }
     Ok(())
@@ -244,7 +240,7 @@ fn run_validated(
     let evals = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {
         status,
-        controller: k.to_json(),
+        controller: k,
         gamma: fig.gamma,
         k_hinf: fig.k_hinf,
         alpha_cl: fig.alpha_cl,

@@ -26,6 +26,21 @@ pub struct Controller {
     pub dk: Mat<f64>,
 }
 
+/// As [`Controller::to_json`]: the `{AK, BK, CK, DK}` object of a controller file.
+impl serde::Serialize for Controller {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        serde::Serialize::serialize(&self.to_json(), s)
+    }
+}
+
+/// As [`Controller::from_json_value`] (shapes checked; the error says which matrix is wrong).
+impl<'de> serde::Deserialize<'de> for Controller {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let doc = <Value as serde::Deserialize>::deserialize(d)?;
+        Controller::from_json_value(&doc).map_err(serde::de::Error::custom)
+    }
+}
+
 /// A controller file that could not be read.
 #[derive(Debug, thiserror::Error)]
 #[error("controller file {}: {kind}", file.display())]
