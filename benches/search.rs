@@ -27,7 +27,7 @@ use std::time::Instant;
 
 use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
 use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver};
-use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
+use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -91,8 +91,8 @@ fn verified_gamma(p: &Plant, o: &DesignOutcome) -> Option<f64> {
     if matches!(o.status, DesignStatus::NotStabilised { .. }) {
         return None;
     }
-    let k = Controller::from_json_value(&o.controller).ok()?;
-    let cl = closed_loop(p, &k).ok()?;
+    let k = &o.controller;
+    let cl = closed_loop(p, k).ok()?;
     let k_stable = k.order() == 0 || spectral_abscissa(k.ak.as_ref()) < 0.0;
     (spectral_abscissa(cl.a.as_ref()) < 0.0 && k_stable).then(|| hinf_norm(&cl, DEFAULT_HINF_TOL).value)
 }

@@ -4,8 +4,8 @@
 use std::ops::ControlFlow;
 
 use hinfix::design::{
-    controller_to_x, run, DesignError, DesignIterRecord, DesignObserver, DesignOptions, DesignStatus, NoDesignObserver,
-    ObjectiveKind, Phase, SearchStop,
+    controller_to_x, run, DesignError, DesignIterRecord, DesignObserver, DesignOptions, DesignStatus, InitError,
+    NoDesignObserver, ObjectiveKind, Phase, SearchStop,
 };
 use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
 
@@ -14,7 +14,7 @@ fn plant(name: &str) -> Plant {
 }
 
 fn controller(o: &hinfix::design::DesignOutcome) -> Controller {
-    Controller::from_json_value(&o.controller).unwrap()
+    o.controller.clone()
 }
 
 /// The outcome's figures agree with an independent recomputation from its controller.
@@ -164,8 +164,8 @@ fn observer_sees_components_and_break_interrupts() {
     let opt: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Optimisation).collect();
     assert!(!opt.is_empty());
     for r in &opt {
-        assert!(r.hinf_cl.is_finite() && r.hinf_k.is_finite() && r.alpha_cl < 0.0 && r.alpha_k < 0.0, "{r:?}");
-        assert!((r.f - r.hinf_cl.max(opts.eps * r.hinf_k)).abs() <= 1e-12 * r.f, "{r:?}");
+        assert!(r.gamma.is_finite() && r.k_hinf.is_finite() && r.alpha_cl < 0.0 && r.alpha_k < 0.0, "{r:?}");
+        assert!((r.f - r.gamma.max(opts.eps * r.k_hinf)).abs() <= 1e-12 * r.f, "{r:?}");
     }
     let stab: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Stabilisation).collect();
     for r in &stab {
@@ -198,9 +198,17 @@ fn bad_options_and_init_are_errors() {
         }
     }
     let wrong_shape = Controller::zeros(1, 1, 1); // HE1 has m2 = 2
-    assert!(matches!(run(&p, &ok, Some(&wrong_shape), &mut NoDesignObserver), Err(DesignError::Init(_))));
+    let e = run(&p, &ok, Some(&wrong_shape), &mut NoDesignObserver).unwrap_err();
+    assert!(matches!(e, DesignError::Init(InitError::Shape(_))), "{e:?}");
+    assert_eq!(e.to_string(), "initial controller: does not fit plant HE1: DK is 1×1, the plant needs m2×p2 = 2×1");
     let too_big = Controller::zeros(2, 2, 1);
-    assert!(matches!(run(&p, &ok, Some(&too_big), &mut NoDesignObserver), Err(DesignError::Init(_))));
+    let e = run(&p, &ok, Some(&too_big), &mut NoDesignObserver).unwrap_err();
+    assert!(matches!(e, DesignError::Init(InitError::OrderTooHigh { order: 2, target: 1 })), "{e:?}");
+    let mut nan = Controller::zeros(1, 2, 1);
+    nan.dk[(0, 0)] = f64::NAN;
+    let e = run(&p, &ok, Some(&nan), &mut NoDesignObserver).unwrap_err();
+    assert!(matches!(e, DesignError::Init(InitError::NonFinite)), "{e:?}");
+    assert_eq!(e.to_string(), "initial controller: has a non-finite entry");
 }
 
 #[test]

@@ -39,7 +39,7 @@ fn regular_plants_match_sb10ad() {
     }
 }
 
-/// Regularised-D21 cases at a fixed ε: the same regularised plant through SB10AD.
+/// Regularised-D21 cases at a fixed regularisation δ: the same regularised plant through SB10AD.
 #[test]
 fn regularised_d21_matches_sb10ad() {
     for (name, eps) in [("HE1", 1e-6), ("HE1", 1e-5), ("REA2", 1e-5)] {
@@ -83,11 +83,11 @@ fn large_plants_match_check() {
 fn bdt2_eps_sequence() {
     let r = full_order_gamma(&plant("BDT2")).unwrap();
     let expect = [(1e-5, 0.4260), (1e-6, 0.3961), (1e-7, 0.3724)];
-    for ((e, g), (ee, gg)) in r.eps_history.iter().zip(expect) {
+    for ((e, g), (ee, gg)) in r.regularisation_history.iter().zip(expect) {
         assert_eq!(*e, ee);
         assert!(rel(*g, gg) < 2e-4, "{r}");
     }
-    assert!(!r.eps_converged);
+    assert!(!r.regularisation_converged);
 }
 
 /// Scalar plant x' = w1 + u, z = [x; u], y = x + w2 (A = 0, B1 = [1 0], B2 = 1, C1 = [1; 0],

@@ -152,7 +152,7 @@ fn command_line_designs_into_mat_checks_plots_and_exports_it() {
     let (k_s, plant_s) = (k.to_str().unwrap(), plant.to_str().unwrap());
     cli(&["design", "--plant", plant_s, "--order", "1", "--cpumax", "2", "--nrand", "1", "--out", k_s]);
     let kk = Controller::load(&k).unwrap();
-    assert_eq!((kk.order(), kk.m(), kk.p()), (1, 2, 1));
+    assert_eq!((kk.order(), kk.outputs(), kk.inputs()), (1, 2, 1));
     let svg = dir.path().join("sigma.svg");
     let png = dir.path().join("sigma.png");
     let out = cli(&["check", "--plant", "HE1", "--controller", k_s, "--json", "--plot", svg.to_str().unwrap()]);

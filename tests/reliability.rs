@@ -53,7 +53,10 @@ fn record(out: Result<DesignOutcome, String>) -> JobRecord {
 fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
     DesignOutcome {
         status,
-        controller: serde_json::json!({"AK": [[-1.0]], "BK": [[0.0]], "CK": [[0.0], [0.0]], "DK": [[0.0], [0.0]]}),
+        controller: serde_json::from_value(
+            serde_json::json!({"AK": [[-1.0]], "BK": [[0.0]], "CK": [[0.0], [0.0]], "DK": [[0.0], [0.0]]}),
+        )
+        .unwrap(),
         gamma: x,
         k_hinf: x,
         alpha_cl: x,

@@ -97,8 +97,8 @@ impl JobRunner for FakeRunner {
                 start: 0,
                 iter: iter + 1,
                 f,
-                hinf_cl: f,
-                hinf_k: 1.0,
+                gamma: f,
+                k_hinf: 1.0,
                 alpha_cl: -1.0,
                 alpha_k: -1.0,
                 dnorm: 1.0 / (1.0 + iter as f64),
@@ -113,7 +113,7 @@ impl JobRunner for FakeRunner {
         }
         Ok(DesignOutcome {
             status,
-            controller: k.to_json(),
+            controller: k,
             gamma,
             k_hinf: 1.0 + seed,
             alpha_cl: -1.0,

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::compare::{CompareRow, FullOrderRow};
+use super::compare::{CompareRow, FullOrderRow, FULL_ORDER_MAX_N};
 use super::reduce::BestRow;
 use super::reference::{RefMethod, ReferenceRow};
 
@@ -126,8 +126,9 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
         }
         s.push_str("\\bottomrule\n\\end{tabular}\n");
         if dagger {
-            s.push_str(
-                "\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > 60$).\n",
+            let _ = writeln!(
+                s,
+                "\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > {FULL_ORDER_MAX_N}$)."
             );
         }
         s.push_str("\\end{table}\n\n");

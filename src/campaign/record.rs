@@ -240,7 +240,7 @@ impl JobRecord {
                 r.phases = out.phases;
                 r.search = Some(out.search);
                 r.design_cpu_s = out.cpu_s;
-                r.controller = Some(out.controller);
+                r.controller = Some(out.controller.to_json());
             }
         }
         Some(r)

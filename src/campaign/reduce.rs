@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::record::JobRecord;
-use crate::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
+use crate::lti::{closed_loop, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
 /// them.
@@ -73,12 +73,12 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
         Err(e) => return Verdict::Rejected(format!("closed loop: {e}")),
     };
     let alpha_cl = spectral_abscissa(cl.a.as_ref());
-    if !(alpha_cl < 0.0) {
+    if !is_stable(alpha_cl) {
         return Verdict::Rejected(format!("closed loop not stable (α = {alpha_cl})"));
     }
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     if let Some(a) = alpha_k {
-        if !(a < 0.0) {
+        if !is_stable(a) {
             return Verdict::Rejected(format!("controller not stable (α_K = {a})"));
         }
     }

@@ -152,3 +152,16 @@ pub fn write_reports(
 
     Ok(ReportSummary { files, best, compare })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::FULL_ORDER_MAX_N;
+
+    /// campaigns/FORMAT.md states the limit in prose; it must say what the code does.
+    #[test]
+    fn format_md_states_full_order_max_n() {
+        let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/campaigns/FORMAT.md")).unwrap();
+        let want = format!("n ≤ {FULL_ORDER_MAX_N} ");
+        assert!(doc.contains(&want), "campaigns/FORMAT.md should say `{want}` (FULL_ORDER_MAX_N)");
+    }
+}

@@ -120,19 +120,40 @@ pub trait JobObserver: Send {
         ControlFlow::Continue(())
     }
     /// The job finished with `record` (which is journaled next). An error becomes a warning.
-    fn finish(self: Box<Self>, _record: &JobRecord) -> Result<(), String> {
+    fn finish(self: Box<Self>, _record: &JobRecord) -> Result<(), ObserverError> {
         Ok(())
     }
     /// The job was interrupted: nothing will be journaled.
     fn abandon(self: Box<Self>) {}
 }
 
-/// Makes the observer of a job (called on the worker). An error becomes a warning and the job
-/// runs unobserved.
-pub type ObserverFactory<'a> = dyn Fn(&Job) -> Result<Box<dyn JobObserver>, String> + Sync + 'a;
+/// Makes the observer of a job (called on the worker). An error — or a panic of the factory —
+/// becomes a [`CampaignEvent::Warning`] of the job, which then runs unobserved.
+pub type ObserverFactory<'a> = dyn Fn(&Job) -> Result<Box<dyn JobObserver>, ObserverError> + Sync + 'a;
+
+/// Why a job's observer could not be made or finished. Reported as a warning; never fails the
+/// job.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ObserverError {
+    /// The observer's own error (e.g. a `TraceError` naming the trace file), kept with its
+    /// `source` chain; its message is the warning's.
+    #[error(transparent)]
+    Failed(Box<dyn std::error::Error + Send + Sync>),
+    /// The observer factory panicked (the scheduler catches it).
+    #[error("the job's observer could not be made (panic: {0}); the job runs unobserved")]
+    FactoryPanicked(String),
+}
+
+impl ObserverError {
+    /// Wraps an observer's error.
+    pub fn failed(e: impl std::error::Error + Send + Sync + 'static) -> Self {
+        ObserverError::Failed(Box::new(e))
+    }
+}
 
 /// A factory that observes nothing.
-pub fn no_observers(_: &Job) -> Result<Box<dyn JobObserver>, String> {
+pub fn no_observers(_: &Job) -> Result<Box<dyn JobObserver>, ObserverError> {
     struct Nothing;
     impl JobObserver for Nothing {}
     Ok(Box::new(Nothing))
@@ -528,7 +549,7 @@ impl DesignObserver for WorkerObserver<'_> {
                 phase: rec.phase,
                 iter: rec.iter,
                 f: rec.f,
-                gamma: rec.hinf_cl,
+                gamma: rec.gamma,
             });
         }
         if self.cancel.load(Ordering::Relaxed) {
@@ -554,13 +575,14 @@ fn run_one(
 ) {
     let cpu0 = thread_cpu_time();
     let t0 = Instant::now();
-    let user = match catch_unwind(AssertUnwindSafe(|| observers(job))) {
-        Ok(Ok(o)) => Some(o),
-        Ok(Err(message)) => {
-            let _ = tx.send(WorkerMsg::Warning { index, message });
+    let made = catch_unwind(AssertUnwindSafe(|| observers(job)))
+        .unwrap_or_else(|panic| Err(ObserverError::FactoryPanicked(panic_message(&panic))));
+    let user = match made {
+        Ok(o) => Some(o),
+        Err(e) => {
+            let _ = tx.send(WorkerMsg::Warning { index, message: e.to_string() });
             None
         }
-        Err(_) => None,
     };
     let mut obs = WorkerObserver { user, cancel, tx: &tx, index, worker, interval, last_sent: None };
     let warm = init.is_some();
@@ -584,8 +606,8 @@ fn run_one(
         }
         Some(record) => {
             if let Some(u) = user {
-                if let Err(message) = u.finish(&record) {
-                    let _ = tx.send(WorkerMsg::Warning { index, message });
+                if let Err(e) = u.finish(&record) {
+                    let _ = tx.send(WorkerMsg::Warning { index, message: e.to_string() });
                 }
             }
             let _ = tx.send(WorkerMsg::Finished { index, worker, record: Box::new(record) });
@@ -600,5 +622,41 @@ fn panic_message(p: &Box<dyn std::any::Any + Send>) -> String {
         s.clone()
     } else {
         "(no message)".to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::campaign::fake::FakeRunner;
+    use crate::campaign::{expand, Campaign, RunnerTag};
+
+    /// A factory that panics must not be dropped silently: every job warns, runs unobserved and
+    /// is journaled as usual.
+    #[test]
+    fn panicking_observer_factory_is_a_warning_per_job() {
+        let text = "name = \"t\"\n[defaults]\neps = [1e-2]\nseeds = 2\ncpumax = 5.0\n[[problem]]\nplant = \"HE1\"\norders = [1]\n";
+        let jobs = expand(&Campaign::from_toml_str(text, std::path::Path::new("t.toml")).unwrap(), RunnerTag::Fake);
+        assert_eq!(jobs.len(), 2);
+        let panicking = |_: &Job| -> Result<Box<dyn JobObserver>, ObserverError> { panic!("factory boom") };
+        let runner = FakeRunner { pause: Duration::ZERO };
+        let (mut warnings, mut finished) = (Vec::new(), 0);
+        let stats =
+            execute(&jobs, &HashMap::new(), &runner, &panicking, &mut Solo, &ExecuteOptions::new("t", 2), |ev| {
+                match ev {
+                    CampaignEvent::Warning { index, message } => warnings.push((index, message)),
+                    CampaignEvent::JobFinished { .. } => finished += 1,
+                    _ => {}
+                }
+                Ok::<(), std::convert::Infallible>(())
+            })
+            .unwrap();
+        assert_eq!((stats.finished, stats.failed, finished), (2, 0, 2));
+        warnings.sort();
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        for (i, (index, message)) in warnings.iter().enumerate() {
+            assert_eq!(*index, Some(i));
+            assert!(message.contains("panic: factory boom") && message.contains("unobserved"), "{message}");
+        }
     }
 }

@@ -3,7 +3,8 @@
 //! Two channels, both with message encoding `json` and a JSON Schema (schema encoding
 //! `jsonschema`):
 //! * [`ITER_TOPIC`] — one message per optimiser iteration ([`iter_message`]: phase, start,
-//!   iteration, f, ‖Tzw‖∞, ‖K‖∞, α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds);
+//!   iteration, f, ‖Tzw‖∞ as `gamma`, ‖K‖∞ as `k_hinf` (older builds: `hinf_cl`, `hinf_k`),
+//!   α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds);
 //! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled (with its
 //!   `search` summary: starts, best start, CPU time to best, stop reason).
 //!
@@ -30,7 +31,7 @@ use serde_json::{json, Value};
 
 use super::jobs::Job;
 use super::record::JobRecord;
-use super::scheduler::JobObserver;
+use super::scheduler::{JobObserver, ObserverError};
 use crate::design::{DesignIterRecord, Phase};
 
 /// Topic of the per-iteration channel.
@@ -88,6 +89,20 @@ fn phase_name(p: Phase) -> String {
     }
 }
 
+/// Keys of [`ITER_TOPIC`] messages renamed since older builds: (current, old). ‖Tzw‖∞ and ‖K‖∞
+/// have one name each across the crate (docs/ARCHITECTURE.md §5); traces written before the
+/// rename stay readable through [`iter_field`].
+pub const RENAMED_ITER_KEYS: [(&str, &str); 2] = [("gamma", "hinf_cl"), ("k_hinf", "hinf_k")];
+
+/// Field `key` of an iteration message, under its old name if the message predates the rename
+/// ([`RENAMED_ITER_KEYS`]); `Null` if absent.
+pub fn iter_field<'a>(v: &'a Value, key: &str) -> &'a Value {
+    match (v.get(key), RENAMED_ITER_KEYS.iter().find(|(new, _)| *new == key)) {
+        (None, Some((_, old))) => &v[*old],
+        _ => &v[key],
+    }
+}
+
 /// One iteration as written on [`ITER_TOPIC`].
 pub fn iter_message(rec: &DesignIterRecord) -> Value {
     json!({
@@ -95,8 +110,8 @@ pub fn iter_message(rec: &DesignIterRecord) -> Value {
         "start": rec.start,
         "iteration": rec.iter,
         "f": json_f64(rec.f),
-        "hinf_cl": json_f64(rec.hinf_cl),
-        "hinf_k": json_f64(rec.hinf_k),
+        "gamma": json_f64(rec.gamma),
+        "k_hinf": json_f64(rec.k_hinf),
         "alpha_cl": json_f64(rec.alpha_cl),
         "alpha_k": json_f64(rec.alpha_k),
         "dnorm": json_f64(rec.dnorm),
@@ -118,7 +133,7 @@ pub fn iter_schema() -> Value {
             "phase": {"type": "string"},
             "start": {"type": "integer"},
             "iteration": {"type": "integer"},
-            "f": float, "hinf_cl": float, "hinf_k": float, "alpha_cl": float, "alpha_k": float,
+            "f": float, "gamma": float, "k_hinf": float, "alpha_cl": float, "alpha_k": float,
             "dnorm": float, "step": float,
             "evaluations": {"type": "integer"},
             "elapsed_cpu_s": float,
@@ -281,8 +296,8 @@ impl JobObserver for TraceWriter {
         ControlFlow::Continue(())
     }
 
-    fn finish(self: Box<Self>, record: &JobRecord) -> Result<(), String> {
-        self.complete(record).map(|_| ()).map_err(|e| e.to_string())
+    fn finish(self: Box<Self>, record: &JobRecord) -> Result<(), ObserverError> {
+        self.complete(record).map(|_| ()).map_err(ObserverError::failed)
     }
 
     fn abandon(self: Box<Self>) {
@@ -291,10 +306,10 @@ impl JobObserver for TraceWriter {
 }
 
 /// The observer factory for `scheduler::execute`: one [`TraceWriter`] per job in `traces_dir`.
-pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, String> + Sync {
+pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, ObserverError> + Sync {
     let dir = traces_dir.to_path_buf();
     move |job: &Job| {
-        TraceWriter::create(&dir, &job.id.0).map(|w| Box::new(w) as Box<dyn JobObserver>).map_err(|e| e.to_string())
+        TraceWriter::create(&dir, &job.id.0).map(|w| Box::new(w) as Box<dyn JobObserver>).map_err(ObserverError::failed)
     }
 }
 
@@ -326,7 +341,7 @@ pub struct TraceSummary {
     /// Last f of the trace.
     pub last_f: f64,
     /// Smallest finite ‖Tzw‖∞ seen at an iterate (NaN if none).
-    pub best_hinf_cl: f64,
+    pub best_gamma: f64,
     /// Evaluations at the last iteration.
     pub evaluations: usize,
     /// Elapsed CPU seconds at the last iteration.
@@ -401,7 +416,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
         phases: Vec::new(),
         first_f: f64::NAN,
         last_f: f64::NAN,
-        best_hinf_cl: f64::NAN,
+        best_gamma: f64::NAN,
         evaluations: 0,
         elapsed_cpu_s: f64::NAN,
         final_status: None,
@@ -419,9 +434,9 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
                 s.iterations += 1;
             }
             s.last_f = f;
-            let h = f64_from_json(&v["hinf_cl"]);
-            if h.is_finite() && !(h >= s.best_hinf_cl) {
-                s.best_hinf_cl = h;
+            let h = f64_from_json(iter_field(&v, "gamma"));
+            if h.is_finite() && !(h >= s.best_gamma) {
+                s.best_gamma = h;
             }
             s.evaluations = v["evaluations"].as_u64().unwrap_or(0) as usize;
             s.elapsed_cpu_s = f64_from_json(&v["elapsed_cpu_s"]);
@@ -453,7 +468,7 @@ impl fmt::Display for TraceSummary {
             "  iterations {} ({} messages with the starting points)  evaluations {}  cpu {:.2} s",
             self.iterations, self.messages, self.evaluations, self.elapsed_cpu_s
         )?;
-        writeln!(f, "  f: first {:.6e}  last {:.6e}  best ‖Tzw‖∞ {:.6}", self.first_f, self.last_f, self.best_hinf_cl)?;
+        writeln!(f, "  f: first {:.6e}  last {:.6e}  best ‖Tzw‖∞ {:.6}", self.first_f, self.last_f, self.best_gamma)?;
         for (name, p) in &self.phases {
             writeln!(f, "  {name:<16} {:>6} msgs  f {:.6e} → {:.6e}", p.messages, p.first_f, p.last_f)?;
         }

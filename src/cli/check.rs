@@ -2,9 +2,11 @@
 //! closed-loop and controller spectral abscissas, ‖Tzw‖∞ with its peak frequency, ‖K‖∞, and both
 //! stability decisions; `--plot` also draws the σ-plot.
 //!
-//! JSON keys are those of the SLICOT oracle (`closed_loop_spectral_abscissa`,
-//! `controller_spectral_abscissa` (null for nk = 0), `closed_loop_hinf`, `closed_loop_peak_freq`,
-//! `controller_hinf`, `closed_loop_stable`, `controller_stable`); non-finite numbers are written
+//! JSON keys: `closed_loop_spectral_abscissa`, `controller_spectral_abscissa` (null for nk = 0),
+//! `gamma` (‖Tzw‖∞) and `k_hinf` (‖K‖∞) — the names of the journal, the traces and
+//! [`hinfix::design::DesignOutcome`] (docs/ARCHITECTURE.md §5; builds before that wrote the SLICOT
+//! oracle's `closed_loop_hinf` / `controller_hinf`) — `closed_loop_peak_freq` (where ‖Tzw‖∞
+//! peaks), `closed_loop_stable`, `controller_stable`; non-finite numbers are written
 //! as the strings "inf" / "-inf" / "nan" (as `design::float_serde`), a frequency that does not
 //! exist (unstable loop) as null.
 //!
@@ -15,7 +17,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use hinfix::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
+    closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
 };
 use serde_json::{json, Value};
 
@@ -41,17 +43,17 @@ pub struct CheckArgs {
 struct CheckReport {
     alpha_cl: f64,
     alpha_k: Option<f64>,
-    hinf_cl: f64,
+    gamma: f64,
     peak_freq: f64,
-    hinf_k: f64,
+    k_hinf: f64,
 }
 
 impl CheckReport {
     fn closed_loop_stable(&self) -> bool {
-        self.alpha_cl < 0.0
+        is_stable(self.alpha_cl)
     }
     fn controller_stable(&self) -> bool {
-        self.alpha_k.is_none_or(|a| a < 0.0)
+        self.alpha_k.is_none_or(is_stable)
     }
 }
 
@@ -80,7 +82,7 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
-    Ok(CheckReport { alpha_cl, alpha_k, hinf_cl: h.value, peak_freq: h.peak_freq, hinf_k: hk.value })
+    Ok(CheckReport { alpha_cl, alpha_k, gamma: h.value, peak_freq: h.peak_freq, k_hinf: hk.value })
 }
 
 use hinfix::design::f64_to_json as num;
@@ -89,9 +91,9 @@ fn to_json(r: &CheckReport) -> Value {
     json!({
         "closed_loop_spectral_abscissa": num(r.alpha_cl),
         "controller_spectral_abscissa": r.alpha_k.map(num),
-        "closed_loop_hinf": num(r.hinf_cl),
+        "gamma": num(r.gamma),
         "closed_loop_peak_freq": if r.peak_freq.is_nan() { Value::Null } else { num(r.peak_freq) },
-        "controller_hinf": num(r.hinf_k),
+        "k_hinf": num(r.k_hinf),
         "closed_loop_stable": r.closed_loop_stable(),
         "controller_stable": r.controller_stable(),
     })
@@ -113,12 +115,12 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         k.order()
     );
     s += &format!("closed loop: α(A_cl) = {:+.6e}   {}\n", r.alpha_cl, yes_no(r.closed_loop_stable()));
-    s += &format!("             ‖Tzw‖∞  = {}   at {}\n", super::fmt_num(r.hinf_cl, 10), freq);
+    s += &format!("             ‖Tzw‖∞  = {}   at {}\n", super::fmt_num(r.gamma, 10), freq);
     match r.alpha_k {
         Some(a) => s += &format!("controller:  α(Ak)    = {:+.6e}   {}\n", a, yes_no(r.controller_stable())),
         None => s += "controller:  static gain (order 0), trivially stable\n",
     }
-    s += &format!("             ‖K‖∞    = {}\n", super::fmt_num(r.hinf_k, 10));
+    s += &format!("             ‖K‖∞    = {}\n", super::fmt_num(r.k_hinf, 10));
     s
 }
 
@@ -128,16 +130,16 @@ mod tests {
 
     #[test]
     fn json_keys_and_infinities() {
-        let r = CheckReport { alpha_cl: 0.3, alpha_k: None, hinf_cl: f64::INFINITY, peak_freq: f64::NAN, hinf_k: 1.5 };
+        let r = CheckReport { alpha_cl: 0.3, alpha_k: None, gamma: f64::INFINITY, peak_freq: f64::NAN, k_hinf: 1.5 };
         let v = to_json(&r);
-        assert_eq!(v["closed_loop_hinf"], json!("inf"));
+        assert_eq!(v["gamma"], json!("inf"));
+        assert_eq!(v["k_hinf"], json!(1.5));
         assert_eq!(v["closed_loop_peak_freq"], Value::Null);
         assert_eq!(v["controller_spectral_abscissa"], Value::Null);
         assert_eq!(v["closed_loop_stable"], json!(false));
         assert_eq!(v["controller_stable"], json!(true));
         assert!(!serde_json::to_string(&v).unwrap().contains("Infinity"));
-        let r =
-            CheckReport { alpha_cl: -0.3, alpha_k: Some(-1.0), hinf_cl: 2.0, peak_freq: f64::INFINITY, hinf_k: 1.5 };
+        let r = CheckReport { alpha_cl: -0.3, alpha_k: Some(-1.0), gamma: 2.0, peak_freq: f64::INFINITY, k_hinf: 1.5 };
         assert_eq!(to_json(&r)["closed_loop_peak_freq"], json!("inf"));
     }
 }

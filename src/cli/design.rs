@@ -39,8 +39,8 @@ pub struct DesignArgs {
     /// Seed of the random starting points.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// CPU-second budget of the whole design (thread CPU time; a run it ends is not
-    /// reproducible bit for bit).
+    /// Budget of the whole design in CPU seconds (thread CPU time, not wall-clock time; a run
+    /// it ends is not reproducible bit for bit).
     #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub cpumax: f64,
     /// Evaluation budget of the whole design (deterministic: same seed, same controller).
@@ -110,8 +110,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
     if hinfix::lti::mat_file::is_mat_path(&a.out) {
-        let k = Controller::from_json_value(&outcome.controller).context("the designed controller")?;
-        k.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+        outcome.controller.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
     } else {
         let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
         write_atomic(&a.out, text.as_bytes()).with_context(|| format!("writing {}", a.out.display()))?;

@@ -39,7 +39,7 @@ impl Summary {
         Summary { name: plant.name.clone(), plant, alpha }
     }
     fn stable(&self) -> bool {
-        self.alpha < 0.0
+        lti::is_stable(self.alpha)
     }
     fn json(&self) -> Value {
         let d = self.plant.dims;

@@ -23,8 +23,8 @@ pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string, serde_opt
 pub use objective::{Components, DesignObjective, ObjectivePhase};
 pub use options::{DesignOptions, ObjectiveKind, DEFAULT_HOP_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND};
 pub use outcome::{
-    DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats,
-    SearchStop, SearchSummary,
+    DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError, NoDesignObserver, Phase,
+    PhaseStats, SearchStop, SearchSummary,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};

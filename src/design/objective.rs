@@ -60,9 +60,9 @@ pub struct Components {
     /// The objective value.
     pub f: f64,
     /// ‖Tzw‖∞.
-    pub hinf_cl: f64,
+    pub gamma: f64,
     /// ‖K‖∞.
-    pub hinf_k: f64,
+    pub k_hinf: f64,
     /// α(Acl).
     pub alpha_cl: f64,
     /// α(Ak) (NaN for order 0).
@@ -71,7 +71,7 @@ pub struct Components {
 
 impl Components {
     const UNKNOWN: Components =
-        Components { f: f64::NAN, hinf_cl: f64::NAN, hinf_k: f64::NAN, alpha_cl: f64::NAN, alpha_k: f64::NAN };
+        Components { f: f64::NAN, gamma: f64::NAN, k_hinf: f64::NAN, alpha_cl: f64::NAN, alpha_k: f64::NAN };
 }
 
 /// Components at the most recently evaluated points (exact bitwise match on x).
@@ -179,7 +179,7 @@ impl<'p> DesignObjective<'p> {
         let mut k_term = (f64::NEG_INFINITY, None);
         if self.strong {
             let (norm, g) = controller_hinf_grad(k, self.hinf_tol);
-            c.hinf_k = norm.value;
+            c.k_hinf = norm.value;
             if !norm.value.is_finite() {
                 c.f = f64::INFINITY;
                 return (c, None);
@@ -195,7 +195,7 @@ impl<'p> DesignObjective<'p> {
             }
             Err(_) => (f64::INFINITY, None),
         };
-        c.hinf_cl = gamma;
+        c.gamma = gamma;
         if !gamma.is_finite() {
             c.f = f64::INFINITY;
             return (c, None);
@@ -388,8 +388,8 @@ impl Observer for ObserverAdapter<'_, '_> {
             start: rec.start,
             iter: rec.iter,
             f: rec.f,
-            hinf_cl: c.hinf_cl,
-            hinf_k: c.hinf_k,
+            gamma: c.gamma,
+            k_hinf: c.k_hinf,
             alpha_cl: c.alpha_cl,
             alpha_k: c.alpha_k,
             dnorm: rec.dnorm,

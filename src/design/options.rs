@@ -40,8 +40,9 @@ pub struct DesignOptions {
     pub eps: f64,
     /// Seed of the run's random number generator.
     pub seed: u64,
-    /// CPU-second budget of the whole run (both phases and gradient sampling). Thread CPU time:
-    /// a run stopped by it is not reproducible bit for bit (it depends on the machine's speed).
+    /// Budget of the whole run in **CPU seconds** (both phases and gradient sampling): thread CPU
+    /// time, not wall-clock time. A run stopped by it is not reproducible bit for bit (it depends
+    /// on the machine's speed).
     #[serde(with = "serde_f64_or_string")]
     pub cpumax: f64,
     /// Evaluation budget of the whole run (objective evaluations, both phases and gradient
@@ -106,12 +107,39 @@ impl Default for DesignOptions {
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
             objective: ObjectiveKind::Strong,
-            hinf_tol: 1e-10,
+            hinf_tol: crate::lti::DEFAULT_HINF_TOL,
             maxit: 1000,
             normtol: 1e-3,
             evaldist: 1e-3,
             gradient_sampling: true,
             gradsamp_maxit: 300,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DesignOptions;
+
+    /// campaigns/FORMAT.md lists the defaults in prose; they must be the code's defaults.
+    #[test]
+    fn format_md_states_the_defaults() {
+        let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/campaigns/FORMAT.md")).unwrap();
+        let doc = doc.split_whitespace().collect::<Vec<_>>().join(" ");
+        let d = DesignOptions::default();
+        for want in [
+            format!("ε {:e},", d.eps),
+            format!("seed {},", d.seed),
+            format!("cpumax {} CPU seconds,", d.cpumax),
+            format!("nrand {},", d.nrand),
+            format!("stall_starts {},", d.stall_starts),
+            format!("stall_rtol {:e},", d.stall_rtol),
+            format!("maxit {},", d.maxit),
+            format!("normtol {:e},", d.normtol),
+            format!("evaldist {:e},", d.evaldist),
+            format!("hinf_tol {:e},", d.hinf_tol),
+        ] {
+            assert!(doc.contains(&want), "campaigns/FORMAT.md's list of defaults should say `{want}`");
         }
     }
 }

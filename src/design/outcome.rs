@@ -127,8 +127,9 @@ pub struct SearchSummary {
 pub struct DesignOutcome {
     /// How the run ended.
     pub status: DesignStatus,
-    /// The returned controller as JSON `{AK, BK, CK, DK}` (see [`crate::lti::Controller`]).
-    pub controller: serde_json::Value,
+    /// The returned controller (serialised as the JSON `{AK, BK, CK, DK}` of
+    /// [`crate::lti::Controller::to_json`], as in a controller file).
+    pub controller: crate::lti::Controller,
     /// ‖Tzw‖∞ of the returned controller (+∞ if the loop is unstable or ill-posed).
     #[serde(with = "serde_f64_or_string")]
     pub gamma: f64,
@@ -180,9 +181,9 @@ pub struct DesignIterRecord {
     /// Objective value.
     pub f: f64,
     /// ‖Tzw‖∞ at the iterate (+∞ if unstable; NaN if not computed in this phase).
-    pub hinf_cl: f64,
+    pub gamma: f64,
     /// ‖K‖∞ at the iterate (NaN if not computed).
-    pub hinf_k: f64,
+    pub k_hinf: f64,
     /// α(A_cl).
     pub alpha_cl: f64,
     /// α(Ak) (NaN for order 0).
@@ -234,8 +235,29 @@ pub enum DesignError {
     },
     /// The initial controller does not fit.
     #[error("initial controller: {0}")]
-    Init(String),
-    /// A numerical failure that left no trustworthy point.
+    Init(InitError),
+    /// A numerical failure of the optimiser that left no trustworthy point.
     #[error("numerical failure: {0}")]
-    Numerical(String),
+    Numerical(crate::optim::OptimError),
+}
+
+/// Why an initial controller (warm start, `--init`) cannot start a design run. Part of the
+/// message of [`DesignError::Init`], so not also its `source`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum InitError {
+    /// Its Dk does not match the plant's m2 × p2 ([`crate::lti::Controller::check_fits`]).
+    #[error("{0}")]
+    Shape(crate::lti::ControllerErrorKind),
+    /// Its order is above the target order.
+    #[error("its order {order} exceeds the target order {target} (warm starts only grow the order)")]
+    OrderTooHigh {
+        /// The initial controller's order.
+        order: usize,
+        /// The order being designed.
+        target: usize,
+    },
+    /// An entry of Ak, Bk, Ck or Dk is NaN or infinite.
+    #[error("has a non-finite entry")]
+    NonFinite,
 }

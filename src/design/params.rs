@@ -18,16 +18,16 @@ use crate::lti::Controller;
 pub struct ControllerShape {
     /// Order nk.
     pub nk: usize,
-    /// Controls m (rows of Dk).
+    /// The plant's controls m (rows of Dk; the controller's [`Controller::outputs`]).
     pub m: usize,
-    /// Measurements p (columns of Dk).
+    /// The plant's measurements p (columns of Dk; the controller's [`Controller::inputs`]).
     pub p: usize,
 }
 
 impl ControllerShape {
     /// The shape of an existing controller.
     pub fn of(k: &Controller) -> Self {
-        ControllerShape { nk: k.order(), m: k.m(), p: k.p() }
+        ControllerShape { nk: k.order(), m: k.outputs(), p: k.inputs() }
     }
 
     /// Number of variables (nk + m)(nk + p).

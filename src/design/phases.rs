@@ -23,6 +23,6 @@ pub(crate) fn optim_error(e: OptimError) -> DesignError {
         OptimError::Options { field, value, range } => {
             DesignError::Options { field, problem: format!("{value} is out of range (must be {range})") }
         }
-        other => DesignError::Numerical(other.to_string()),
+        other => DesignError::Numerical(other),
     }
 }

@@ -7,12 +7,14 @@ use std::rc::Rc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL};
+use crate::lti::{
+    closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, MIN_HINF_TOL,
+};
 use crate::optim::RunControl;
 
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
-use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase, SearchStop};
+use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop};
 use super::params::{controller_to_x, ControllerShape};
 use super::search::Search;
 use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
@@ -120,16 +122,12 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
         }
     }
     if let Some(k) = init {
-        k.check_fits(plant).map_err(|e| DesignError::Init(e.to_string()))?;
+        k.check_fits(plant).map_err(|e| DesignError::Init(InitError::Shape(e)))?;
         if k.order() > opts.order {
-            return Err(DesignError::Init(format!(
-                "its order {} exceeds the target order {} (warm starts only grow the order)",
-                k.order(),
-                opts.order
-            )));
+            return Err(DesignError::Init(InitError::OrderTooHigh { order: k.order(), target: opts.order }));
         }
         if !k.is_finite() {
-            return Err(DesignError::Init("has a non-finite entry".into()));
+            return Err(DesignError::Init(InitError::NonFinite));
         }
     }
     Ok(())
@@ -169,7 +167,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
     let (alpha_cl, gamma) = match closed_loop(plant, k) {
         Ok(cl) => {
             let a = spectral_abscissa(cl.a.as_ref());
-            let g = if a < 0.0 { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
+            let g = if is_stable(a) { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
             (a, g)
         }
         Err(_) => (f64::INFINITY, f64::INFINITY),
@@ -242,7 +240,7 @@ fn run_validated(
     let evals = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {
         status,
-        controller: k.to_json(),
+        controller: k,
         gamma: fig.gamma,
         k_hinf: fig.k_hinf,
         alpha_cl: fig.alpha_cl,

@@ -44,6 +44,7 @@
 
 use rand::RngCore;
 
+use crate::lti::is_stable;
 use crate::optim::{bfgs, gradient_sampling, OptimError, OptimResult, RunControl, Termination};
 
 use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
@@ -204,7 +205,7 @@ impl Search<'_, '_, '_> {
             Err(e) => return Err(optim_error(e)),
         };
         let stab_better = st.offer_stab(xs.clone(), fs, k);
-        if !(fs < 0.0) {
+        if !is_stable(fs) {
             // Not stabilised: progress only counts while no stable point is known.
             return Ok((None, !st.stabilised && stab_better));
         }
@@ -262,7 +263,7 @@ impl Search<'_, '_, '_> {
                 if let Some(stop) = stop_of(r.termination) {
                     return Ok((Some(stop), better));
                 }
-                if r.f < 0.0 {
+                if is_stable(r.f) {
                     st.stabilised = true;
                     return self.optimise_from(st, &r.x, k, ctl);
                 }

@@ -92,7 +92,7 @@ pub fn pad_controller(k: &Controller, nk: usize, diag: f64) -> Option<Controller
     if nk < n0 {
         return None;
     }
-    let (m, p) = (k.m(), k.p());
+    let (m, p) = (k.outputs(), k.inputs());
     let ak = Mat::from_fn(nk, nk, |i, j| {
         if i < n0 && j < n0 {
             k.ak[(i, j)]

@@ -26,6 +26,21 @@ pub struct Controller {
     pub dk: Mat<f64>,
 }
 
+/// As [`Controller::to_json`]: the `{AK, BK, CK, DK}` object of a controller file.
+impl serde::Serialize for Controller {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        serde::Serialize::serialize(&self.to_json(), s)
+    }
+}
+
+/// As [`Controller::from_json_value`] (shapes checked; the error says which matrix is wrong).
+impl<'de> serde::Deserialize<'de> for Controller {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let doc = <Value as serde::Deserialize>::deserialize(d)?;
+        Controller::from_json_value(&doc).map_err(serde::de::Error::custom)
+    }
+}
+
 /// A controller file that could not be read.
 #[derive(Debug, thiserror::Error)]
 #[error("controller file {}: {kind}", file.display())]
@@ -78,7 +93,9 @@ pub enum ControllerErrorKind {
 }
 
 impl Controller {
-    /// The zero controller of order `nk` for `m` inputs and `p` measurements.
+    /// The zero controller of order `nk` for a plant with `m` control inputs u and `p`
+    /// measurements y: Dk is m × p, so the controller has [`Self::outputs`] = m and
+    /// [`Self::inputs`] = p.
     pub fn zeros(nk: usize, m: usize, p: usize) -> Self {
         Controller { ak: Mat::zeros(nk, nk), bk: Mat::zeros(nk, p), ck: Mat::zeros(m, nk), dk: Mat::zeros(m, p) }
     }
@@ -93,14 +110,18 @@ impl Controller {
         [&self.ak, &self.bk, &self.ck, &self.dk].iter().all(|m| crate::numeric::all_finite(m.as_ref()))
     }
 
-    /// Number of control inputs m (rows of Dk).
-    pub fn m(&self) -> usize {
-        self.dk.nrows()
+    /// Number of the controller's inputs: the plant's measurements y, p of them (columns of Dk).
+    ///
+    /// Named from the controller's own point of view, like [`super::StateSpace::inputs`]: the
+    /// controller's inputs are the plant's outputs y and vice versa (u = K y).
+    pub fn inputs(&self) -> usize {
+        self.dk.ncols()
     }
 
-    /// Number of measurements p (columns of Dk).
-    pub fn p(&self) -> usize {
-        self.dk.ncols()
+    /// Number of the controller's outputs: the plant's control inputs u, m of them (rows of Dk).
+    /// See [`Self::inputs`].
+    pub fn outputs(&self) -> usize {
+        self.dk.nrows()
     }
 
     /// Reads a controller file: JSON, or a MATLAB `.mat` file with `AK BK CK DK`.
@@ -181,15 +202,16 @@ impl Controller {
         })
     }
 
-    /// Checks that the controller's m and p match the plant's m2 and p2.
+    /// Checks that the controller fits the plant: its outputs are the plant's m2 control inputs
+    /// and its inputs the plant's p2 measurements (Dk is m2 × p2).
     pub fn check_fits(&self, plant: &super::Plant) -> Result<(), ControllerErrorKind> {
-        if self.m() != plant.dims.m2 || self.p() != plant.dims.p2 {
+        if self.outputs() != plant.dims.m2 || self.inputs() != plant.dims.p2 {
             return Err(ControllerErrorKind::Mismatch {
                 plant: plant.name.clone(),
                 problem: format!(
                     "DK is {}×{}, the plant needs m2×p2 = {}×{}",
-                    self.m(),
-                    self.p(),
+                    self.outputs(),
+                    self.inputs(),
                     plant.dims.m2,
                     plant.dims.p2
                 ),
@@ -200,7 +222,7 @@ impl Controller {
 
     /// Number of free variables (nk+m)(nk+p) in x = [vec Ak; vec Bk; vec Ck; vec Dk].
     pub fn nvar(&self) -> usize {
-        (self.order() + self.m()) * (self.order() + self.p())
+        (self.order() + self.outputs()) * (self.order() + self.inputs())
     }
 }
 
@@ -212,7 +234,7 @@ mod tests {
     fn order_zero_round_trip() {
         let text = r#"{"AK": [], "BK": [], "CK": [[], []], "DK": [[1.0, 2.0], [3.0, 4.0]]}"#;
         let k = Controller::from_json_str(text, "k.json").unwrap();
-        assert_eq!((k.order(), k.m(), k.p()), (0, 2, 2));
+        assert_eq!((k.order(), k.outputs(), k.inputs()), (0, 2, 2));
         let back = Controller::from_json_value(&k.to_json()).unwrap();
         assert_eq!(back, k);
     }

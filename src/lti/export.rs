@@ -55,7 +55,7 @@ fn python_matrix(m: MatRef<'_, f64>) -> String {
 /// The code that builds `k` as a state-space object in `target`, with the sign convention in
 /// comments. `source` names where the controller came from (printed in the first comment).
 pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String {
-    let (nk, m, p) = (k.order(), k.m(), k.p());
+    let (nk, m, p) = (k.order(), k.outputs(), k.inputs());
     let mats = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
     let mut s = String::new();
     match target {

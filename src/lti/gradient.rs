@@ -46,11 +46,11 @@ pub fn closed_loop_abscissa_grad(plant: &Plant, k: &Controller) -> Result<(f64, 
 pub fn controller_abscissa_grad(k: &Controller) -> (f64, ControllerGradient) {
     let nk = k.order();
     if nk == 0 {
-        return (f64::NEG_INFINITY, Controller::zeros(0, k.m(), k.p()));
+        return (f64::NEG_INFINITY, Controller::zeros(0, k.outputs(), k.inputs()));
     }
     match rightmost_eigen(k.ak.as_ref()) {
         Some(e) => {
-            let mut g = Controller::zeros(nk, k.m(), k.p());
+            let mut g = Controller::zeros(nk, k.outputs(), k.inputs());
             g.ak = Mat::from_fn(nk, nk, |i, j| (e.u[i].conj() * e.v_scaled[j]).re);
             (e.alpha, g)
         }

@@ -26,7 +26,7 @@ pub use controller::{Controller, ControllerError, ControllerErrorKind};
 pub use error::LtiError;
 pub use full_order::{
     full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions, Regularisation,
-    FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_EPS,
+    FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
@@ -41,5 +41,5 @@ pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
-pub use spectral::{spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
+pub use spectral::{is_stable, spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;

@@ -30,7 +30,7 @@
 //!
 //! Before iterating, `H` is balanced by a *symplectic* diagonal similarity `T = diag(D, D⁻¹)`
 //! (powers of two, so exact): `A → D⁻¹AD`, `G → D⁻¹GD⁻¹`, `Q → DQD`, reducing ‖H‖_F. This matters
-//! for the ε-regularised H∞ problems of [`super::full_order`], whose `G` holds entries ~ 1/ε²:
+//! for the δ-regularised H∞ problems of [`super::full_order`], whose `G` holds entries ~ 1/δ²:
 //! unbalanced, eigenvalues close to the imaginary axis lose accuracy like √(u‖H‖). The balanced
 //! solution is `X̃ = D X D`.
 //!
@@ -193,7 +193,7 @@ pub fn solve_care(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) ->
     }
     let acl = a - &gs * &x;
     let closed_loop_abscissa = abscissa(acl.as_ref());
-    if !(closed_loop_abscissa < 0.0) {
+    if !super::spectral::is_stable(closed_loop_abscissa) {
         return Err(RiccatiError::NotStabilising { abscissa: closed_loop_abscissa });
     }
     Ok(CareSolution { x, iterations, residual, closed_loop_abscissa })
@@ -372,7 +372,7 @@ mod tests {
         }
     }
 
-    /// Badly scaled G (entries ~ 1/ε²) as produced by the D21 regularisation: balancing keeps the
+    /// Badly scaled G (entries ~ 1/δ²) as produced by the D21 regularisation: balancing keeps the
     /// residual small.
     #[test]
     fn badly_scaled_care() {
@@ -381,8 +381,8 @@ mod tests {
         let a = random(&mut rng, n, n);
         let c = random(&mut rng, 2, n);
         let b = random(&mut rng, n, 3);
-        let eps: f64 = 1e-6;
-        let g = c.transpose() * &c * faer::Scale(1.0 / (eps * eps));
+        let delta: f64 = 1e-6;
+        let g = c.transpose() * &c * faer::Scale(1.0 / (delta * delta));
         let q = &b * b.transpose();
         let sol = solve_care(a.transpose(), g.as_ref(), q.as_ref()).expect("solvable");
         assert!(sol.residual < 1e-10, "residual {}", sol.residual);

@@ -42,6 +42,19 @@ pub fn spectral_abscissa(a: MatRef<'_, f64>) -> f64 {
     }
 }
 
+/// Whether a system with spectral abscissa `spectral_abscissa` (= α(A), from
+/// [`spectral_abscissa`]) is (asymptotically) stable: α < 0, **strictly**.
+///
+/// The one stability test of the crate. Strict, because α = 0 puts a pole on the imaginary axis:
+/// the system is then not asymptotically stable and its H∞ norm is infinite (or undefined), so a
+/// controller at α = 0 is no stabilising controller. A NaN abscissa (a failed computation) is
+/// not stable. No margin is added: the computed α of a marginal system is what the γ and the
+/// tables report, and the H∞ computation checks its own poles (docs/ALGORITHMS.md §3.1, §5).
+/// −∞ (an empty matrix, e.g. Ak of an order-0 controller) counts as stable.
+pub fn is_stable(spectral_abscissa: f64) -> bool {
+    spectral_abscissa < 0.0
+}
+
 /// Eigenvalues of a real square matrix; `None` on non-finite input or failure.
 pub(crate) fn eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
     let n = a.nrows();

@@ -3,7 +3,7 @@
 //! BFGS keeps the gradients of consecutive iterates as long as each step is ≤ `evaldist`
 //! (a longer step resets the bundle to the new point), at most `ngrad` of them, newest first.
 //! d = the smallest vector in their convex hull (the simplex QP of [`qp`](super::qp)) approximates
-//! the minimum-norm element of the Clarke ε-subdifferential with ε ≈ evaldist, so
+//! the minimum-norm element of the Clarke r-subdifferential with r ≈ evaldist, so
 //!
 //! * dnorm = ‖d‖ small **and** evaldist = maxⱼ ‖x − Xⱼ‖ small ⇒ x is close to a Clarke stationary
 //!   point ("the smaller dnorm and evaldist, the more likely x is an approximate stationary point").

@@ -43,6 +43,7 @@ pub fn thread_cpu_time() -> f64 {
 #[derive(Debug, Clone)]
 pub struct RunControl {
     start_cpu: f64,
+    /// Budget in CPU seconds (thread CPU time, not wall-clock time).
     cpumax: f64,
     cancel: Option<Arc<AtomicBool>>,
     evals: Arc<AtomicUsize>,
@@ -50,7 +51,8 @@ pub struct RunControl {
 }
 
 impl RunControl {
-    /// Start the clock now; `cpumax` in CPU seconds, `f64::INFINITY` for no limit
+    /// Start the clock now; `cpumax` in CPU seconds (thread CPU time, not wall-clock time),
+    /// `f64::INFINITY` for no limit
     /// (NaN or negative values are treated as 0, i.e. already exhausted).
     pub fn new(cpumax: f64) -> Self {
         let cpumax = if cpumax.is_nan() { 0.0 } else { cpumax.max(0.0) };
@@ -108,7 +110,7 @@ impl RunControl {
         thread_cpu_time() - self.start_cpu
     }
 
-    /// The budget given to `new()`.
+    /// The budget given to `new()`, in CPU seconds (thread CPU time).
     pub fn cpumax(&self) -> f64 {
         self.cpumax
     }

@@ -2,14 +2,15 @@
 //! "Gradient sampling methods for nonsmooth optimization" (in Numerical Nonsmooth Optimization,
 //! Springer), the variant of HANSO 3.0 (docs/ALGORITHMS.md §7.4).
 //!
-//! At iteration k, with sampling radius ε and stationarity target ν:
+//! At iteration k, with sampling radius ρ and stationarity target ν (the literature's ε, renamed
+//! so that ε keeps one meaning in the project, docs/ARCHITECTURE.md §5):
 //!
-//! 1. sample m points uniformly in the Euclidean ball B(x, ε) (direction u/‖u‖ with u ~ N(0, I),
-//!    radius ε·U^{1/n}, U ~ U[0, 1]); G = [∇f(x), ∇f(x₁), …, ∇f(x_m)];
+//! 1. sample m points uniformly in the Euclidean ball B(x, ρ) (direction u/‖u‖ with u ~ N(0, I),
+//!    radius ρ·U^{1/n}, U ~ U[0, 1]); G = [∇f(x), ∇f(x₁), …, ∇f(x_m)];
 //! 2. d = the min-norm element of conv G (the simplex QP, [`qp`](super::qp)), an approximation of
-//!    the min-norm element of the Clarke ε-subdifferential;
-//! 3. if ‖d‖ ≤ ν_opt and ε ≤ ε_opt: stop (`GradSampConverged`);
-//! 4. if ‖d‖ ≤ ν: ν ← θ_ν ν, ε ← θ_ε ε, no step;
+//!    the min-norm element of the Clarke ρ-subdifferential;
+//! 3. if ‖d‖ ≤ ν_opt and ρ ≤ ρ_opt: stop (`GradSampConverged`);
+//! 4. if ‖d‖ ≤ ν: ν ← θ_ν ν, ρ ← θ_ρ ρ, no step;
 //! 5. else backtrack from t = 1 along −d (unnormalised) until
 //!    f(x − t d) < f(x) − β t ‖d‖², t ← γ t; give up (`LineSearchFailed`) when
 //!    t < 10⁻¹⁶·max(‖x‖, 1)/‖d‖; stop (`NotDescent`) if ∇f(x)ᵀd ≤ 0.
@@ -51,8 +52,8 @@ pub struct GradSampState {
     pub f: f64,
     /// ∇f(x).
     pub g: Vec<f64>,
-    /// Current sampling radius ε.
-    pub eps: f64,
+    /// Current sampling radius ρ.
+    pub sampling_radius: f64,
     /// Current stationarity target ν.
     pub nu: f64,
     /// ‖d‖ of the last sampled bundle.
@@ -80,12 +81,12 @@ pub(crate) struct GradSamp<'a> {
 }
 
 impl GradSamp<'_> {
-    /// A point uniformly distributed in the ball B(x, eps).
-    fn sample_ball(&mut self, x: &[f64], eps: f64) -> Vec<f64> {
+    /// A point uniformly distributed in the ball B(x, radius).
+    fn sample_ball(&mut self, x: &[f64], radius: f64) -> Vec<f64> {
         let n = x.len();
         let mut u: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut *self.rng)).collect();
         let un = dot(&u, &u).sqrt();
-        let r = eps * self.rng.random::<f64>().powf(1.0 / n as f64);
+        let r = radius * self.rng.random::<f64>().powf(1.0 / n as f64);
         let c = if un > 0.0 { r / un } else { 0.0 };
         for (ui, xi) in u.iter_mut().zip(x) {
             *ui = xi + c * *ui;
@@ -113,7 +114,7 @@ impl Solver for GradSamp<'_> {
             x: x0.to_vec(),
             f,
             g: g.clone(),
-            eps: self.opts.samprad0,
+            sampling_radius: self.opts.samprad0,
             nu: self.opts.target0,
             dnorm,
             xs: vec![x0.to_vec()],
@@ -128,7 +129,7 @@ impl Solver for GradSamp<'_> {
         let mut gs = vec![s.g.clone()];
         let mut gj = vec![0.0; n];
         for _ in 0..m {
-            let mut xj = self.sample_ball(&s.x, s.eps);
+            let mut xj = self.sample_ball(&s.x, s.sampling_radius);
             let mut ok = false;
             for _ in 0..=GS_MAX_CONTRACT {
                 let fj = ev.eval_checked(&xj, &mut gj)?;
@@ -152,12 +153,12 @@ impl Solver for GradSamp<'_> {
         s.gs = gs;
         let d = qp.d;
         let dn = qp.dnorm;
-        if dn <= self.opts.target_opt && s.eps <= self.opts.samprad_opt {
+        if dn <= self.opts.target_opt && s.sampling_radius <= self.opts.samprad_opt {
             return Err(Termination::GradSampConverged);
         }
         if dn <= s.nu {
             s.nu *= self.opts.target_factor;
-            s.eps *= self.opts.samprad_factor;
+            s.sampling_radius *= self.opts.samprad_factor;
             return Ok(0.0);
         }
         if !(dot(&s.g, &d) > 0.0) {

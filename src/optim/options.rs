@@ -112,15 +112,15 @@ impl BfgsOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GradSampOptions {
-    /// Initial sampling radius ε₀ (absolute, Euclidean ball). Default 0.1 (HANSO 3.0 `samprad0`).
+    /// Initial sampling radius ρ₀ (absolute, Euclidean ball). Default 0.1 (HANSO 3.0 `samprad0`).
     pub samprad0: f64,
     /// Initial stationarity target ν₀. Default 0.1 (HANSO 3.0 `target0`).
     pub target0: f64,
-    /// Final sampling radius ε_opt. Default 1e-6.
+    /// Final sampling radius ρ_opt. Default 1e-6.
     pub samprad_opt: f64,
     /// Final stationarity target ν_opt. Default 1e-6.
     pub target_opt: f64,
-    /// Factor θ_ε applied to ε when ‖d‖ ≤ ν. Default 0.1.
+    /// Factor θ_ρ applied to ρ when ‖d‖ ≤ ν. Default 0.1.
     pub samprad_factor: f64,
     /// Factor θ_ν applied to ν when ‖d‖ ≤ ν. Default 0.1.
     pub target_factor: f64,

@@ -33,7 +33,7 @@ pub enum Termination {
     Unbounded,
     /// The observer returned `Break`, or the cancel flag of the `RunControl` was set.
     Interrupted,
-    /// Gradient sampling met its final targets: ‖d‖ ≤ ν_opt with sampling radius ε ≤ ε_opt.
+    /// Gradient sampling met its final targets: ‖d‖ ≤ ν_opt with sampling radius ρ ≤ ρ_opt.
     GradSampConverged,
 }
 

@@ -1,7 +1,7 @@
 //! The γ-iteration: feasibility ([`Problem::test`]) is monotone in γ, so γ_opt is found by
 //! bracketing (factors of 10 from 2× the D11 bound, or from 1) and geometric bisection down to
 //! the relative width [`GAMMA_RTOL`]; the reported `gamma` is the feasible end. With a known
-//! feasible level (the previous ε of the regularisation), the bracket is searched downwards from
+//! feasible level (the previous δ of the regularisation), the bracket is searched downwards from
 //! it in growing relative steps instead.
 
 use super::gamma_test::Problem;
@@ -23,7 +23,7 @@ pub(crate) struct Bracket {
 }
 
 /// Bracket and bisect γ_opt of `prob` to relative width `rtol`, counting γ-tests in `tests`.
-/// `warm`: a γ known feasible (previous ε), searched downwards from.
+/// `warm`: a γ known feasible (previous δ), searched downwards from.
 pub(crate) fn gamma_opt(
     prob: &Problem,
     rtol: f64,

@@ -36,7 +36,7 @@ pub(crate) const PSD_RTOL: f64 = 1e-8;
 pub(crate) const PSD_ATOL: f64 = 1e-12;
 
 /// The plant's exogenous channels (B1, C1, D11, D12, D21): the plant's own ([`Channels::of`]) or
-/// ε-augmented (`regularisation::augment`). A, B2 and C2 are always the plant's; D22 plays no
+/// δ-augmented (`regularisation::augment`). A, B2 and C2 are always the plant's; D22 plays no
 /// part in γ_opt.
 pub(crate) struct Channels {
     pub(crate) b1: Mat<f64>,

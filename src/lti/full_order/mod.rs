@@ -5,8 +5,8 @@
 //!   coupling ρ(XY) < γ² (the theory and references are there);
 //! * `bracketing.rs`: the γ-iteration — feasibility is monotone in γ, so γ_opt is bracketed and
 //!   bisected to [`GAMMA_RTOL`];
-//! * `regularisation.rs`: plants with a rank-deficient D12 or D21 — ε-weighted channels are added
-//!   and ε is decreased through [`REGULARISATION_EPS`] while γ(ε) can be trusted;
+//! * `regularisation.rs`: plants with a rank-deficient D12 or D21 — δ-weighted channels are added
+//!   and δ is decreased through [`REGULARISATION_DELTAS`] while γ(δ) can be trusted;
 //! * `linalg.rs`: the small dense linear algebra the others share (numerical rank, the D11 bound,
 //!   symmetric eigen-decomposition, LU solve, block concatenation).
 //!
@@ -25,7 +25,7 @@ mod linalg;
 mod regularisation;
 
 pub use bracketing::{GAMMA_MAX, GAMMA_RTOL};
-pub use regularisation::{Regularisation, FLAT_RTOL, REGULARISATION_EPS};
+pub use regularisation::{Regularisation, FLAT_RTOL, REGULARISATION_DELTAS};
 
 use bracketing::gamma_opt;
 use gamma_test::{Channels, Problem};
@@ -64,31 +64,31 @@ impl Binding {
 /// The full-order optimal H∞ level and how it was obtained.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct FullOrderGamma {
-    /// γ_opt (feasible end of the final bracket; at the reported ε for singular plants).
+    /// γ_opt (feasible end of the final bracket; at the reported δ for singular plants).
     pub gamma: f64,
     /// Infeasible end of the final bracket (γ_opt ∈ (gamma_lower, gamma]).
     pub gamma_lower: f64,
-    /// The regularisation ε at which `gamma` was evaluated; `None` for a regular plant.
+    /// The regularisation δ at which `gamma` was evaluated; `None` for a regular plant.
     pub regularisation: Option<f64>,
     /// Numerical rank of D12 (m2 = full column rank).
     pub d12_rank: usize,
     /// Numerical rank of D21 (p2 = full row rank).
     pub d21_rank: usize,
-    /// D12 was regularised (z augmented with ε x, ε u).
+    /// D12 was regularised (z augmented with δ x, δ u).
     pub d12_regularised: bool,
-    /// D21 was regularised (w augmented with ε state noise, ε sensor noise).
+    /// D21 was regularised (w augmented with δ state noise, δ sensor noise).
     pub d21_regularised: bool,
-    /// γ(ε) for every ε evaluated, in order (empty for a regular plant).
-    pub eps_history: Vec<(f64, f64)>,
-    /// Whether γ(ε) was flat to [`FLAT_RTOL`] at the reported ε (true for a regular plant).
-    pub eps_converged: bool,
+    /// γ(δ) for every δ evaluated, in order (empty for a regular plant).
+    pub regularisation_history: Vec<(f64, f64)>,
+    /// Whether γ(δ) was flat to [`FLAT_RTOL`] at the reported δ (true for a regular plant).
+    pub regularisation_converged: bool,
     /// The condition that fails just below γ_opt.
     pub binding: Binding,
     /// The D11 lower bound (condition (i)).
     pub feedthrough_bound: f64,
     /// Number of γ-tests (pairs of Riccati solves) performed in total.
     pub gamma_tests: usize,
-    /// Remarks (e.g. why ε was not decreased further).
+    /// Remarks (e.g. why δ was not decreased further).
     pub notes: Vec<String>,
 }
 
@@ -110,21 +110,21 @@ impl fmt::Display for FullOrderGamma {
             self.gamma_tests,
             self.binding.text()
         )?;
-        if let Some(eps) = self.regularisation {
+        if let Some(delta) = self.regularisation {
             let mut what = Vec::new();
             if self.d21_regularised {
-                what.push(format!("D21 rank {} (w augmented with eps*I state and sensor noise)", self.d21_rank));
+                what.push(format!("D21 rank {} (w augmented with delta*I state and sensor noise)", self.d21_rank));
             }
             if self.d12_regularised {
-                what.push(format!("D12 rank {} (z augmented with eps*x, eps*u)", self.d12_rank));
+                what.push(format!("D12 rank {} (z augmented with delta*x, delta*u)", self.d12_rank));
             }
-            write!(f, "\n  singular plant: {}; regularised, reported at eps = {eps:.0e}", what.join("; "))?;
-            let hist: Vec<String> = self.eps_history.iter().map(|(e, g)| format!("{e:.0e}: {g:.7}")).collect();
+            write!(f, "\n  singular plant: {}; regularised, reported at delta = {delta:.0e}", what.join("; "))?;
+            let hist: Vec<String> = self.regularisation_history.iter().map(|(e, g)| format!("{e:.0e}: {g:.7}")).collect();
             write!(
                 f,
-                "\n  gamma(eps): {}{}",
+                "\n  gamma(delta): {}{}",
                 hist.join(", "),
-                if self.eps_converged { " (flat)" } else { " (not flat: an upper bound of the eps -> 0 limit)" }
+                if self.regularisation_converged { " (flat)" } else { " (not flat: an upper bound of the delta -> 0 limit)" }
             )?;
         }
         for n in &self.notes {
@@ -212,8 +212,8 @@ pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<F
             d21_rank,
             d12_regularised: false,
             d21_regularised: false,
-            eps_history: Vec::new(),
-            eps_converged: true,
+            regularisation_history: Vec::new(),
+            regularisation_converged: true,
             binding: b.binding,
             feedthrough_bound: prob.gamma_d,
             gamma_tests: tests,
@@ -225,13 +225,13 @@ pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<F
     Ok(FullOrderGamma {
         gamma: r.bracket.hi,
         gamma_lower: r.bracket.lo,
-        regularisation: Some(r.eps),
+        regularisation: Some(r.delta),
         d12_rank,
         d21_rank,
         d12_regularised: d12_reg,
         d21_regularised: d21_reg,
-        eps_history: r.history,
-        eps_converged: r.converged,
+        regularisation_history: r.history,
+        regularisation_converged: r.converged,
         binding: r.bracket.binding,
         feedthrough_bound: r.feedthrough_bound,
         gamma_tests: tests,

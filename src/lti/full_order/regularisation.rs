@@ -3,21 +3,21 @@
 //! Several benchmark plants have D12 without full column rank or D21 without full row rank (HE1,
 //! REA2, HF1, AC10, BDT2: D21 = 0; CM4: D21 is 2×1). As is usual in the field (e.g. the
 //! regularisation used with `hinfsyn`, and the perturbation argument of Stoorvogel 1992 showing
-//! γ_opt(ε) ↓ γ_opt as ε ↓ 0), the singular side is augmented with ε-weighted channels:
+//! γ_opt(δ) ↓ γ_opt as δ ↓ 0), the singular side is augmented with δ-weighted channels:
 //!
 //! * D21 rank-deficient: new disturbances w_x (state noise) and v (sensor noise),
-//!   `B1 → [B1, εI_n, 0]`, `D21 → [D21, 0, εI_p2]`, `D11 → [D11, 0, 0]`;
-//! * D12 rank-deficient: new outputs ε x and ε u,
-//!   `C1 → [C1; εI_n; 0]`, `D12 → [D12; 0; εI_m2]`, `D11 → [D11; 0; 0]`.
+//!   `B1 → [B1, δI_n, 0]`, `D21 → [D21, 0, δI_p2]`, `D11 → [D11, 0, 0]`;
+//! * D12 rank-deficient: new outputs δ x and δ u,
+//!   `C1 → [C1; δI_n; 0]`, `D12 → [D12; 0; δI_m2]`, `D11 → [D11; 0; 0]`.
 //!
 //! The state channels also restore the imaginary-axis rank conditions (BDT2 has integrators not
-//! reached by B1). Augmenting w and z can only increase ‖T_zw‖ for every controller, so γ(ε) is an
-//! upper bound of the singular infimum and decreases to it as ε → 0. ε is absolute (in the plant's
-//! units). It is decreased through [`REGULARISATION_EPS`] (10⁻⁵ … 10⁻⁸) until γ(ε) is flat to
-//! [`FLAT_RTOL`], or until the numerics stop being trustworthy (γ(ε) would increase as ε
-//! decreases, which is impossible in exact arithmetic: the Hamiltonians carry 1/ε² terms), and
-//! the value at the smallest trusted ε is reported, with the whole sequence, in
-//! [`super::FullOrderGamma::eps_history`]. Very slowly converging plants (BDT2) are reported as such.
+//! reached by B1). Augmenting w and z can only increase ‖T_zw‖ for every controller, so γ(δ) is an
+//! upper bound of the singular infimum and decreases to it as δ → 0. δ is absolute (in the plant's
+//! units). It is decreased through [`REGULARISATION_DELTAS`] (10⁻⁵ … 10⁻⁸) until γ(δ) is flat to
+//! [`FLAT_RTOL`], or until the numerics stop being trustworthy (γ(δ) would increase as δ
+//! decreases, which is impossible in exact arithmetic: the Hamiltonians carry 1/δ² terms), and
+//! the value at the smallest trusted δ is reported, with the whole sequence, in
+//! [`super::FullOrderGamma::regularisation_history`]. Very slowly converging plants (BDT2) are reported as such.
 
 use faer::Mat;
 
@@ -27,35 +27,35 @@ use super::{FullOrderError, FullOrderOptions};
 use crate::lti::plant::Plant;
 
 /// Regularisation levels tried in order (absolute), for plants with singular D12 or D21.
-pub const REGULARISATION_EPS: [f64; 4] = [1e-5, 1e-6, 1e-7, 1e-8];
-/// Stop decreasing ε once γ changes relatively by less than this.
+pub const REGULARISATION_DELTAS: [f64; 4] = [1e-5, 1e-6, 1e-7, 1e-8];
+/// Stop decreasing δ once γ changes relatively by less than this.
 pub const FLAT_RTOL: f64 = 1e-6;
 
 /// How singular problems are regularised.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Regularisation {
-    /// Decrease ε through [`REGULARISATION_EPS`] until flat or no longer trustworthy (default).
+    /// Decrease δ through [`REGULARISATION_DELTAS`] until flat or no longer trustworthy (default).
     Auto,
-    /// One fixed ε (used if D12 or D21 is rank-deficient).
+    /// One fixed δ (used if D12 or D21 is rank-deficient).
     Fixed(f64),
 }
 
-/// What the ε sequence gave: the bracket at the smallest trusted ε, and how it got there.
+/// What the δ sequence gave: the bracket at the smallest trusted δ, and how it got there.
 pub(crate) struct Regularised {
-    /// The smallest trusted ε.
-    pub(crate) eps: f64,
-    /// The γ bracket at `eps`.
+    /// The smallest trusted δ.
+    pub(crate) delta: f64,
+    /// The γ bracket at `delta`.
     pub(crate) bracket: Bracket,
-    /// The D11 bound (condition (i)) of the augmented plant at `eps`.
+    /// The D11 bound (condition (i)) of the augmented plant at `delta`.
     pub(crate) feedthrough_bound: f64,
-    /// γ(ε) for every ε evaluated, in order.
+    /// γ(δ) for every δ evaluated, in order.
     pub(crate) history: Vec<(f64, f64)>,
-    /// γ(ε) was flat to [`FLAT_RTOL`] at `eps` (never for a fixed ε).
+    /// γ(δ) was flat to [`FLAT_RTOL`] at `delta` (never for a fixed δ).
     pub(crate) converged: bool,
 }
 
-/// γ_opt of a plant whose D12 (`reg12`) and/or D21 (`reg21`) is rank-deficient, at decreasing ε
-/// as the module docs describe; counts γ-tests in `tests` and says in `notes` why ε stopped.
+/// γ_opt of a plant whose D12 (`reg12`) and/or D21 (`reg21`) is rank-deficient, at decreasing δ
+/// as the module docs describe; counts γ-tests in `tests` and says in `notes` why δ stopped.
 pub(crate) fn decrease_eps(
     plant: &Plant,
     opts: &FullOrderOptions,
@@ -64,23 +64,23 @@ pub(crate) fn decrease_eps(
     tests: &mut usize,
     notes: &mut Vec<String>,
 ) -> Result<Regularised, FullOrderError> {
-    let eps_list: Vec<f64> = match opts.regularisation {
-        Regularisation::Auto => REGULARISATION_EPS.to_vec(),
+    let delta_list: Vec<f64> = match opts.regularisation {
+        Regularisation::Auto => REGULARISATION_DELTAS.to_vec(),
         Regularisation::Fixed(e) => vec![e],
     };
     let mut history: Vec<(f64, f64)> = Vec::new();
-    let mut best: Option<(f64, Bracket, f64)> = None; // (eps, bracket, gamma_d)
+    let mut best: Option<(f64, Bracket, f64)> = None; // (delta, bracket, gamma_d)
     let mut converged = false;
-    for &eps in &eps_list {
-        let prob = Problem::new(plant, augment(plant, eps, reg12, reg21))?;
+    for &delta in &delta_list {
+        let prob = Problem::new(plant, augment(plant, delta, reg12, reg21))?;
         let warm = best.as_ref().map(|(_, b, _)| b.hi);
         if let Some(prev) = warm {
-            // γ(ε) is non-increasing as ε decreases: the previous γ must still be feasible.
+            // γ(δ) is non-increasing as δ decreases: the previous γ must still be feasible.
             *tests += 1;
             if let Err(why) = prob.test(prev) {
                 notes.push(format!(
-                    "eps = {eps:.0e} not used: the previous gamma {prev:.7} tested infeasible there ({}), \
-                     i.e. the 1/eps^2-scaled Riccati equations are no longer numerically reliable",
+                    "delta = {delta:.0e} not used: the previous gamma {prev:.7} tested infeasible there ({}), \
+                     i.e. the 1/delta^2-scaled Riccati equations are no longer numerically reliable",
                     why.1
                 ));
                 break;
@@ -89,14 +89,14 @@ pub(crate) fn decrease_eps(
         let b = match gamma_opt(&prob, opts.rtol, warm, tests) {
             Ok(b) => b,
             Err(e) if best.is_some() => {
-                notes.push(format!("eps = {eps:.0e} not used: {e}"));
+                notes.push(format!("delta = {delta:.0e} not used: {e}"));
                 break;
             }
             Err(e) => return Err(e),
         };
-        history.push((eps, b.hi));
+        history.push((delta, b.hi));
         let prev = best.as_ref().map(|(_, pb, _)| pb.hi);
-        best = Some((eps, b, prob.gamma_d));
+        best = Some((delta, b, prob.gamma_d));
         if let Some(p) = prev {
             if (p - history.last().expect("pushed").1).abs() <= FLAT_RTOL * p {
                 converged = true;
@@ -104,16 +104,16 @@ pub(crate) fn decrease_eps(
             }
         }
     }
-    let (eps, bracket, feedthrough_bound) = best.expect("the first eps either succeeds or returns an error");
+    let (delta, bracket, feedthrough_bound) = best.expect("the first delta either succeeds or returns an error");
     if matches!(opts.regularisation, Regularisation::Fixed(_)) {
         converged = false;
-        notes.push("fixed eps requested: no eps -> 0 convergence check".into());
+        notes.push("fixed delta requested: no delta -> 0 convergence check".into());
     }
-    Ok(Regularised { eps, bracket, feedthrough_bound, history, converged })
+    Ok(Regularised { delta, bracket, feedthrough_bound, history, converged })
 }
 
-/// The plant's channels with the ε-weighted ones of the module docs added on the singular side(s).
-pub(crate) fn augment(plant: &Plant, eps: f64, reg12: bool, reg21: bool) -> Channels {
+/// The plant's channels with the δ-weighted ones of the module docs added on the singular side(s).
+pub(crate) fn augment(plant: &Plant, delta: f64, reg12: bool, reg21: bool) -> Channels {
     let (n, m2, p2) = (plant.dims.n, plant.dims.m2, plant.dims.p2);
     let (mut b1, mut c1) = (plant.b1.clone(), plant.c1.clone());
     let (mut d11, mut d12, mut d21) = (plant.d11.clone(), plant.d12.clone(), plant.d21.clone());
@@ -123,7 +123,7 @@ pub(crate) fn augment(plant: &Plant, eps: f64, reg12: bool, reg21: bool) -> Chan
             if i < p1 {
                 c1[(i, j)]
             } else if i - p1 == j {
-                eps
+                delta
             } else {
                 0.0
             }
@@ -132,7 +132,7 @@ pub(crate) fn augment(plant: &Plant, eps: f64, reg12: bool, reg21: bool) -> Chan
             if i < p1 {
                 d12[(i, j)]
             } else if i >= p1 + n && i - p1 - n == j {
-                eps
+                delta
             } else {
                 0.0
             }
@@ -145,7 +145,7 @@ pub(crate) fn augment(plant: &Plant, eps: f64, reg12: bool, reg21: bool) -> Chan
             if j < m1 {
                 b1[(i, j)]
             } else if j - m1 == i {
-                eps
+                delta
             } else {
                 0.0
             }
@@ -154,7 +154,7 @@ pub(crate) fn augment(plant: &Plant, eps: f64, reg12: bool, reg21: bool) -> Chan
             if j < m1 {
                 d21[(i, j)]
             } else if j >= m1 + n && j - m1 - n == i {
-                eps
+                delta
             } else {
                 0.0
             }
