@@ -74,7 +74,7 @@ fn trace_messages_of_2980e60_summarise() {
             "iter" => {
                 assert!(v.get("gamma").is_none() && v.get("hinf_cl").is_some(), "fixture has the old keys");
                 let h = f64_from_json(&v["hinf_cl"]);
-                if h.is_finite() && !(h >= best_old) {
+                if h.is_finite() && (best_old.is_nan() || h < best_old) {
                     best_old = h;
                 }
                 messages.push((ITER_TOPIC, json.as_bytes()));
