@@ -7,10 +7,13 @@ use std::rc::Rc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL};
+use crate::lti::{
+    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles, spectral_abscissa,
+    Controller, Plant, MIN_HINF_TOL,
+};
 use crate::optim::RunControl;
 
-use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
+use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase, SearchStop};
 use super::params::{controller_to_x, ControllerShape};
@@ -38,7 +41,10 @@ pub fn run(
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
     validate(plant, opts, init)?;
-    let ctl = RunControl::new(opts.cpumax);
+    let mut ctl = RunControl::new(opts.cpumax);
+    if let Some(flag) = obs.cancel_flag() {
+        ctl = ctl.with_cancel(flag);
+    }
     run_validated(plant, opts, init, &ctl, obs)
 }
 
@@ -166,12 +172,21 @@ struct Figures {
 }
 
 fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
+    // One eigenvalue computation of Acl serves α(Acl) and the norm (on large plants these figures
+    // are what a run spends after its budget: the evaluation in flight is abandoned, these not).
     let (alpha_cl, gamma) = match closed_loop(plant, k) {
-        Ok(cl) => {
-            let a = spectral_abscissa(cl.a.as_ref());
-            let g = if a < 0.0 { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
-            (a, g)
-        }
+        Ok(cl) => match eigenvalues_of(cl.a.as_ref()) {
+            Some(poles) => {
+                let a = abscissa_of(&poles);
+                let g = if a < 0.0 && cl.is_finite() {
+                    hinf_norm_with_poles(&cl, &poles, opts.hinf_tol).value
+                } else {
+                    f64::INFINITY
+                };
+                (a, g)
+            }
+            None => (f64::INFINITY, f64::INFINITY),
+        },
         Err(_) => (f64::INFINITY, f64::INFINITY),
     };
     let k_hinf = controller_hinf_grad(k, opts.hinf_tol).0.value;
@@ -201,7 +216,7 @@ fn run_validated(
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let first = starting_points(plant, opts, init, shape, &mut rng);
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
-    let mut stab_obj = DesignObjective::new(
+    let stab_obj = DesignObjective::new(
         plant,
         shape,
         ObjectivePhase::Stabilisation,
@@ -210,8 +225,14 @@ fn run_validated(
         opts.hinf_tol,
         Rc::clone(&cache),
     );
+    // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
+    // sub-budget of the search is checked between evaluations.
+    let stop_ctl = ctl.clone();
+    let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
+    let mut stab_obj = stab_obj.with_interrupt(Some(Rc::clone(&stop)));
     let mut perf_obj =
-        DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
+        DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache)
+            .with_interrupt(Some(stop));
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
     let res =
         Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
