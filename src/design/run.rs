@@ -8,12 +8,14 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles, spectral_abscissa,
-    Controller, Plant, MIN_HINF_TOL,
+    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_interruptible,
+    spectral_abscissa, Controller, Interrupt, Plant, MIN_HINF_TOL,
 };
 use crate::optim::RunControl;
 
-use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook};
+use super::objective::{
+    ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
+};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase, SearchStop};
 use super::params::{controller_to_x, ControllerShape};
@@ -171,15 +173,18 @@ struct Figures {
     objective: f64,
 }
 
-fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
-    // One eigenvalue computation of Acl serves α(Acl) and the norm (on large plants these figures
-    // are what a run spends after its budget: the evaluation in flight is abandoned, these not).
+/// The figures of `k`. One eigenvalue computation of Acl serves α(Acl) and the norm: on large
+/// plants these figures are what a run spends after its budget (the evaluation in flight is
+/// abandoned, these are not). `stop` fires only for a cancelled run (Ctrl-C) of a large plant:
+/// then α(Acl) and γ may be left NaN ("not computed") rather than keep the user waiting.
+fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<'_>) -> Figures {
     let (alpha_cl, gamma) = match closed_loop(plant, k) {
+        Ok(_) if stop.poll().is_err() => (f64::NAN, f64::NAN),
         Ok(cl) => match eigenvalues_of(cl.a.as_ref()) {
             Some(poles) => {
                 let a = abscissa_of(&poles);
                 let g = if a < 0.0 && cl.is_finite() {
-                    hinf_norm_with_poles(&cl, &poles, opts.hinf_tol).value
+                    hinf_norm_with_poles_interruptible(&cl, &poles, opts.hinf_tol, stop).map_or(f64::NAN, |h| h.value)
                 } else {
                     f64::INFINITY
                 };
@@ -198,9 +203,10 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
     Figures { gamma, k_hinf, alpha_cl, alpha_k, objective }
 }
 
-/// Whether ε‖K‖∞ ≥ ‖Tzw‖∞, i.e. the controller-norm term sets max(‖Tzw‖∞, ε‖K‖∞).
+/// Whether ε‖K‖∞ ≥ ‖Tzw‖∞, i.e. the controller-norm term sets max(‖Tzw‖∞, ε‖K‖∞) (false for an
+/// unstable controller, ‖K‖∞ = ∞: then the controller is simply not strongly stabilising).
 pub(crate) fn controller_norm_active(opts: &DesignOptions, gamma: f64, k_hinf: f64) -> bool {
-    opts.objective == ObjectiveKind::Strong && gamma.is_finite() && opts.eps * k_hinf >= gamma
+    opts.objective == ObjectiveKind::Strong && gamma.is_finite() && k_hinf.is_finite() && opts.eps * k_hinf >= gamma
 }
 
 fn run_validated(
@@ -258,7 +264,9 @@ fn run_validated(
     };
 
     let k = shape.controller(&final_x);
-    let fig = figures(plant, opts, &k);
+    let cancelled = || ctl.cancelled();
+    let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
+    let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
     let iters = res.phases.iter().map(|p| p.iters).sum();
     let evals = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {

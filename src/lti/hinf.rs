@@ -142,16 +142,8 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
     best
 }
 
-/// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
-/// test). The data must be finite.
-pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) -> HinfNorm {
-    match hinf_norm_with_poles_interruptible(sys, poles, tol, Interrupt::NEVER) {
-        Ok(h) => h,
-        Err(Interrupted) => unreachable!("Interrupt::NEVER never fires"),
-    }
-}
-
-/// [`hinf_norm_with_poles`] polling `stop` ([`hinf_norm_interruptible`]).
+/// [`hinf_norm_interruptible`] when the poles (eigenvalues of A) are already known (shared with
+/// the stability test). The data must be finite.
 pub(crate) fn hinf_norm_with_poles_interruptible(
     sys: &StateSpace,
     poles: &[c64],

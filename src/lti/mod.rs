@@ -33,7 +33,7 @@ pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, controller_abscissa_grad,
     controller_hinf_grad, ControllerGradient,
 };
-pub(crate) use hinf::hinf_norm_with_poles;
+pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
     hinf_lower_bound, hinf_norm, hinf_norm_interruptible, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
     MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
