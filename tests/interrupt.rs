@@ -203,6 +203,7 @@ fn cancelled_design_reports_recomputed_figures_or_none() {
             assert_eq!(out.gamma.to_bits(), gamma.to_bits(), "n = {n}: γ {} vs recomputed {gamma}", out.gamma);
         } else {
             assert!(out.gamma.is_nan(), "n = {n}: γ {} should be left uncomputed", out.gamma);
+            assert!(out.objective.is_nan(), "n = {n}: objective {} without γ", out.objective);
         }
     }
 }

@@ -197,6 +197,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
     let k_hinf = controller_hinf_grad(k, opts.hinf_tol).0.value;
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let objective = match opts.objective {
+        _ if gamma.is_nan() => f64::NAN, // not computed (f64::max would drop it)
         ObjectiveKind::Strong => gamma.max(opts.eps * k_hinf),
         ObjectiveKind::Plain => gamma,
     };
