@@ -527,7 +527,7 @@ pub fn execute<E>(
 /// The observer a job actually runs with: the user's (trace), progress events, cancellation.
 struct WorkerObserver<'a> {
     user: Option<Box<dyn JobObserver>>,
-    cancel: &'a AtomicBool,
+    cancel: &'a Arc<AtomicBool>,
     tx: &'a mpsc::Sender<WorkerMsg>,
     index: usize,
     worker: usize,
@@ -557,6 +557,10 @@ impl DesignObserver for WorkerObserver<'_> {
         }
         user
     }
+
+    fn cancel_flag(&self) -> Option<Arc<AtomicBool>> {
+        Some(Arc::clone(self.cancel))
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -569,7 +573,7 @@ fn run_one(
     init: Option<Controller>,
     runner: &dyn JobRunner,
     observers: &ObserverFactory<'_>,
-    cancel: &AtomicBool,
+    cancel: &Arc<AtomicBool>,
     interval: Duration,
     tx: mpsc::Sender<WorkerMsg>,
 ) {

@@ -31,35 +31,35 @@ pub struct DesignArgs {
     #[arg(long)]
     pub plant: String,
     /// Controller order nk ≥ 0.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub order: usize,
     /// Weight ε of ‖K‖∞ and α(Ak) (strong stabilisation), > 0.
     #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
     pub eps: f64,
     /// Seed of the random starting points.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
     /// Budget of the whole design in CPU seconds (thread CPU time, not wall-clock time; a run
     /// it ends is not reproducible bit for bit).
     #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub cpumax: f64,
     /// Evaluation budget of the whole design (deterministic: same seed, same controller).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub maxevals: Option<u64>,
     /// Number of first random starts (HIFOO's nrand), or of perturbations of --init, 1..=10000.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub nrand: usize,
     /// After the first starts, keep starting local searches (basin hops of the best point and
     /// random starts) until this many in a row have not improved the best objective by
     /// --stall-rtol, or a budget ends the run. While no stabilising controller is found, only a
     /// budget ends it. 0: HIFOO's search (the first starts only).
-    #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS)]
+    #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS, allow_negative_numbers = true)]
     pub stall_starts: usize,
     /// Relative improvement that resets the stall count.
     #[arg(long, value_name = "R", default_value_t = 1e-6, allow_negative_numbers = true)]
     pub stall_rtol: f64,
     /// Largest number of local searches (first starts included; deterministic).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub max_starts: Option<u64>,
     /// Relative sizes of the basin-hopping perturbations of the best point, comma-separated
     /// (one hop per size, then one random start, in turn). "none": random starts only.
@@ -191,6 +191,9 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
         fmt_num(o.k_hinf, 6),
         fmt_num(o.objective, 6)
     );
+    if o.status == DesignStatus::Interrupted && o.gamma.is_nan() {
+        s += "note:     ‖Tzw‖∞ not recomputed: interrupted (`campaign check` computes it from the controller file)\n";
+    }
     if o.controller_norm_active {
         s += &format!(
             "note:     ε‖K‖∞ = {} ≥ ‖Tzw‖∞: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets γ go lower)\n",

@@ -85,15 +85,38 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", hinfix::campaign::sanitise::for_terminal(&format!("{e:#}")));
+            eprintln!("error: {}", hinfix::campaign::sanitise::for_terminal(&error_text(&e)));
             ExitCode::FAILURE
         }
     }
 }
 
+/// An error and its causes, each cause left out when the text before it already contains it
+/// (many errors print their source in their own message: `{e:#}` alone repeated it).
+fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if !text.contains(&c) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&c);
+        }
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::fmt_num;
+
+    #[test]
+    fn error_causes_are_not_repeated() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file");
+        let e = anyhow::Error::new(io).context("x.mcap: No such file").context("reading the trace");
+        assert_eq!(super::error_text(&e), "reading the trace: x.mcap: No such file");
+    }
 
     #[test]
     fn numbers_stay_short() {

@@ -18,6 +18,14 @@
 //! For order 0 the controller term is dropped from f_s (a static gain has no dynamics) but kept
 //! in f_h as ε·σmax(Dk) (docs/ALGORITHMS.md §3.2).
 //!
+//! Interruption: an objective given a stop hook ([`DesignObjective::with_interrupt`]: the run's
+//! "CPU budget spent or cancelled") polls it inside the closed-loop H∞ norm (`lti::Interrupt`) when
+//! the closed loop has at least [`MIN_ORDER_FOR_INTERRUPT`] states. An interrupted evaluation
+//! returns f = NaN with a NaN gradient and caches nothing: the solvers treat it as a failed trial,
+//! and since the hook's conditions only ever become true, their next budget check ends the run
+//! with its honest reason (CPU budget or interrupted). No value of a half-finished norm is ever
+//! returned.
+//!
 //! Cost: ε·‖K‖∞ (an nk-state system) is evaluated before ‖Tzw‖∞ (n + nk states), so an unstable
 //! controller costs almost nothing. Each evaluation stores its components (‖Tzw‖∞, ‖K‖∞, α's) in
 //! a small cache keyed by x, from which [`ObserverAdapter`] reports them per iteration.
@@ -28,8 +36,9 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    hinf_lower_bound, spectral_abscissa, Controller, ControllerGradient, Plant,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_interruptible, controller_abscissa_grad,
+    controller_hinf_grad, hinf_lower_bound, spectral_abscissa, Controller, ControllerGradient, Interrupt, LtiError,
+    Plant,
 };
 use crate::optim::{IterRecord, Objective, Observer, SolverKind};
 
@@ -44,6 +53,15 @@ pub const COMPONENT_CACHE_LEN: usize = 32;
 /// evaluation (HE1, n + nK = 5: 0.11–0.18 ms/eval with screening against 0.08–0.12 without, issue
 /// 13), on large ones it saves the eigenvalue and Hamiltonian work of rejected trials.
 pub const MIN_ORDER_FOR_REJECTION: usize = 30;
+
+/// Closed-loop order (n + nK) from which an objective with a stop hook polls it inside an
+/// evaluation. Below it an evaluation takes milliseconds, so the solvers' checks between
+/// evaluations already honour the budget, and not polling keeps small plants' evaluations
+/// exactly as fast as without a hook.
+pub const MIN_ORDER_FOR_INTERRUPT: usize = 50;
+
+/// A stop test for [`DesignObjective::with_interrupt`].
+pub type StopHook = Rc<dyn Fn() -> bool>;
 
 /// Which of the two objectives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,6 +132,10 @@ pub struct DesignObjective<'p> {
     /// Peak frequency of ‖Tzw‖∞ at the last finite performance evaluation (NaN: none yet), where
     /// σmax(Tzw(iω)) gives a line search's trial point a cheap lower bound of f.
     peak_hint: Cell<f64>,
+    /// Polled inside long evaluations (module docs).
+    stop: Option<StopHook>,
+    /// Whether the last evaluation was abandoned because `stop` fired.
+    abandoned: Cell<bool>,
 }
 
 impl<'p> DesignObjective<'p> {
@@ -128,7 +150,38 @@ impl<'p> DesignObjective<'p> {
         hinf_tol: f64,
         cache: Rc<RefCell<ComponentCache>>,
     ) -> Self {
-        DesignObjective { plant, shape, phase, strong, eps, hinf_tol, cache, peak_hint: Cell::new(f64::NAN) }
+        DesignObjective {
+            plant,
+            shape,
+            phase,
+            strong,
+            eps,
+            hinf_tol,
+            cache,
+            peak_hint: Cell::new(f64::NAN),
+            stop: None,
+            abandoned: Cell::new(false),
+        }
+    }
+
+    /// Polls `stop` inside evaluations of closed loops of at least [`MIN_ORDER_FOR_INTERRUPT`]
+    /// states; once it returns true, evaluations are abandoned with f = NaN (module docs). The
+    /// hook must stay true once it has fired (a spent budget, a cancel flag).
+    pub fn with_interrupt(mut self, stop: Option<StopHook>) -> Self {
+        self.stop = stop;
+        self
+    }
+
+    /// A copy of this objective sharing its cache and stop hook (not its peak hint).
+    fn sibling(&self) -> Self {
+        let o = self;
+        DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache())
+            .with_interrupt(o.stop.clone())
+    }
+
+    /// True if the stop hook applies to this plant and has fired.
+    fn stop_fired(&self) -> bool {
+        self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_INTERRUPT && self.stop.as_ref().is_some_and(|s| s())
     }
 
     /// The cache this objective writes to.
@@ -186,12 +239,21 @@ impl<'p> DesignObjective<'p> {
             }
             k_term = (self.eps * norm.value, Some(g));
         }
-        let (gamma, g_cl) = match closed_loop_hinf_grad(self.plant, k, self.hinf_tol) {
+        let hook = self.stop.as_deref().filter(|_| self.plant.dims.n + k.order() >= MIN_ORDER_FOR_INTERRUPT);
+        let stop = hook.map_or(Interrupt::NEVER, Interrupt::new);
+        let (gamma, g_cl) = match closed_loop_hinf_grad_interruptible(self.plant, k, self.hinf_tol, stop) {
             Ok((norm, g)) => {
                 if norm.value.is_finite() {
                     self.peak_hint.set(norm.peak_freq);
                 }
                 (norm.value, Some(g))
+            }
+            Err(LtiError::Interrupted(_)) => {
+                // Abandoned: no value (module docs).
+                self.abandoned.set(true);
+                c.f = f64::NAN;
+                c.hinf_k = f64::NAN;
+                return (c, None);
             }
             Err(_) => (f64::INFINITY, None),
         };
@@ -246,12 +308,15 @@ impl Objective for DesignObjective<'_> {
 
     fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
         let k = self.shape.controller(x);
+        self.abandoned.set(false);
         let (c, grad) = self.components(&k, true);
         match grad {
             Some(gk) if c.f.is_finite() => self.shape.write_x(&gk, g),
             _ => g.iter_mut().for_each(|v| *v = f64::NAN),
         }
-        self.cache.borrow_mut().insert(x, c);
+        if !self.abandoned.get() {
+            self.cache.borrow_mut().insert(x, c);
+        }
         c.f
     }
 
@@ -308,9 +373,7 @@ fn slot(p: ObjectivePhase) -> usize {
 impl<'a, 'p> ObserverAdapter<'a, 'p> {
     /// An adapter for `inner`, reading components from `objective`'s cache.
     pub fn new(inner: &'a mut dyn DesignObserver, objective: &DesignObjective<'p>, phase: Phase) -> Self {
-        let o = objective;
-        let objective_for_misses =
-            DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache());
+        let objective_for_misses = objective.sibling();
         ObserverAdapter {
             inner,
             objective_for_misses,
@@ -324,9 +387,7 @@ impl<'a, 'p> ObserverAdapter<'a, 'p> {
     /// Reports the iterations of `objective` as `phase` from now on (one adapter serves a whole
     /// search, whose local searches alternate between the two objectives).
     pub fn switch(&mut self, objective: &DesignObjective<'p>, phase: Phase) {
-        let o = objective;
-        self.objective_for_misses =
-            DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache());
+        self.objective_for_misses = objective.sibling();
         self.phase = phase;
     }
 
@@ -374,7 +435,7 @@ impl Observer for ObserverAdapter<'_, '_> {
             }
             None => Components::UNKNOWN,
         };
-        if wants && c.alpha_cl.is_nan() && obj.phase == ObjectivePhase::Performance {
+        if wants && c.alpha_cl.is_nan() && obj.phase == ObjectivePhase::Performance && !obj.stop_fired() {
             let k = obj.shape.controller(rec.x);
             c.alpha_cl = closed_loop(obj.plant, &k).map(|cl| spectral_abscissa(cl.a.as_ref())).unwrap_or(f64::INFINITY);
             obj.cache.borrow_mut().update(rec.x, c);

@@ -1,6 +1,8 @@
 //! What a design run returns and what its observers see.
 
 use std::ops::ControlFlow;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -210,6 +212,13 @@ pub trait DesignObserver {
     /// Called once per optimiser iteration.
     fn on_iter(&mut self, _rec: &DesignIterRecord) -> ControlFlow<()> {
         ControlFlow::Continue(())
+    }
+
+    /// A cancel flag that [`run`](super::run) attaches to its `RunControl`, so that setting it
+    /// stops the run inside a long evaluation, not only at the next iteration (`on_iter`
+    /// returning `Break` takes effect only there). Default: none.
+    fn cancel_flag(&self) -> Option<Arc<AtomicBool>> {
+        None
     }
 }
 

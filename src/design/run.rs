@@ -8,11 +8,14 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, MIN_HINF_TOL,
+    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_interruptible, is_stable,
+    Controller, Interrupt, Plant, MIN_HINF_TOL,
 };
 use crate::optim::RunControl;
 
-use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
+use super::objective::{
+    ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
+};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop};
 use super::params::{controller_to_x, ControllerShape};
@@ -40,7 +43,10 @@ pub fn run(
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
     validate(plant, opts, init)?;
-    let ctl = RunControl::new(opts.cpumax);
+    let mut ctl = RunControl::new(opts.cpumax);
+    if let Some(flag) = obs.cancel_flag() {
+        ctl = ctl.with_cancel(flag);
+    }
     run_validated(plant, opts, init, &ctl, obs)
 }
 
@@ -163,27 +169,41 @@ struct Figures {
     objective: f64,
 }
 
-fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller) -> Figures {
+/// The figures of `k`. One eigenvalue computation of Acl serves α(Acl) and the norm: on large
+/// plants these figures are what a run spends after its budget (the evaluation in flight is
+/// abandoned, these are not). `stop` fires only for a cancelled run (Ctrl-C) of a large plant:
+/// then α(Acl) and γ may be left NaN ("not computed") rather than keep the user waiting.
+fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<'_>) -> Figures {
     let (alpha_cl, gamma) = match closed_loop(plant, k) {
-        Ok(cl) => {
-            let a = spectral_abscissa(cl.a.as_ref());
-            let g = if is_stable(a) { hinf_norm(&cl, opts.hinf_tol).value } else { f64::INFINITY };
-            (a, g)
-        }
+        Ok(_) if stop.poll().is_err() => (f64::NAN, f64::NAN),
+        Ok(cl) => match eigenvalues_of(cl.a.as_ref()) {
+            Some(poles) => {
+                let a = abscissa_of(&poles);
+                let g = if is_stable(a) && cl.is_finite() {
+                    hinf_norm_with_poles_interruptible(&cl, &poles, opts.hinf_tol, stop).map_or(f64::NAN, |h| h.value)
+                } else {
+                    f64::INFINITY
+                };
+                (a, g)
+            }
+            None => (f64::INFINITY, f64::INFINITY),
+        },
         Err(_) => (f64::INFINITY, f64::INFINITY),
     };
     let k_hinf = controller_hinf_grad(k, opts.hinf_tol).0.value;
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let objective = match opts.objective {
+        _ if gamma.is_nan() => f64::NAN, // not computed (f64::max would drop it)
         ObjectiveKind::Strong => gamma.max(opts.eps * k_hinf),
         ObjectiveKind::Plain => gamma,
     };
     Figures { gamma, k_hinf, alpha_cl, alpha_k, objective }
 }
 
-/// Whether ε‖K‖∞ ≥ ‖Tzw‖∞, i.e. the controller-norm term sets max(‖Tzw‖∞, ε‖K‖∞).
+/// Whether ε‖K‖∞ ≥ ‖Tzw‖∞, i.e. the controller-norm term sets max(‖Tzw‖∞, ε‖K‖∞) (false for an
+/// unstable controller, ‖K‖∞ = ∞: then the controller is simply not strongly stabilising).
 pub(crate) fn controller_norm_active(opts: &DesignOptions, gamma: f64, k_hinf: f64) -> bool {
-    opts.objective == ObjectiveKind::Strong && gamma.is_finite() && opts.eps * k_hinf >= gamma
+    opts.objective == ObjectiveKind::Strong && gamma.is_finite() && k_hinf.is_finite() && opts.eps * k_hinf >= gamma
 }
 
 fn run_validated(
@@ -199,7 +219,7 @@ fn run_validated(
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let first = starting_points(plant, opts, init, shape, &mut rng);
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
-    let mut stab_obj = DesignObjective::new(
+    let stab_obj = DesignObjective::new(
         plant,
         shape,
         ObjectivePhase::Stabilisation,
@@ -208,8 +228,14 @@ fn run_validated(
         opts.hinf_tol,
         Rc::clone(&cache),
     );
+    // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
+    // sub-budget of the search is checked between evaluations.
+    let stop_ctl = ctl.clone();
+    let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
+    let mut stab_obj = stab_obj.with_interrupt(Some(Rc::clone(&stop)));
     let mut perf_obj =
-        DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache);
+        DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache)
+            .with_interrupt(Some(stop));
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
     let res =
         Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
@@ -235,7 +261,9 @@ fn run_validated(
     };
 
     let k = shape.controller(&final_x);
-    let fig = figures(plant, opts, &k);
+    let cancelled = || ctl.cancelled();
+    let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
+    let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
     let iters = res.phases.iter().map(|p| p.iters).sum();
     let evals = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {

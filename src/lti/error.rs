@@ -19,6 +19,10 @@ pub enum LtiError {
     /// An iterative eigenvalue or singular-value computation did not converge.
     #[error("no convergence in {0}")]
     NoConvergence(&'static str),
+    /// The computation was abandoned because its [`Interrupt`](super::Interrupt) fired (CPU
+    /// budget spent or run cancelled): there is no value.
+    #[error("{0}")]
+    Interrupted(#[from] super::Interrupted),
     /// Matrices whose shapes do not fit together.
     #[error("{what} is {}×{}, expected {}×{}", got.0, got.1, expected.0, expected.1)]
     Shape {

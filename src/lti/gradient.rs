@@ -25,7 +25,8 @@ use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
 
 use super::closed_loop::ClosedLoop;
-use super::hinf::{hinf_norm_with_poles, HinfNorm};
+use super::hinf::{hinf_norm_with_poles_interruptible, HinfNorm};
+use super::interrupt::Interrupt;
 use super::spectral::{eigenvalues, rightmost_eigen};
 use super::{Controller, LtiError, Plant, StateSpace};
 
@@ -64,8 +65,19 @@ pub fn closed_loop_hinf_grad(
     k: &Controller,
     tol: f64,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    closed_loop_hinf_grad_interruptible(plant, k, tol, Interrupt::NEVER)
+}
+
+/// [`closed_loop_hinf_grad`] polling `stop` between its heavy steps (`interrupt.rs`):
+/// `Err(LtiError::Interrupted)` once it fires.
+pub fn closed_loop_hinf_grad_interruptible(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+    stop: Interrupt<'_>,
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol) else {
+    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, stop)? else {
         return Ok((HinfNorm::UNSTABLE, nan_like(k)));
     };
     Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
@@ -74,7 +86,7 @@ pub fn closed_loop_hinf_grad(
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Some((norm, pv)) = hinf_with_vectors(&sys, tol) else {
+    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, Interrupt::NEVER) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -99,18 +111,23 @@ pub(crate) struct PeakVectors {
     pub b: Vec<c64>,
 }
 
-/// Norm and gradient vectors; `None` if unstable (or not finite).
-pub(crate) fn hinf_with_vectors(sys: &StateSpace, tol: f64) -> Option<(HinfNorm, PeakVectors)> {
+/// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `stop` fires.
+pub(crate) fn hinf_with_vectors(
+    sys: &StateSpace,
+    tol: f64,
+    stop: Interrupt<'_>,
+) -> Result<Option<(HinfNorm, PeakVectors)>, LtiError> {
     if !sys.is_finite() {
-        return None;
+        return Ok(None);
     }
-    let poles = eigenvalues(sys.a.as_ref())?;
-    let norm = hinf_norm_with_poles(sys, &poles, tol);
+    stop.poll()?;
+    let Some(poles) = eigenvalues(sys.a.as_ref()) else { return Ok(None) };
+    let norm = hinf_norm_with_poles_interruptible(sys, &poles, tol, stop)?;
     if !norm.value.is_finite() {
-        return None;
+        return Ok(None);
     }
-    let pv = peak_vectors(sys, norm.peak_freq)?;
-    Some((norm, pv))
+    stop.poll()?;
+    Ok(peak_vectors(sys, norm.peak_freq).map(|pv| (norm, pv)))
 }
 
 /// u, v, a, b at frequency w (module docs); `None` if an SVD fails.

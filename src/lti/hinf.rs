@@ -61,6 +61,7 @@
 use faer::{c64, Mat};
 
 use super::freq_response::FreqResponse;
+use super::interrupt::{Interrupt, Interrupted};
 use super::level_set_pencil::pencil_crossings;
 use super::spectral::eigenvalues;
 use super::square_reduced::{hamiltonian_squared_eigenvalues, SquaredSpectrum};
@@ -104,12 +105,23 @@ impl HinfNorm {
 
 /// ‖sys‖∞ to relative tolerance `tol` (use [`DEFAULT_HINF_TOL`]); +∞ if unstable.
 pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
-    if !sys.is_finite() {
-        return HinfNorm::UNSTABLE;
+    match hinf_norm_interruptible(sys, tol, Interrupt::NEVER) {
+        Ok(h) => h,
+        Err(Interrupted) => unreachable!("Interrupt::NEVER never fires"),
     }
+}
+
+/// [`hinf_norm`] polling `stop` between its heavy steps (before the eigenvalues of A, between
+/// frequency evaluations, before each level-set eigenproblem; `interrupt.rs`):
+/// `Err(Interrupted)` as soon as it fires, never a partial value.
+pub fn hinf_norm_interruptible(sys: &StateSpace, tol: f64, stop: Interrupt<'_>) -> Result<HinfNorm, Interrupted> {
+    if !sys.is_finite() {
+        return Ok(HinfNorm::UNSTABLE);
+    }
+    stop.poll()?;
     match eigenvalues(sys.a.as_ref()) {
-        Some(poles) => hinf_norm_with_poles(sys, &poles, tol),
-        None => HinfNorm::UNSTABLE,
+        Some(poles) => hinf_norm_with_poles_interruptible(sys, &poles, tol, stop),
+        None => Ok(HinfNorm::UNSTABLE),
     }
 }
 
@@ -130,17 +142,23 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
     best
 }
 
-/// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
-/// test). The data must be finite.
-pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) -> HinfNorm {
+/// [`hinf_norm_interruptible`] when the poles (eigenvalues of A) are already known (shared with
+/// the stability test). The data must be finite.
+pub(crate) fn hinf_norm_with_poles_interruptible(
+    sys: &StateSpace,
+    poles: &[c64],
+    tol: f64,
+    stop: Interrupt<'_>,
+) -> Result<HinfNorm, Interrupted> {
     let tol = if tol.is_nan() { DEFAULT_HINF_TOL } else { tol.max(MIN_HINF_TOL) };
     if poles.iter().any(|l| !(l.re < 0.0) || !l.im.is_finite()) {
-        return HinfNorm::UNSTABLE;
+        return Ok(HinfNorm::UNSTABLE);
     }
     let sigma_d = super::freq_response::sigma_max_c(complexify(sys.d.as_ref()).as_ref());
     if sys.order() == 0 {
-        return HinfNorm { value: sigma_d, peak_freq: f64::INFINITY };
+        return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
+    stop.poll()?;
     let mut fr = FreqResponse::new(sys);
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
@@ -159,12 +177,14 @@ pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) ->
     modes.truncate(MAX_POLE_TEST_FREQS);
     let mut tested: Vec<f64> = vec![0.0];
     for &(_, w) in &modes {
+        stop.poll()?;
         best.offer(w, fr.sigma_max(w));
         tested.push(w);
     }
+    stop.poll()?;
     refine(&mut fr, &mut best, &tested);
     if !best.gamma.is_finite() {
-        return HinfNorm { value: f64::INFINITY, peak_freq: best.freq };
+        return Ok(HinfNorm { value: f64::INFINITY, peak_freq: best.freq });
     }
 
     let ham = Hamiltonian::new(sys, sigma_d, poles);
@@ -173,6 +193,7 @@ pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) ->
         if gamma <= 0.0 {
             break; // G ≡ 0
         }
+        stop.poll()?;
         let Some(ws) = ham.crossings(gamma) else { break };
         if ws.is_empty() {
             break;
@@ -200,12 +221,13 @@ pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) ->
         let mut all = ws.clone();
         all.extend(&mids);
         all.sort_by(f64::total_cmp);
+        stop.poll()?;
         refine(&mut fr, &mut best, &all);
         if !(best.gamma >= before * (1.0 + 0.1 * tol)) {
             break; // no progress: the crossings were spurious
         }
     }
-    HinfNorm { value: best.gamma, peak_freq: best.freq }
+    Ok(HinfNorm { value: best.gamma, peak_freq: best.freq })
 }
 
 /// Best σmax found so far and its frequency.

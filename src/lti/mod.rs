@@ -11,6 +11,7 @@ pub(crate) mod freq_response;
 mod full_order;
 mod gradient;
 mod hinf;
+mod interrupt;
 mod level_set_pencil;
 pub mod mat_file;
 mod matrix_json;
@@ -29,17 +30,20 @@ pub use full_order::{
     FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
 pub use gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    ControllerGradient,
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, controller_abscissa_grad,
+    controller_hinf_grad, ControllerGradient,
 };
+pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
-    hinf_lower_bound, hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS,
-    MIN_HINF_TOL,
+    hinf_lower_bound, hinf_norm, hinf_norm_interruptible, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
+    MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
+pub use interrupt::{Interrupt, Interrupted};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
+pub(crate) use spectral::abscissa_of;
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
 pub use spectral::{is_stable, spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
 pub use state_space::StateSpace;
