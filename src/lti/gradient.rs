@@ -64,8 +64,19 @@ pub fn closed_loop_hinf_grad(
     k: &Controller,
     tol: f64,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    closed_loop_hinf_grad_near(plant, k, tol, &[])
+}
+
+/// [`closed_loop_hinf_grad`] with the norm warm-started at `hints` (see
+/// [`hinf_norm_near`](super::hinf_norm_near)): the peak frequencies of a nearby controller.
+pub fn closed_loop_hinf_grad_near(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+    hints: &[f64],
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol) else {
+    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, hints) else {
         return Ok((HinfNorm::UNSTABLE, nan_like(k)));
     };
     Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
@@ -74,7 +85,7 @@ pub fn closed_loop_hinf_grad(
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Some((norm, pv)) = hinf_with_vectors(&sys, tol) else {
+    let Some((norm, pv)) = hinf_with_vectors(&sys, tol, &[]) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -100,12 +111,12 @@ pub(crate) struct PeakVectors {
 }
 
 /// Norm and gradient vectors; `None` if unstable (or not finite).
-pub(crate) fn hinf_with_vectors(sys: &StateSpace, tol: f64) -> Option<(HinfNorm, PeakVectors)> {
+pub(crate) fn hinf_with_vectors(sys: &StateSpace, tol: f64, hints: &[f64]) -> Option<(HinfNorm, PeakVectors)> {
     if !sys.is_finite() {
         return None;
     }
     let poles = eigenvalues(sys.a.as_ref())?;
-    let norm = hinf_norm_with_poles(sys, &poles, tol);
+    let norm = hinf_norm_with_poles(sys, &poles, tol, hints);
     if !norm.value.is_finite() {
         return None;
     }

@@ -107,8 +107,19 @@ pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
     if !sys.is_finite() {
         return HinfNorm::UNSTABLE;
     }
+    hinf_norm_near(sys, tol, &[])
+}
+
+/// [`hinf_norm`] warm-started at `hints`, frequencies where the peak is expected (e.g. the peak
+/// of a nearby system, as in an optimisation). With hints, the mode-based test frequencies are
+/// skipped; the result is certified by the same level-set test, so it is as reliable as without
+/// (only the cost differs: a hint away from the peak costs more level-set iterations).
+pub fn hinf_norm_near(sys: &StateSpace, tol: f64, hints: &[f64]) -> HinfNorm {
+    if !sys.is_finite() {
+        return HinfNorm::UNSTABLE;
+    }
     match eigenvalues(sys.a.as_ref()) {
-        Some(poles) => hinf_norm_with_poles(sys, &poles, tol),
+        Some(poles) => hinf_norm_with_poles(sys, &poles, tol, hints),
         None => HinfNorm::UNSTABLE,
     }
 }
@@ -130,9 +141,9 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
     best
 }
 
-/// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
-/// test). The data must be finite.
-pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) -> HinfNorm {
+/// [`hinf_norm_near`] when the poles (eigenvalues of A) are already known (shared with the
+/// stability test). The data must be finite.
+pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64, hints: &[f64]) -> HinfNorm {
     let tol = if tol.is_nan() { DEFAULT_HINF_TOL } else { tol.max(MIN_HINF_TOL) };
     if poles.iter().any(|l| !(l.re < 0.0) || !l.im.is_finite()) {
         return HinfNorm::UNSTABLE;
@@ -145,22 +156,14 @@ pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) ->
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
 
-    // Mode-based test frequencies, least damped first.
-    let mut modes: Vec<(f64, f64)> = poles
-        .iter()
-        .filter(|l| l.im >= 0.0 && l.norm() > 0.0)
-        .map(|l| {
-            let r = l.norm();
-            let zeta = l.re.abs() / r;
-            (zeta, r * (1.0 - 2.0 * zeta * zeta).max(0.25).sqrt())
-        })
-        .collect();
-    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
-    modes.truncate(MAX_POLE_TEST_FREQS);
+    let hints: Vec<f64> = hints.iter().copied().filter(|w| w.is_finite() && *w > 0.0).collect();
     let mut tested: Vec<f64> = vec![0.0];
-    for &(_, w) in &modes {
+    for &w in &hints {
         best.offer(w, fr.sigma_max(w));
         tested.push(w);
+    }
+    if hints.is_empty() {
+        mode_frequencies(poles, &mut fr, &mut best, &mut tested);
     }
     refine(&mut fr, &mut best, &tested);
     if !best.gamma.is_finite() {
@@ -206,6 +209,26 @@ pub(crate) fn hinf_norm_with_poles(sys: &StateSpace, poles: &[c64], tol: f64) ->
         }
     }
     HinfNorm { value: best.gamma, peak_freq: best.freq }
+}
+
+/// Offers σmax at one test frequency per mode, least damped first (at most
+/// [`MAX_POLE_TEST_FREQS`]; module docs, step 2), and records them in `tested`.
+fn mode_frequencies(poles: &[c64], fr: &mut FreqResponse, best: &mut Best, tested: &mut Vec<f64>) {
+    let mut modes: Vec<(f64, f64)> = poles
+        .iter()
+        .filter(|l| l.im >= 0.0 && l.norm() > 0.0)
+        .map(|l| {
+            let r = l.norm();
+            let zeta = l.re.abs() / r;
+            (zeta, r * (1.0 - 2.0 * zeta * zeta).max(0.25).sqrt())
+        })
+        .collect();
+    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    modes.truncate(MAX_POLE_TEST_FREQS);
+    for &(_, w) in &modes {
+        best.offer(w, fr.sigma_max(w));
+        tested.push(w);
+    }
 }
 
 /// Best σmax found so far and its frequency.

@@ -29,12 +29,12 @@ pub use full_order::{
     FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_EPS,
 };
 pub use gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    ControllerGradient,
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_near, controller_abscissa_grad,
+    controller_hinf_grad, ControllerGradient,
 };
 pub use hinf::{
-    hinf_lower_bound, hinf_norm, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS,
-    MIN_HINF_TOL,
+    hinf_lower_bound, hinf_norm, hinf_norm_near, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
+    MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
