@@ -8,7 +8,8 @@
 //! logarithmic sweep (plus points packed around every mode at its damping's scale, ω = 0 and
 //! ω = ∞), and the best local maxima of the sweep are refined by golden-section search.
 //!
-//! Asserted for every system: `hinf_norm` is never below the truth by more than [`REL_TOL`], and
+//! Asserted for every system, for `hinf_norm` and for `hinf_norm_near` warm-started at a
+//! frequency unrelated to the peak: the norm is never below the truth by more than [`REL_TOL`], and
 //! the returned frequency attains the returned value (no over-estimate).
 //!
 //! `cargo test --test hinf_property` runs a fast subset; the full family (4000 systems) is
@@ -16,7 +17,7 @@
 //! and the worst relative error.
 
 use faer::{c64, Mat};
-use hinfix::lti::{hinf_norm, StateSpace, DEFAULT_HINF_TOL};
+use hinfix::lti::{hinf_norm, hinf_norm_near, StateSpace, DEFAULT_HINF_TOL};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -255,28 +256,34 @@ fn check(seeds: std::ops::Range<u64>) -> Tally {
             let doc = serde_json::json!({"A": j(&mb.sys.a), "B": j(&mb.sys.b), "C": j(&mb.sys.c), "D": j(&mb.sys.d)});
             std::fs::write(format!("{dir}/seed{seed}.json"), doc.to_string()).unwrap();
         }
-        let under = (want - got.value) / want;
-        let attained = sigma_modal(&mb, got.peak_freq);
-        let over = (got.value - attained) / got.value;
+        // The warm-started norm (design runs) with a misleading hint: a frequency unrelated to
+        // the peak, so its certification has to find the peak.
+        let hint = 10f64.powf(-2.0 + 4.0 * ((seed * 7919) % 1000) as f64 / 1000.0);
+        let hinted = hinf_norm_near(&mb.sys, DEFAULT_HINF_TOL, &[hint]);
         t.count += 1;
         t.square += mb.square as usize;
         t.non_square += !mb.square as usize;
         t.light += mb.lightly_damped as usize;
         t.peak_at_infinity += want_w.is_infinite() as usize;
-        if under > t.worst_under {
-            t.worst_under = under;
-            t.worst_under_seed = seed;
-        }
-        t.worst_over = t.worst_over.max(over);
-        let allowed = REL_TOL + EVAL_ERROR_FACTOR * eval_error(&mb, want_w).max(eval_error(&mb, got.peak_freq));
-        // NaN-aware: a NaN error counts as a failure.
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        let failed = !(under <= allowed) || !(over <= allowed);
-        if failed {
-            t.failures.push(format!(
-                "seed {seed}: n={} m={} p={} δ={:.2e} light={}: hinf {} at ω={} (attains {attained}), truth {want} at ω={want_w}, under {under:.2e}",
-                mb.sys.order(), mb.sys.inputs(), mb.sys.outputs(), mb.delta, mb.lightly_damped, got.value, got.peak_freq
-            ));
+        for (label, got) in [("", got), (" (hinted)", hinted)] {
+            let under = (want - got.value) / want;
+            let attained = sigma_modal(&mb, got.peak_freq);
+            let over = (got.value - attained) / got.value;
+            if under > t.worst_under {
+                t.worst_under = under;
+                t.worst_under_seed = seed;
+            }
+            t.worst_over = t.worst_over.max(over);
+            let allowed = REL_TOL + EVAL_ERROR_FACTOR * eval_error(&mb, want_w).max(eval_error(&mb, got.peak_freq));
+            // NaN-aware: a NaN error counts as a failure.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            let failed = !(under <= allowed) || !(over <= allowed);
+            if failed {
+                t.failures.push(format!(
+                    "seed {seed}{label}: n={} m={} p={} δ={:.2e} light={}: hinf {} at ω={} (attains {attained}), truth {want} at ω={want_w}, under {under:.2e}",
+                    mb.sys.order(), mb.sys.inputs(), mb.sys.outputs(), mb.delta, mb.lightly_damped, got.value, got.peak_freq
+                ));
+            }
         }
     }
     t

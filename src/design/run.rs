@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
     abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_interruptible, is_stable,
-    Controller, Interrupt, Plant, MIN_HINF_TOL,
+    spectral_abscissa, Controller, Interrupt, Plant, MIN_HINF_TOL,
 };
 use crate::optim::RunControl;
 

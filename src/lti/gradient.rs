@@ -25,7 +25,7 @@ use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
 
 use super::closed_loop::ClosedLoop;
-use super::hinf::{hinf_norm_with_poles_interruptible, HinfNorm};
+use super::hinf::{hinf_norm_with_poles, HinfNorm};
 use super::interrupt::Interrupt;
 use super::spectral::{eigenvalues, rightmost_eigen};
 use super::{Controller, LtiError, Plant, StateSpace};
@@ -65,7 +65,7 @@ pub fn closed_loop_hinf_grad(
     k: &Controller,
     tol: f64,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_interruptible(plant, k, tol, Interrupt::NEVER)
+    closed_loop_hinf_grad_near_interruptible(plant, k, tol, &[], Interrupt::NEVER)
 }
 
 /// [`closed_loop_hinf_grad`] polling `stop` between its heavy steps (`interrupt.rs`):
@@ -76,8 +76,30 @@ pub fn closed_loop_hinf_grad_interruptible(
     tol: f64,
     stop: Interrupt<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    closed_loop_hinf_grad_near_interruptible(plant, k, tol, &[], stop)
+}
+
+/// [`closed_loop_hinf_grad`] with the norm warm-started at `hints` (see
+/// [`hinf_norm_near`](super::hinf_norm_near)): the peak frequencies of a nearby controller.
+pub fn closed_loop_hinf_grad_near(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+    hints: &[f64],
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    closed_loop_hinf_grad_near_interruptible(plant, k, tol, hints, Interrupt::NEVER)
+}
+
+/// [`closed_loop_hinf_grad_near`] and [`closed_loop_hinf_grad_interruptible`] in one.
+pub fn closed_loop_hinf_grad_near_interruptible(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, stop)? else {
+    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, hints, stop)? else {
         return Ok((HinfNorm::UNSTABLE, nan_like(k)));
     };
     Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
@@ -86,7 +108,7 @@ pub fn closed_loop_hinf_grad_interruptible(
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, Interrupt::NEVER) else {
+    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -115,6 +137,7 @@ pub(crate) struct PeakVectors {
 pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
     tol: f64,
+    hints: &[f64],
     stop: Interrupt<'_>,
 ) -> Result<Option<(HinfNorm, PeakVectors)>, LtiError> {
     if !sys.is_finite() {
@@ -122,7 +145,7 @@ pub(crate) fn hinf_with_vectors(
     }
     stop.poll()?;
     let Some(poles) = eigenvalues(sys.a.as_ref()) else { return Ok(None) };
-    let norm = hinf_norm_with_poles_interruptible(sys, &poles, tol, stop)?;
+    let norm = hinf_norm_with_poles(sys, &poles, tol, hints, stop)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }

@@ -111,16 +111,37 @@ pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
     }
 }
 
+/// [`hinf_norm`] warm-started at `hints`, frequencies where the peak is expected (e.g. the peak
+/// of a nearby system, as in an optimisation). With hints, the mode-based test frequencies are
+/// skipped; the result is certified by the same level-set test, so it is as reliable as without
+/// (only the cost differs: a hint away from the peak costs more level-set iterations).
+pub fn hinf_norm_near(sys: &StateSpace, tol: f64, hints: &[f64]) -> HinfNorm {
+    match hinf_norm_near_interruptible(sys, tol, hints, Interrupt::NEVER) {
+        Ok(h) => h,
+        Err(Interrupted) => unreachable!("Interrupt::NEVER never fires"),
+    }
+}
+
 /// [`hinf_norm`] polling `stop` between its heavy steps (before the eigenvalues of A, between
 /// frequency evaluations, before each level-set eigenproblem; `interrupt.rs`):
 /// `Err(Interrupted)` as soon as it fires, never a partial value.
 pub fn hinf_norm_interruptible(sys: &StateSpace, tol: f64, stop: Interrupt<'_>) -> Result<HinfNorm, Interrupted> {
+    hinf_norm_near_interruptible(sys, tol, &[], stop)
+}
+
+/// [`hinf_norm_near`] and [`hinf_norm_interruptible`] in one.
+pub fn hinf_norm_near_interruptible(
+    sys: &StateSpace,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+) -> Result<HinfNorm, Interrupted> {
     if !sys.is_finite() {
         return Ok(HinfNorm::UNSTABLE);
     }
     stop.poll()?;
     match eigenvalues(sys.a.as_ref()) {
-        Some(poles) => hinf_norm_with_poles_interruptible(sys, &poles, tol, stop),
+        Some(poles) => hinf_norm_with_poles(sys, &poles, tol, hints, stop),
         None => Ok(HinfNorm::UNSTABLE),
     }
 }
@@ -150,6 +171,18 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
     tol: f64,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
+    hinf_norm_with_poles(sys, poles, tol, &[], stop)
+}
+
+/// [`hinf_norm_near_interruptible`] when the poles (eigenvalues of A) are already known (shared
+/// with the stability test). The data must be finite.
+pub(crate) fn hinf_norm_with_poles(
+    sys: &StateSpace,
+    poles: &[c64],
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+) -> Result<HinfNorm, Interrupted> {
     let tol = if tol.is_nan() { DEFAULT_HINF_TOL } else { tol.max(MIN_HINF_TOL) };
     if poles.iter().any(|l| !(l.re < 0.0) || !l.im.is_finite()) {
         return Ok(HinfNorm::UNSTABLE);
@@ -163,23 +196,15 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
 
-    // Mode-based test frequencies, least damped first.
-    let mut modes: Vec<(f64, f64)> = poles
-        .iter()
-        .filter(|l| l.im >= 0.0 && l.norm() > 0.0)
-        .map(|l| {
-            let r = l.norm();
-            let zeta = l.re.abs() / r;
-            (zeta, r * (1.0 - 2.0 * zeta * zeta).max(0.25).sqrt())
-        })
-        .collect();
-    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
-    modes.truncate(MAX_POLE_TEST_FREQS);
+    let hints: Vec<f64> = hints.iter().copied().filter(|w| w.is_finite() && *w > 0.0).collect();
     let mut tested: Vec<f64> = vec![0.0];
-    for &(_, w) in &modes {
+    for &w in &hints {
         stop.poll()?;
         best.offer(w, fr.sigma_max(w));
         tested.push(w);
+    }
+    if hints.is_empty() {
+        mode_frequencies(poles, &mut fr, &mut best, &mut tested, stop)?;
     }
     stop.poll()?;
     refine(&mut fr, &mut best, &tested);
@@ -228,6 +253,34 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
         }
     }
     Ok(HinfNorm { value: best.gamma, peak_freq: best.freq })
+}
+
+/// Offers σmax at one test frequency per mode, least damped first (at most
+/// [`MAX_POLE_TEST_FREQS`]; module docs, step 2), and records them in `tested`.
+fn mode_frequencies(
+    poles: &[c64],
+    fr: &mut FreqResponse,
+    best: &mut Best,
+    tested: &mut Vec<f64>,
+    stop: Interrupt<'_>,
+) -> Result<(), Interrupted> {
+    let mut modes: Vec<(f64, f64)> = poles
+        .iter()
+        .filter(|l| l.im >= 0.0 && l.norm() > 0.0)
+        .map(|l| {
+            let r = l.norm();
+            let zeta = l.re.abs() / r;
+            (zeta, r * (1.0 - 2.0 * zeta * zeta).max(0.25).sqrt())
+        })
+        .collect();
+    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    modes.truncate(MAX_POLE_TEST_FREQS);
+    for &(_, w) in &modes {
+        stop.poll()?;
+        best.offer(w, fr.sigma_max(w));
+        tested.push(w);
+    }
+    Ok(())
 }
 
 /// Best σmax found so far and its frequency.

@@ -30,12 +30,14 @@ pub use full_order::{
     FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
 pub use gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, controller_abscissa_grad,
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, closed_loop_hinf_grad_near,
+    closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad,
     controller_hinf_grad, ControllerGradient,
 };
 pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
-    hinf_lower_bound, hinf_norm, hinf_norm_interruptible, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
+    hinf_lower_bound, hinf_norm, hinf_norm_interruptible, hinf_norm_near, hinf_norm_near_interruptible, HinfNorm,
+    DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
     MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use interrupt::{Interrupt, Interrupted};

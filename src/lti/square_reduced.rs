@@ -48,7 +48,6 @@ pub(crate) fn hamiltonian_squared_eigenvalues(
     g: MatRef<'_, f64>,
     k: MatRef<'_, f64>,
 ) -> Option<SquaredSpectrum> {
-    let n = f.nrows();
     // M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], and GFᵀ = (FG)ᵀ, FᵀK = (KF)ᵀ.
     let m11 = f * f + g * k;
     let fg = f * g;
@@ -59,15 +58,23 @@ pub(crate) fn hamiltonian_squared_eigenvalues(
     if !norm.is_finite() {
         return None;
     }
-    let mut blocks = SkewHamiltonian {
-        a: ColMajor::from(m11.as_ref()),
-        g: ColMajor::from(m12.as_ref()),
-        q: ColMajor::from(m21.as_ref()),
-    };
+    let mu = skew_hamiltonian_eigenvalues(m11.as_ref(), m12.as_ref(), m21.as_ref())?;
+    Some(SquaredSpectrum { mu, abs_error: ERROR_FACTOR * f64::EPSILON * norm.max(f64::MIN_POSITIVE) })
+}
+
+/// The n eigenvalues of the real skew-Hamiltonian matrix W = [A G; Q Aᵀ] (G, Q skew-symmetric,
+/// all n×n; W has each of them twice), by the PVL reduction and an n×n Hessenberg QR. Backward
+/// stable for W: errors of order ε‖W‖. `None` if the QR fails.
+pub(crate) fn skew_hamiltonian_eigenvalues(
+    a: MatRef<'_, f64>,
+    g: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+) -> Option<Vec<c64>> {
+    let n = a.nrows();
+    let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
     blocks.pvl_reduce();
     let w = Mat::from_fn(n, n, |i, j| if i <= j + 1 { blocks.a.at(i, j) } else { 0.0 });
-    let mu = eigenvalues(w.as_ref())?;
-    Some(SquaredSpectrum { mu, abs_error: ERROR_FACTOR * f64::EPSILON * norm.max(f64::MIN_POSITIVE) })
+    eigenvalues(w.as_ref())
 }
 
 /// A dense column-major square matrix with direct slice access to its columns (the reduction
