@@ -148,6 +148,7 @@ struct RawDefaults {
     stall_rtol: Option<Spanned<f64>>,
     max_starts: Option<Spanned<usize>>,
     hop_scales: Option<Spanned<Vec<f64>>>,
+    central_gammas: Option<Spanned<Vec<f64>>>,
     threads: Option<Spanned<usize>>,
 }
 
@@ -173,6 +174,7 @@ struct RawProblem {
     stall_rtol: Option<Spanned<f64>>,
     max_starts: Option<Spanned<usize>>,
     hop_scales: Option<Spanned<Vec<f64>>>,
+    central_gammas: Option<Spanned<Vec<f64>>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -472,6 +474,11 @@ impl Campaign {
             if let Some((x, _)) = &hop_scales {
                 base.hop_scales = x.clone();
             }
+            let central_gammas =
+                p.central_gammas.as_ref().or(d.central_gammas.as_ref()).map(|s| (s.get_ref().clone(), s.span()));
+            if let Some((x, _)) = &central_gammas {
+                base.central_gammas = x.clone();
+            }
 
             let plant_arg = p.plant.get_ref().clone();
             let pspan = p.plant.span();
@@ -502,6 +509,7 @@ impl Campaign {
                         "stall_starts" => stall_starts.as_ref().map(|c| c.1.clone()),
                         "stall_rtol" => stall_rtol.as_ref().map(|c| c.1.clone()),
                         "hop_scales" => hop_scales.as_ref().map(|c| c.1.clone()),
+                        "central_gammas" => central_gammas.as_ref().map(|c| c.1.clone()),
                         _ => None,
                     };
                     return Err(at(span.unwrap_or(pspan.clone()), err.to_string()));
