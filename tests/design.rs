@@ -189,6 +189,7 @@ fn bad_options_and_init_are_errors() {
         (DesignOptions { max_starts: Some(0), ..ok.clone() }, "max_starts"),
         (DesignOptions { stall_rtol: -1.0, ..ok.clone() }, "stall_rtol"),
         (DesignOptions { hop_scales: vec![0.1, f64::NAN], ..ok.clone() }, "hop_scales"),
+        (DesignOptions { central_gammas: vec![2.0, 1.0], ..ok.clone() }, "central_gammas"),
         (DesignOptions { cpumax: f64::INFINITY, stall_rtol: 0.0, ..ok.clone() }, "stall_rtol"),
     ];
     for (opts, field) in cases {
