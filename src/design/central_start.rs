@@ -19,7 +19,8 @@
 use faer::Mat;
 
 use crate::lti::{
-    balanced_truncation, coprime_factor_truncation, dc_gain, spectral_abscissa, CentralProblem, Controller, Plant, StateSpace,
+    balanced_truncation, coprime_factor_truncation, dc_gain, spectral_abscissa, CentralProblem, Controller, Plant,
+    StateSpace,
 };
 
 use super::starts::{pad_controller, padding_diagonal};

@@ -10,11 +10,11 @@ use rand_chacha::ChaCha8Rng;
 use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, Controller, Plant, MIN_HINF_TOL};
 use crate::optim::RunControl;
 
+use super::central_start::central_starts;
 use super::objective::{ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, Phase, SearchStop, StartKind};
 use super::params::{controller_to_x, ControllerShape};
-use super::central_start::central_starts;
 use super::search::Search;
 use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
 

@@ -105,12 +105,8 @@ pub fn balanced_truncation_stable(sys: &StateSpace, order: usize) -> Result<Redu
     let r = hsv.iter().take(order).filter(|&&s| s > HSV_RTOL * s1 && s > 0.0).count();
     let tr = Mat::from_fn(n, r, |i, j| (0..n).map(|k| lc[(i, k)] * v[(k, j)]).sum::<f64>() / hsv[j].sqrt());
     let tl = Mat::from_fn(n, r, |i, j| (0..n).map(|k| lo[(i, k)] * u[(k, j)]).sum::<f64>() / hsv[j].sqrt());
-    let red = StateSpace {
-        a: tl.transpose() * &sys.a * &tr,
-        b: tl.transpose() * &sys.b,
-        c: &sys.c * &tr,
-        d: sys.d.clone(),
-    };
+    let red =
+        StateSpace { a: tl.transpose() * &sys.a * &tr, b: tl.transpose() * &sys.b, c: &sys.c * &tr, d: sys.d.clone() };
     Ok(Reduced { sys: red, hsv, n_unstable: 0 })
 }
 
@@ -188,12 +184,8 @@ pub fn coprime_factor_truncation(sys: &StateSpace, order: usize) -> Result<Reduc
     let r = red.sys.order();
     let br = Mat::from_fn(r, m, |i, j| red.sys.b[(i, j)]);
     let hr = Mat::from_fn(r, p, |i, j| red.sys.b[(i, m + j)]);
-    let g = StateSpace {
-        a: &red.sys.a - &hr * &red.sys.c,
-        b: &br - &hr * &sys.d,
-        c: red.sys.c.clone(),
-        d: sys.d.clone(),
-    };
+    let g =
+        StateSpace { a: &red.sys.a - &hr * &red.sys.c, b: &br - &hr * &sys.d, c: red.sys.c.clone(), d: sys.d.clone() };
     let n_unstable = g.a.eigenvalues().map(|ev| ev.iter().filter(|l| l.re >= 0.0).count()).unwrap_or(0);
     Ok(Reduced { sys: g, hsv: red.hsv, n_unstable })
 }

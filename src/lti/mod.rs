@@ -25,7 +25,8 @@ mod square_reduced;
 mod state_space;
 
 pub use balanced_truncation::{
-    balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values, Reduced, ReductionError, HSV_RTOL,
+    balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values,
+    Reduced, ReductionError, HSV_RTOL,
 };
 pub use central_controller::{CentralError, CentralProblem, GAMMA_OPT_RTOL, START_REGULARISATION};
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
