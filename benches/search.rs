@@ -121,7 +121,7 @@ fn run_all(jobs: Vec<Job>, threads: usize) -> Vec<(Job, DesignOutcome)> {
                     job.tag,
                     o.gamma,
                     o.search.starts,
-                    o.search.best_start,
+                    o.search.best_start_label(),
                     o.search.cpu_to_best_s,
                     o.cpu_s,
                     o.search.stop.name()
@@ -188,7 +188,7 @@ fn paper(a: &Args) {
                     if ok { "yes" } else { "NO" },
                     j.opts.eps,
                     o.search.starts,
-                    o.search.best_start,
+                    o.search.best_start_label(),
                     o.search.cpu_to_best_s,
                     o.cpu_s,
                     o.search.stop.name()
@@ -227,7 +227,7 @@ fn singles(a: &Args) {
             g.map_or("unstable".into(), |g| format!("{g:.5}")),
             if ok { "yes" } else { "NO" },
             o.search.starts,
-            o.search.best_start,
+            o.search.best_start_label(),
             o.search.cpu_to_best_s,
             o.cpu_s,
             o.search.stop.name(),

@@ -196,8 +196,8 @@ fn cancelled_design_reports_recomputed_figures_or_none() {
         let ctl = RunControl::new(f64::INFINITY).with_cancel(flag);
         let out = hinfix::design::run_with_control(&plant, &opts, None, &ctl, &mut NoDesignObserver).unwrap();
         assert_eq!(out.search.stop, SearchStop::Interrupted);
-        let k = Controller::from_json_value(&out.controller).unwrap();
-        let cl = closed_loop(&plant, &k).unwrap();
+        let k = &out.controller;
+        let cl = closed_loop(&plant, k).unwrap();
         let gamma = hinf_norm(&cl, opts.hinf_tol).value;
         if recomputed {
             assert_eq!(out.gamma.to_bits(), gamma.to_bits(), "n = {n}: γ {} vs recomputed {gamma}", out.gamma);

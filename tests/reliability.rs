@@ -72,6 +72,7 @@ fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
         search: hinfix::design::SearchSummary {
             starts: 1,
             best_start: 0,
+            best_start_kind: None,
             cpu_to_best_s: x,
             evals_to_best: 1,
             stop: hinfix::design::SearchStop::Stall,

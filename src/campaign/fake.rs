@@ -129,6 +129,7 @@ impl JobRunner for FakeRunner {
             search: SearchSummary {
                 starts: 1,
                 best_start: 0,
+                best_start_kind: None,
                 cpu_to_best_s: 0.0,
                 evals_to_best: iters,
                 stop: SearchStop::Starts,

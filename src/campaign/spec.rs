@@ -82,6 +82,7 @@ macro_rules! with_design_settings {
             stall_rtol: Option<Spanned<f64>>,
             max_starts: Option<Spanned<usize>>,
             hop_scales: Option<Spanned<Vec<f64>>>,
+            central_gammas: Option<Spanned<Vec<f64>>>,
             $($tail)*
         }
     };
@@ -390,6 +391,7 @@ struct Layered {
     max_starts: Setting<usize>,
     stall_starts: Setting<usize>,
     hop_scales: Setting<Vec<f64>>,
+    central_gammas: Setting<Vec<f64>>,
 }
 
 impl Layered {
@@ -410,6 +412,7 @@ impl Layered {
             max_starts: layer(&p.max_starts, &d.max_starts),
             stall_starts: layer(&p.stall_starts, &d.stall_starts),
             hop_scales: layer(&p.hop_scales, &d.hop_scales),
+            central_gammas: layer(&p.central_gammas, &d.central_gammas),
         }
     }
 
@@ -435,6 +438,9 @@ impl Layered {
         }
         if let Some((x, _)) = &self.hop_scales {
             o.hop_scales = x.clone();
+        }
+        if let Some((x, _)) = &self.central_gammas {
+            o.central_gammas = x.clone();
         }
         if let Some(k) = self.objective {
             o.objective = k;
@@ -463,6 +469,7 @@ impl Layered {
             "max_starts" => span(&self.max_starts),
             "stall_starts" => span(&self.stall_starts),
             "hop_scales" => span(&self.hop_scales),
+            "central_gammas" => span(&self.central_gammas),
             _ => None,
         }
     }

@@ -482,7 +482,7 @@ impl fmt::Display for TraceSummary {
                 f,
                 "  search: {} starts, best from start {}, CPU to best {:.2} s ({} evaluations), stopped: {}",
                 s.starts,
-                s.best_start,
+                s.best_start_label(),
                 s.cpu_to_best_s,
                 s.evals_to_best,
                 s.stop.name()

@@ -1,5 +1,6 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--max-starts N] [--hop-scales 0.01,0.1,1]
+//! [--central-gammas 1.1,2]
 //! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`hinfix::fs_atomic`).
@@ -65,6 +66,11 @@ pub struct DesignArgs {
     /// (one hop per size, then one random start, in turn). "none": random starts only.
     #[arg(long, value_name = "R,R,...", default_value = "0.01,0.1,1")]
     pub hop_scales: String,
+    /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
+    /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
+    /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.
+    #[arg(long, value_name = "F,F,...", default_value = "1.1,2")]
+    pub central_gammas: String,
     /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
     #[arg(long)]
     pub init: Option<PathBuf>,
@@ -97,7 +103,8 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         stall_starts: a.stall_starts,
         stall_rtol: a.stall_rtol,
         max_starts: a.max_starts.map(|n| n as usize),
-        hop_scales: parse_scales(&a.hop_scales)?,
+        hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
+        central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,
         objective: if a.no_strong { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
         ..Default::default()
     };
@@ -127,15 +134,15 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-/// `--hop-scales`: comma-separated positive numbers, or "none" (empty).
-fn parse_scales(text: &str) -> anyhow::Result<Vec<f64>> {
+/// `--hop-scales`, `--central-gammas`: comma-separated positive numbers, or "none" (empty).
+fn parse_scales(text: &str, flag: &str) -> anyhow::Result<Vec<f64>> {
     if text.trim() == "none" || text.trim().is_empty() {
         return Ok(Vec::new());
     }
     text.split(',')
         .map(|t| match t.trim().parse::<f64>() {
             Ok(r) if r.is_finite() && r > 0.0 => Ok(r),
-            _ => anyhow::bail!("--hop-scales: {t:?} is not a finite positive number"),
+            _ => anyhow::bail!("{flag}: {t:?} is not a finite positive number"),
         })
         .collect()
 }
@@ -217,7 +224,7 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
     s += &format!(
         "search: {} local searches, best from start {}, reached after {:.2} CPU s ({} evaluations), stopped: {}\n",
         sr.starts,
-        sr.best_start,
+        sr.best_start_label(),
         sr.cpu_to_best_s,
         sr.evals_to_best,
         sr.stop.name()

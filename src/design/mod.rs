@@ -3,12 +3,14 @@
 //!
 //! * [`params`]: x = [vec Ak; vec Bk; vec Ck; vec Dk] ↔ controller;
 //! * [`starts`]: seeded random starts, perturbations of an initial controller, warm-start padding;
+//! * [`central_start`]: reduced-order full-order-central-controller starts;
 //! * [`objective`]: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
 //!   observer adapter;
 //! * `phases`: the optimiser options of the two phases;
 //! * `search`: the multi-start search (local searches until a budget or the stall rule, basin
 //!   hopping, gradient sampling on the best point);
 //! * [`run`]: the entry point.
+pub mod central_start;
 mod float_serde;
 pub mod objective;
 mod options;
@@ -21,10 +23,13 @@ pub mod starts;
 
 pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
 pub use objective::{Components, DesignObjective, ObjectivePhase};
-pub use options::{DesignOptions, ObjectiveKind, DEFAULT_HOP_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND};
+pub use options::{
+    DesignOptions, ObjectiveKind, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS,
+    MAX_NRAND,
+};
 pub use outcome::{
     DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError, NoDesignObserver, Phase,
-    PhaseStats, SearchStop, SearchSummary,
+    PhaseStats, SearchStop, SearchSummary, StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};

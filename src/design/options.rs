@@ -28,6 +28,9 @@ pub const DEFAULT_STALL_STARTS: usize = 60;
 /// Default of [`DesignOptions::hop_scales`].
 pub const DEFAULT_HOP_SCALES: [f64; 3] = [1e-2, 1e-1, 1.0];
 
+/// Default of [`DesignOptions::central_gammas`].
+pub const DEFAULT_CENTRAL_GAMMAS: [f64; 2] = [1.1, 2.0];
+
 /// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (docs/ALGORITHMS.md §8), except that
 /// the search goes on after HIFOO's starts (`stall_starts`, `hop_scales`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -73,6 +76,12 @@ pub struct DesignOptions {
     /// Empty: random starts only. (Missing in a serialised record: empty.)
     #[serde(default, with = "serde_vec_f64_or_string")]
     pub hop_scales: Vec<f64>,
+    /// Levels γ = f·γ_opt (factors f > 1 of the full-order optimum) of the reduced-order
+    /// central-controller starts: for each f, the full-order H∞ central controller at that level,
+    /// reduced to `order` by balanced truncation, is one more first start, made after the `nrand`
+    /// starts (`design::central_start`). Empty: none. (Missing in a serialised record: empty.)
+    #[serde(default, with = "serde_vec_f64_or_string")]
+    pub central_gammas: Vec<f64>,
     /// Strong stabilisation or plain H∞.
     pub objective: ObjectiveKind,
     /// Relative tolerance of the H∞ norm computation.
@@ -106,6 +115,7 @@ impl Default for DesignOptions {
             stall_rtol: 1e-6,
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
+            central_gammas: DEFAULT_CENTRAL_GAMMAS.to_vec(),
             objective: ObjectiveKind::Strong,
             hinf_tol: crate::lti::DEFAULT_HINF_TOL,
             maxit: 1000,

@@ -105,6 +105,35 @@ impl SearchStop {
     }
 }
 
+/// What kind of start a local search began from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StartKind {
+    /// A standard-normal random point (a first start or a fresh start of the continued search).
+    Random,
+    /// The initial controller or one of its perturbations.
+    Init,
+    /// A reduced-order full-order-central-controller start (`central_gammas`).
+    Central,
+    /// A basin-hopping perturbation of the best point.
+    Hop,
+    /// HIFOO's gradient-sampling stabilisation fallback.
+    GradientSampling,
+}
+
+impl StartKind {
+    /// The name used in journals and traces.
+    pub fn name(self) -> &'static str {
+        match self {
+            StartKind::Random => "random",
+            StartKind::Init => "init",
+            StartKind::Central => "central",
+            StartKind::Hop => "hop",
+            StartKind::GradientSampling => "gradient_sampling",
+        }
+    }
+}
+
 /// How the multi-start search went.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SearchSummary {
@@ -113,6 +142,9 @@ pub struct SearchSummary {
     /// Index (0-based, in the order started) of the local search that produced the returned
     /// controller.
     pub best_start: usize,
+    /// The kind of that start (absent in records of older builds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub best_start_kind: Option<StartKind>,
     /// CPU seconds from the start of the run until the returned objective value was first
     /// reached within a relative 1e-6 (the final objective of a not-stabilised run: its best
     /// abscissa).
@@ -122,6 +154,16 @@ pub struct SearchSummary {
     pub evals_to_best: usize,
     /// Why no further local search was started.
     pub stop: SearchStop,
+}
+
+impl SearchSummary {
+    /// "7 (central)": the best start's index and, if recorded, its kind.
+    pub fn best_start_label(&self) -> String {
+        match self.best_start_kind {
+            Some(k) => format!("{} ({})", self.best_start, k.name()),
+            None => self.best_start.to_string(),
+        }
+    }
 }
 
 /// The result of [`crate::design::run`]. Every figure is recomputed from `controller`.

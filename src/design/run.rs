@@ -13,11 +13,14 @@ use crate::lti::{
 };
 use crate::optim::RunControl;
 
+use super::central_start::central_starts;
 use super::objective::{
     ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
 };
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
-use super::outcome::{DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop};
+use super::outcome::{
+    DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
+};
 use super::params::{controller_to_x, ControllerShape};
 use super::search::Search;
 use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
@@ -92,6 +95,9 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     }
     if let Some(bad) = opts.hop_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
         return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
+    }
+    if let Some(bad) = opts.central_gammas.iter().find(|f| !(f.is_finite() && **f > 1.0)) {
+        return Err(opt_err("central_gammas", format!("every factor of gamma_opt must be finite and > 1, got {bad}")));
     }
     if opts.stall_starts > 0
         && !opts.cpumax.is_finite()
@@ -217,7 +223,12 @@ fn run_validated(
     let strong = opts.objective == ObjectiveKind::Strong;
     let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let first = starting_points(plant, opts, init, shape, &mut rng);
+    let mut first = starting_points(plant, opts, init, shape, &mut rng);
+    let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
+    for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
+        first.push(controller_to_x(&k));
+        kinds.push(StartKind::Central);
+    }
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
     let stab_obj = DesignObjective::new(
         plant,
@@ -239,7 +250,7 @@ fn run_validated(
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
     let res =
         Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
-            .run(opts, &first, shape.nvar())?;
+            .run(opts, &first, &kinds, shape.nvar())?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
 
     let (final_x, certificate) = match &res.perf {

@@ -49,7 +49,7 @@ use crate::optim::{bfgs, gradient_sampling, OptimError, OptimResult, RunControl,
 
 use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::DesignOptions;
-use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary};
+use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
 use super::phases::{bfgs_options, gradsamp_options, optim_error};
 use super::starts::{perturb, random_starts};
 
@@ -278,12 +278,12 @@ impl Search<'_, '_, '_> {
     }
 
     /// The start of continued local search number `j` (0-based after the first starts).
-    fn next_start(&mut self, st: &State<'_>, j: usize, nvar: usize) -> Vec<f64> {
+    fn next_start(&mut self, st: &State<'_>, j: usize, nvar: usize) -> (Vec<f64>, StartKind) {
         let scales = &st.opts.hop_scales;
         let centre = st.perf.as_ref().or(st.stab.as_ref()).filter(|b| b.x.iter().all(|v| v.is_finite()));
         match (j % (scales.len() + 1), centre) {
-            (i, Some(c)) if i < scales.len() => perturb(&c.x, scales[i], self.rng),
-            _ => random_starts(nvar, 1, self.rng).remove(0),
+            (i, Some(c)) if i < scales.len() => (perturb(&c.x, scales[i], self.rng), StartKind::Hop),
+            _ => (random_starts(nvar, 1, self.rng).remove(0), StartKind::Random),
         }
     }
 
@@ -292,6 +292,7 @@ impl Search<'_, '_, '_> {
         &mut self,
         opts: &DesignOptions,
         first: &[Vec<f64>],
+        first_kinds: &[StartKind],
         nvar: usize,
     ) -> Result<SearchResult, DesignError> {
         let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
@@ -307,6 +308,7 @@ impl Search<'_, '_, '_> {
         };
         let mut k = 0usize; // local searches made
         let mut gs_fallback_done = false;
+        let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
         let mut stop = None;
         let full_ctl = self.ctl;
         while stop.is_none() {
@@ -321,9 +323,11 @@ impl Search<'_, '_, '_> {
                 break;
             }
             let (s, better) = if k < first.len() {
+                kinds.push(first_kinds.get(k).copied().unwrap_or(StartKind::Random));
                 self.local(&mut st, &first[k], k, search_ctl)?
             } else if !st.stabilised && opts.gradient_sampling && !gs_fallback_done {
                 gs_fallback_done = true;
+                kinds.push(StartKind::GradientSampling);
                 self.gs_stabilise(&mut st, k, search_ctl)?
             } else {
                 if opts.stall_starts == 0 {
@@ -337,7 +341,8 @@ impl Search<'_, '_, '_> {
                     stop = Some(SearchStop::Stall);
                     break;
                 }
-                let x0 = self.next_start(&st, k - first.len() - gs_fallback_done as usize, nvar);
+                let (x0, kind) = self.next_start(&st, k - first.len() - gs_fallback_done as usize, nvar);
+                kinds.push(kind);
                 self.local(&mut st, &x0, k, search_ctl)?
             };
             k += 1;
@@ -402,6 +407,7 @@ impl Search<'_, '_, '_> {
         let summary = SearchSummary {
             starts: k,
             best_start,
+            best_start_kind: kinds.get(best_start).copied(),
             cpu_to_best_s: reached.map_or(0.0, |r| r.cpu_s),
             evals_to_best: reached.map_or(0, |r| r.evals),
             stop,

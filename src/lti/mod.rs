@@ -3,6 +3,8 @@
 //!
 //! The H∞ norm and all gradients are hand-written (`hinf.rs`, `gradient.rs`): no Rust crate
 //! offers them. Linear algebra is faer, always single-threaded (`Par::Seq`).
+mod balanced_truncation;
+mod central_controller;
 mod closed_loop;
 mod controller;
 mod error;
@@ -13,6 +15,7 @@ mod gradient;
 mod hinf;
 mod interrupt;
 mod level_set_pencil;
+mod lyapunov;
 pub mod mat_file;
 mod matrix_json;
 mod plant;
@@ -22,6 +25,11 @@ mod spectral;
 mod square_reduced;
 mod state_space;
 
+pub use balanced_truncation::{
+    balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values,
+    Reduced, ReductionError, HSV_RTOL,
+};
+pub use central_controller::{CentralError, CentralProblem, GAMMA_OPT_RTOL, START_REGULARISATION};
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use controller::{Controller, ControllerError, ControllerErrorKind};
 pub use error::LtiError;
@@ -31,16 +39,15 @@ pub use full_order::{
 };
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, closed_loop_hinf_grad_near,
-    closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad,
-    controller_hinf_grad, ControllerGradient,
+    closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad, controller_hinf_grad, ControllerGradient,
 };
 pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
     hinf_lower_bound, hinf_norm, hinf_norm_interruptible, hinf_norm_near, hinf_norm_near_interruptible, HinfNorm,
-    DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
-    MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
+    DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use interrupt::{Interrupt, Interrupted};
+pub use lyapunov::{lyapunov_residual, solve_lyapunov, stable_antistable_basis, LyapunovError, LYAPUNOV_RESIDUAL_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};

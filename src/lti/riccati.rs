@@ -211,8 +211,21 @@ pub fn care_residual(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>,
     r.norm_l2() / scale
 }
 
-/// Matrix sign function of `z` (2n × 2n) by the scaled Newton iteration; returns (S, iterations).
-fn sign_function(mut z: Mat<f64>) -> Result<(Mat<f64>, usize), RiccatiError> {
+/// Matrix sign function of the Hamiltonian `z` (2n × 2n): [`sign_iteration`], then the inertia
+/// check trace S ≈ 0 (n eigenvalues on each side).
+fn sign_function(z: Mat<f64>) -> Result<(Mat<f64>, usize), RiccatiError> {
+    let (s, it, change) = sign_iteration(z)?;
+    let tr = trace(s.as_ref());
+    if tr.abs() > TRACE_TOL {
+        return Err(RiccatiError::NoDichotomy { iterations: it, trace: tr, change });
+    }
+    Ok((s, it))
+}
+
+/// Matrix sign function of any square `z` without eigenvalues on the imaginary axis, by the
+/// scaled Newton iteration of the module docs; returns (S, iterations, last relative change).
+/// Also used for Lyapunov equations and stable/antistable splittings (`lti::lyapunov`).
+pub(crate) fn sign_iteration(mut z: Mat<f64>) -> Result<(Mat<f64>, usize, f64), RiccatiError> {
     let m = z.nrows();
     let mut scaled = true;
     let mut change = f64::INFINITY;
@@ -237,11 +250,7 @@ fn sign_function(mut z: Mat<f64>) -> Result<(Mat<f64>, usize), RiccatiError> {
         }
         let stagnated = change <= SIGN_STAGNATION_TOL && change > 0.5 * prev_change;
         if change <= SIGN_TOL || stagnated {
-            let tr = trace(z.as_ref());
-            if tr.abs() > TRACE_TOL {
-                return Err(RiccatiError::NoDichotomy { iterations: it, trace: tr, change });
-            }
-            return Ok((z, it));
+            return Ok((z, it, change));
         }
     }
     Err(RiccatiError::NoDichotomy { iterations: SIGN_MAX_ITER, trace: trace(z.as_ref()), change })

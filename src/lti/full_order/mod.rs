@@ -119,12 +119,17 @@ impl fmt::Display for FullOrderGamma {
                 what.push(format!("D12 rank {} (z augmented with delta*x, delta*u)", self.d12_rank));
             }
             write!(f, "\n  singular plant: {}; regularised, reported at delta = {delta:.0e}", what.join("; "))?;
-            let hist: Vec<String> = self.regularisation_history.iter().map(|(e, g)| format!("{e:.0e}: {g:.7}")).collect();
+            let hist: Vec<String> =
+                self.regularisation_history.iter().map(|(e, g)| format!("{e:.0e}: {g:.7}")).collect();
             write!(
                 f,
                 "\n  gamma(delta): {}{}",
                 hist.join(", "),
-                if self.regularisation_converged { " (flat)" } else { " (not flat: an upper bound of the delta -> 0 limit)" }
+                if self.regularisation_converged {
+                    " (flat)"
+                } else {
+                    " (not flat: an upper bound of the delta -> 0 limit)"
+                }
             )?;
         }
         for n in &self.notes {
