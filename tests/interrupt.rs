@@ -168,7 +168,13 @@ fn bfgs_stopped_inside_an_evaluation_keeps_the_last_complete_value() {
         assert!(r.f.is_finite());
         let mut g = vec![0.0; 4];
         let again = perf_objective(&plant, None).eval(&r.x, &mut g);
-        assert_eq!(r.f.to_bits(), again.to_bits(), "k = {k}: the reported value is a complete evaluation");
+        // Equal to the norm's tolerance, not bitwise: the design objective warm-starts the norm
+        // at the previous peak, so a fresh objective may land on another attained σmax within it.
+        assert!(
+            (r.f - again).abs() <= 1e-9 * again.abs(),
+            "k = {k}: the reported value {} is a complete evaluation ({again})",
+            r.f
+        );
     }
 }
 

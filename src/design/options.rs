@@ -80,7 +80,9 @@ pub struct DesignOptions {
     /// central-controller starts: for each f, the full-order H∞ central controller at that level,
     /// reduced to `order` by balanced truncation, is one more first start, made after the `nrand`
     /// starts (`design::central_start`). Empty: none. (Missing in a serialised record: empty.)
-    #[serde(default, with = "serde_vec_f64_or_string")]
+    /// Not written when empty, so a record of a build without central starts reads and rewrites
+    /// identically (and keeps its job id).
+    #[serde(default, with = "serde_vec_f64_or_string", skip_serializing_if = "Vec::is_empty")]
     pub central_gammas: Vec<f64>,
     /// Strong stabilisation or plain H∞.
     pub objective: ObjectiveKind,

@@ -90,7 +90,8 @@ pub(crate) struct SearchResult {
     pub phases: Vec<PhaseStats>,
     /// The search summary (time to best filled in by the caller's adapter).
     pub summary: SearchSummary,
-    /// True if a budget ended the run before the first starts were all made.
+    /// True if a budget ended the run before HIFOO's first starts (the `nrand` random or init
+    /// starts, not the central-controller ones) were all made.
     pub truncated: bool,
 }
 
@@ -350,7 +351,10 @@ impl Search<'_, '_, '_> {
             stop = s;
         }
         let stop = stop.unwrap_or(SearchStop::Starts);
-        let truncated = k < first.len() && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
+        // HIFOO's own first starts (random or init): the extra central-controller starts are
+        // like the continued search, a budget may end the run before them without truncating it.
+        let hifoo_starts = first_kinds.iter().take(first.len()).filter(|k| **k != StartKind::Central).count();
+        let truncated = k < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
 
         // Gradient sampling from the best stable point, under the whole budget.
         let mut gs_ran = false;
