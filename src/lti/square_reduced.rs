@@ -29,6 +29,7 @@
 use faer::{c64, Mat, MatRef};
 
 use super::spectral::eigenvalues;
+use crate::numeric::dot_four_lanes;
 
 /// The eigenvalues μ = λ² of H² (one per pair ±λ of H) and a bound on their absolute error.
 pub(crate) struct SquaredSpectrum {
@@ -123,7 +124,7 @@ impl ColMajor {
         let len = v.len();
         for c in first_col..self.n {
             let seg = &mut self.col_mut(c)[r..r + len];
-            let s = beta * dot(v, seg);
+            let s = beta * dot_four_lanes(v, seg);
             if s != 0.0 {
                 axpy(-s, v, seg);
             }
@@ -225,23 +226,6 @@ fn householder(x: &[f64], v: &mut [f64]) -> Option<f64> {
         *vi = xi * scale;
     }
     Some((alpha - x0) / alpha)
-}
-
-/// Σ xᵢyᵢ with four partial sums (lets the compiler vectorise the reduction).
-fn dot(x: &[f64], y: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
-    let (xr, yr) = (xc.remainder(), yc.remainder());
-    for (a, b) in xc.zip(yc) {
-        for k in 0..4 {
-            acc[k] += a[k] * b[k];
-        }
-    }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (a, b) in xr.iter().zip(yr) {
-        s += a * b;
-    }
-    s
 }
 
 /// y += a·x.
