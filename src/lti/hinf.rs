@@ -75,7 +75,7 @@ pub const MIN_HINF_TOL: f64 = 1e-14;
 /// Iteration limit of the level-set loop (AB13DD's MAXIT).
 pub const MAX_LEVEL_SET_ITERS: usize = 30;
 /// At most this many mode-based test frequencies are evaluated (the least damped modes first).
-pub const MAX_POLE_TEST_FREQS: usize = 100;
+pub(crate) const MAX_POLE_TEST_FREQS: usize = 100;
 /// Above this κ = γ²/(γ² − σmax(D)²) the explicit Hamiltonian is replaced by the pencil. The
 /// squared method's eigenvalue errors grow like κ²: 1e6 lost a real peak (issue 13); with 1e3 the
 /// property family of `tests/hinf_property.rs` and the SLICOT fixtures pass.
