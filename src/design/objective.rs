@@ -40,7 +40,7 @@ use crate::lti::{
     controller_hinf_grad, hinf_lower_bound, spectral_abscissa, Controller, ControllerGradient, Interrupt, LtiError,
     Plant,
 };
-use crate::optim::{IterRecord, Objective, Observer, SolverKind};
+use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
 use super::outcome::{DesignIterRecord, DesignObserver, Phase};
 use super::params::ControllerShape;
@@ -136,6 +136,9 @@ pub struct DesignObjective<'p> {
     stop: Option<StopHook>,
     /// Whether the last evaluation was abandoned because `stop` fired.
     abandoned: Cell<bool>,
+    /// Told the CPU seconds of every complete closed-loop evaluation where `stop` applies (large
+    /// plants), so the run can hold back what recomputing its result will cost.
+    on_eval_cpu: Option<Rc<dyn Fn(f64)>>,
 }
 
 impl<'p> DesignObjective<'p> {
@@ -161,6 +164,7 @@ impl<'p> DesignObjective<'p> {
             peak_hint: Cell::new(f64::NAN),
             stop: None,
             abandoned: Cell::new(false),
+            on_eval_cpu: None,
         }
     }
 
@@ -172,11 +176,19 @@ impl<'p> DesignObjective<'p> {
         self
     }
 
-    /// A copy of this objective sharing its cache and stop hook (not its peak hint).
+    /// Reports the CPU seconds of each complete closed-loop H∞ evaluation on plants where the
+    /// stop hook applies (at least [`MIN_ORDER_FOR_INTERRUPT`] states) to `report`.
+    pub fn with_eval_cpu_report(mut self, report: Option<Rc<dyn Fn(f64)>>) -> Self {
+        self.on_eval_cpu = report;
+        self
+    }
+
+    /// A copy of this objective sharing its cache, stop hook and CPU report (not its peak hint).
     fn sibling(&self) -> Self {
         let o = self;
         DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache())
             .with_interrupt(o.stop.clone())
+            .with_eval_cpu_report(o.on_eval_cpu.clone())
     }
 
     /// True if the stop hook applies to this plant and has fired.
@@ -244,8 +256,12 @@ impl<'p> DesignObjective<'p> {
         // Warm start at the last peak (Benner & Mitchell 2018): the mode-based test frequencies
         // are skipped; the level-set certification is unchanged.
         let hint = [self.peak_hint.get()];
+        let cpu0 = hook.map(|_| thread_cpu_time());
         let (gamma, g_cl) = match closed_loop_hinf_grad_near_interruptible(self.plant, k, self.hinf_tol, &hint, stop) {
             Ok((norm, g)) => {
+                if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
+                    report(thread_cpu_time() - t0);
+                }
                 if norm.value.is_finite() {
                     self.peak_hint.set(norm.peak_freq);
                 }

@@ -244,9 +244,16 @@ fn run_validated(
     let stop_ctl = ctl.clone();
     let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
     let mut stab_obj = stab_obj.with_interrupt(Some(Rc::clone(&stop)));
+    // On large plants, hold back the largest evaluation seen from the CPU budget: the returned
+    // controller's figures (about one evaluation) are computed after the search, and should end
+    // near cpumax, not one evaluation after it. (Small plants never report: their runs are
+    // unchanged.)
+    let reserve_ctl = ctl.clone();
+    let report: Rc<dyn Fn(f64)> = Rc::new(move |s| reserve_ctl.reserve_cpu(s));
     let mut perf_obj =
         DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache)
-            .with_interrupt(Some(stop));
+            .with_interrupt(Some(stop))
+            .with_eval_cpu_report(Some(report));
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
     let res =
         Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }

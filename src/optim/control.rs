@@ -12,7 +12,7 @@
 //! shares one counter). Unlike CPU time it does not depend on the machine or its load, so a run
 //! stopped by it is reproducible bit for bit.
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// CPU seconds used so far by the calling thread: `clock_gettime(CLOCK_THREAD_CPUTIME_ID)`.
@@ -48,6 +48,8 @@ pub struct RunControl {
     cancel: Option<Arc<AtomicBool>>,
     evals: Arc<AtomicUsize>,
     maxevals: Option<usize>,
+    /// CPU seconds held back from `cpumax` for work after the run (f64 bits; shared by clones).
+    reserve: Arc<AtomicU64>,
 }
 
 impl RunControl {
@@ -56,7 +58,14 @@ impl RunControl {
     /// (NaN or negative values are treated as 0, i.e. already exhausted).
     pub fn new(cpumax: f64) -> Self {
         let cpumax = if cpumax.is_nan() { 0.0 } else { cpumax.max(0.0) };
-        RunControl { start_cpu: thread_cpu_time(), cpumax, cancel: None, evals: Arc::default(), maxevals: None }
+        RunControl {
+            start_cpu: thread_cpu_time(),
+            cpumax,
+            cancel: None,
+            evals: Arc::default(),
+            maxevals: None,
+            reserve: Arc::default(),
+        }
     }
 
     /// Set an evaluation budget: once [`Self::evals`] ≥ `maxevals`, the run stops with
@@ -115,18 +124,61 @@ impl RunControl {
         self.cpumax
     }
 
-    /// CPU seconds left (≥ 0; ∞ without a limit).
-    pub fn cpu_remaining(&self) -> f64 {
-        (self.cpumax - self.cpu_elapsed()).max(0.0)
+    /// Holds back `seconds` of the CPU budget (the largest value asked so far; shared by clones
+    /// and sub-budgets) for work the caller must still do after the run, such as recomputing its
+    /// result: the run then counts as exhausted that much earlier, so that work ends near
+    /// `cpumax` rather than after it. Ignored if not finite and positive.
+    pub fn reserve_cpu(&self, seconds: f64) {
+        if seconds.is_finite() && seconds > 0.0 {
+            let _ = self.reserve.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |old| {
+                (seconds > f64::from_bits(old)).then(|| seconds.to_bits())
+            });
+        }
     }
 
-    /// True once `cpu_elapsed() ≥ cpumax`.
+    /// The CPU seconds held back by [`Self::reserve_cpu`] (0 if none).
+    pub fn cpu_reserved(&self) -> f64 {
+        f64::from_bits(self.reserve.load(Ordering::Relaxed))
+    }
+
+    /// CPU seconds left (≥ 0; ∞ without a limit), after the reserve.
+    pub fn cpu_remaining(&self) -> f64 {
+        (self.cpumax - self.cpu_reserved() - self.cpu_elapsed()).max(0.0)
+    }
+
+    /// True once `cpu_elapsed() + cpu_reserved() ≥ cpumax`.
     pub fn cpu_exhausted(&self) -> bool {
-        self.cpumax.is_finite() && self.cpu_elapsed() >= self.cpumax
+        self.cpumax.is_finite() && self.cpu_elapsed() + self.cpu_reserved() >= self.cpumax
     }
 
     /// True once the cancel flag (if any) is set.
     pub fn cancelled(&self) -> bool {
         self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RunControl;
+
+    #[test]
+    fn reserve_is_shared_monotone_and_counts_against_the_budget() {
+        let ctl = RunControl::new(1e6);
+        let sub = ctl.sub_budget(0.9, 1.0);
+        assert_eq!(ctl.cpu_reserved(), 0.0);
+        sub.reserve_cpu(3.0);
+        ctl.reserve_cpu(2.0); // smaller: ignored
+        ctl.reserve_cpu(f64::NAN);
+        ctl.reserve_cpu(-1.0);
+        assert_eq!(ctl.cpu_reserved(), 3.0, "clones and sub-budgets share the largest reserve");
+        assert_eq!(sub.clone().cpu_reserved(), 3.0);
+        assert!(ctl.cpu_remaining() <= 1e6 - 3.0);
+        assert!(!ctl.cpu_exhausted());
+        ctl.reserve_cpu(2e6);
+        assert!(ctl.cpu_exhausted() && sub.cpu_exhausted(), "a reserve beyond the budget exhausts it");
+        assert_eq!(ctl.cpu_remaining(), 0.0);
+        let unlimited = RunControl::new(f64::INFINITY);
+        unlimited.reserve_cpu(1e9);
+        assert!(!unlimited.cpu_exhausted(), "no limit, nothing to exhaust");
     }
 }
