@@ -41,7 +41,7 @@
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, Side};
 
-use super::full_order::{full_order_gamma_with, FullOrderError, FullOrderOptions, Regularisation};
+use super::full_order::{augment, full_order_gamma_with, FullOrderError, FullOrderOptions, Regularisation};
 use super::riccati::{abscissa, solve_care};
 use super::{Controller, Plant};
 use crate::numeric::all_finite;
@@ -105,50 +105,11 @@ impl CentralProblem {
         }
         let reg12 = rank(plant.d12.as_ref())? < d.m2;
         let reg21 = rank(plant.d21.as_ref())? < d.p2;
-        let (n, m2, p2) = (d.n, d.m2, d.p2);
+        let (m2, p2) = (d.m2, d.p2);
+        // The δ-weighted channels of the full-order regularisation (`full_order::augment`).
+        let ch = augment(plant, eps, reg12, reg21);
         let mut p = plant.clone();
-        if reg12 {
-            let p1 = p.c1.nrows();
-            p.c1 = Mat::from_fn(p1 + n + m2, n, |i, j| {
-                if i < p1 {
-                    plant.c1[(i, j)]
-                } else if i - p1 == j {
-                    eps
-                } else {
-                    0.0
-                }
-            });
-            p.d12 = Mat::from_fn(p1 + n + m2, m2, |i, j| {
-                if i < p1 {
-                    plant.d12[(i, j)]
-                } else if i >= p1 + n && i - p1 - n == j {
-                    eps
-                } else {
-                    0.0
-                }
-            });
-        }
-        if reg21 {
-            let m1 = p.b1.ncols();
-            p.b1 = Mat::from_fn(n, m1 + n + p2, |i, j| {
-                if j < m1 {
-                    plant.b1[(i, j)]
-                } else if j - m1 == i {
-                    eps
-                } else {
-                    0.0
-                }
-            });
-            p.d21 = Mat::from_fn(p2, m1 + n + p2, |i, j| {
-                if j < m1 {
-                    plant.d21[(i, j)]
-                } else if j >= m1 + n && j - m1 - n == i {
-                    eps
-                } else {
-                    0.0
-                }
-            });
-        }
+        (p.b1, p.c1, p.d12, p.d21) = (ch.b1, ch.c1, ch.d12, ch.d21);
         p.d11 = Mat::zeros(p.c1.nrows(), p.b1.ncols());
         p.dims.p1 = p.c1.nrows();
         p.dims.m1 = p.b1.ncols();

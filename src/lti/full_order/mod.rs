@@ -25,6 +25,8 @@ mod linalg;
 mod regularisation;
 
 pub use bracketing::{GAMMA_MAX, GAMMA_RTOL};
+/// The δ-augmentation of a singular D12/D21, shared with the central-controller start.
+pub(crate) use regularisation::augment;
 pub use regularisation::{Regularisation, FLAT_RTOL, REGULARISATION_DELTAS};
 
 use bracketing::gamma_opt;
