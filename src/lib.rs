@@ -7,7 +7,8 @@
 //!   sampling) that knows nothing about control;
 //! - [`lti`]: plants, controllers, closed loops, spectral abscissa, H∞ norm and their gradients;
 //! - [`design`]: the HIFOO method, joining `lti` and `optim`;
-//! - [`campaign`]: campaign files, job scheduling, journal/resume, traces and reports.
+//! - [`campaign`]: campaign files, job scheduling, journal/resume, traces and reports;
+//! - [`cli`]: the `campaign` command line (the binary's `main`), on top of all of them.
 //!
 //! Under all of them, used by any and using none: `numeric` (a few shared numeric helpers,
 //! crate-private), [`fs_atomic`] (atomic, durable file writes) and [`input`] (bounded reading of
@@ -20,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod campaign;
+pub mod cli;
 pub mod design;
 pub mod fs_atomic;
 pub mod input;

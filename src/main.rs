@@ -1,6 +1,5 @@
-//! The `campaign` command line: parse, call the library, print. Nothing else lives here.
-mod cli;
+//! The `campaign` command line: everything is in the library's [`hinfix::cli`].
 
 fn main() -> std::process::ExitCode {
-    cli::main()
+    hinfix::cli::main()
 }

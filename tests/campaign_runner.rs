@@ -2,7 +2,7 @@
 //! moments gives exactly the journal of an uninterrupted run; a torn journal line is reported,
 //! ignored and cut off; a small real-design campaign writes its journal, traces and reports.
 //!
-//! The kill test uses the hidden fake runner (`HINFIX_FAKE_RUNNER`, see `campaign::fake`) so that
+//! The kill test uses the fake runner (examples/fake_campaign.rs, see `campaign::fake`) so that
 //! it takes seconds; its jobs carry their own ids, so fake records can never pass for real ones.
 
 use std::collections::BTreeMap;
@@ -43,13 +43,11 @@ fn campaign_file(dir: &Path, cpumax: f64, seeds: usize) -> PathBuf {
 }
 
 fn command(file: &Path, results: &Path, fake: bool) -> Command {
-    let mut c = Command::new(BIN);
+    let mut c = if fake { Command::new(common::fake_campaign_bin()) } else { Command::new(BIN) };
     c.arg("run").arg(file).arg("--results").arg(results).arg("--no-progress");
     c.env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"));
     if fake {
         c.env(FAKE_RUNNER_ENV, "15");
-    } else {
-        c.env_remove(FAKE_RUNNER_ENV);
     }
     c
 }

@@ -1,6 +1,6 @@
 //! Several `campaign run` processes on one results folder, `--shard K/N`, and reports merged
-//! from several journals — through the real binary, with the fast fake runner
-//! (`HINFIX_FAKE_RUNNER`, see `campaign::fake`).
+//! from several journals — through the command line with the fast fake runner
+//! (examples/fake_campaign.rs, see `campaign::fake`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -12,7 +12,8 @@ use hinfix::campaign::journal::{journals_in, read_journal};
 use hinfix::campaign::record::JobRecord;
 use hinfix::campaign::summarise;
 
-const BIN: &str = env!("CARGO_BIN_EXE_campaign");
+mod common;
+
 
 fn scratch(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hinfix-shared-{tag}-{}", std::process::id()));
@@ -37,7 +38,7 @@ fn campaign_file(dir: &Path, seeds: usize) -> PathBuf {
 }
 
 fn command(sub: &str, file: &Path, results: &Path, pause_ms: u64) -> Command {
-    let mut c = Command::new(BIN);
+    let mut c = Command::new(common::fake_campaign_bin());
     c.arg(sub).arg(file).arg("--results").arg(results);
     if sub == "run" {
         c.arg("--no-progress");

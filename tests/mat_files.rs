@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use hinfix::design::{run, DesignOptions, NoDesignObserver};
-use hinfix::lti::mat_file::{controller_to_mat, plant_to_mat, read_mat_vars};
+use hinfix::lti::{controller_to_mat, plant_to_mat, read_mat_vars};
 use hinfix::lti::{Controller, Plant};
 
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
@@ -124,7 +124,7 @@ fn bad_files_name_the_file_and_the_variable() {
     assert!(e.contains("matrix `A` is missing"), "{e}");
     // Shapes are checked as for JSON: a controller whose BK has the wrong height.
     let k = Controller::load(fixture("K2.json")).unwrap();
-    let bad = hinfix::lti::mat_file::write_mat(
+    let bad = hinfix::lti::write_mat(
         &[("AK", k.ak.as_ref()), ("BK", k.ck.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())],
         "bad",
     );

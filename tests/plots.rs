@@ -50,7 +50,6 @@ fn every_figure_kind_is_rendered_for_a_small_real_campaign() {
             .arg("--results")
             .arg(&results)
             .env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"))
-            .env_remove("HINFIX_FAKE_RUNNER")
             .output()
             .unwrap();
         assert!(out.status.success(), "campaign {args:?}: {}", String::from_utf8_lossy(&out.stderr));

@@ -13,6 +13,8 @@ use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignOb
 use hinfix::lti::Plant;
 use serde_json::Value;
 
+mod common;
+
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
 const PLANTS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/plants");
 
@@ -25,7 +27,14 @@ fn scratch(tag: &str) -> PathBuf {
 
 fn cli(args: &[&str]) -> Command {
     let mut c = Command::new(BIN);
-    c.args(args).env("HINFIX_PLANTS", PLANTS).env_remove(FAKE_RUNNER_ENV);
+    c.args(args).env("HINFIX_PLANTS", PLANTS);
+    c
+}
+
+/// [`cli`] with the fake runner (examples/fake_campaign.rs), pausing `pause_ms` per iteration.
+fn fake_cli(args: &[&str], pause_ms: &str) -> Command {
+    let mut c = Command::new(common::fake_campaign_bin());
+    c.args(args).env("HINFIX_PLANTS", PLANTS).env(FAKE_RUNNER_ENV, pause_ms);
     c
 }
 
@@ -274,8 +283,7 @@ fn item3_campaign_check_calls_design_validate_before_any_job() {
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [9]\n").unwrap();
     let (code, _, err) = output(
-        cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
-            .env(FAKE_RUNNER_ENV, "1"),
+        &mut fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "1"),
     );
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("c.toml:4:10") && err.contains("order"), "{err}");
@@ -360,8 +368,7 @@ fn slow_campaign(dir: &Path) -> PathBuf {
 
 fn spawn_slow(dir: &Path) -> std::process::Child {
     let f = slow_campaign(dir);
-    cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress", "--threads", "2"])
-        .env(FAKE_RUNNER_ENV, "100")
+    fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress", "--threads", "2"], "100")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -411,8 +418,7 @@ fn item5_second_ctrl_c_stops_at_once() {
     let dir = scratch("sigint2");
     let f = slow_campaign(&dir);
     // A pause of 3 s per fake iteration: the first Ctrl-C would wait for it.
-    let child = cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
-        .env(FAKE_RUNNER_ENV, "3000")
+    let child = fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "3000")
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -441,8 +447,7 @@ fn item6_hostile_names_reach_no_output_raw() {
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"evil.json\"\norders = [1]\n").unwrap();
     let (code, out, err) = output(
-        cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
-            .env(FAKE_RUNNER_ENV, "1"),
+        &mut fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "1"),
     );
     assert_eq!(code, Some(0), "{err}");
     for (what, s) in [("stdout", out.as_str()), ("stderr", err.as_str())] {
@@ -600,13 +605,13 @@ fn item8_report_works_with_a_plant_folder_without_reference() {
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
     let results = dir.join("r");
-    let mut c = cli(&["run", f.to_str().unwrap(), "--results", results.to_str().unwrap(), "--no-progress"]);
-    c.env("HINFIX_PLANTS", &own).env(FAKE_RUNNER_ENV, "1").current_dir(&dir);
+    let mut c = fake_cli(&["run", f.to_str().unwrap(), "--results", results.to_str().unwrap(), "--no-progress"], "1");
+    c.env("HINFIX_PLANTS", &own).current_dir(&dir);
     let (code, out, err) = output(&mut c);
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("0.1235"), "the paper's HE1 value must be in the comparison: {out}");
-    let mut c = cli(&["report", f.to_str().unwrap(), "--results", results.to_str().unwrap()]);
-    c.env("HINFIX_PLANTS", &own).current_dir(&dir).env(FAKE_RUNNER_ENV, "1");
+    let mut c = fake_cli(&["report", f.to_str().unwrap(), "--results", results.to_str().unwrap()], "1");
+    c.env("HINFIX_PLANTS", &own).current_dir(&dir);
     let (code, _, err) = output(&mut c);
     assert_eq!(code, Some(0), "{err}");
 }

@@ -1,10 +1,9 @@
 //! A deterministic stand-in for `design::run`, for testing the campaign machinery (scheduling,
-//! journal, resume after kill -9) quickly. It exists only in builds with the test-only cargo
-//! feature `test-fake-runner` (which `cargo test` turns on through the crate's dev-dependency on
-//! itself; `cargo build --release` never does), so a production binary cannot be switched to
-//! fake results. In such a build the command line selects it through the hidden environment
-//! variable [`FAKE_RUNNER_ENV`]; jobs made for it carry [`RunnerTag::Fake`] in their id and
-//! `"runner": "fake"` in their record, so its results can never pass for real ones.
+//! journal, resume after kill -9) quickly. Only the test-only binary examples/fake_campaign.rs
+//! uses it (through [`crate::cli::main_with`]); the `campaign` binary has no way to select it, so
+//! a production binary cannot be switched to fake results. Jobs made for it carry
+//! [`RunnerTag::Fake`] in their id and `"runner": "fake"` in their record, so its results can
+//! never pass for real ones.
 //!
 //! A fake job takes [`FAKE_ITERS`] "iterations", sleeping `pause` between them and reporting each
 //! to the observer (so cancellation works exactly as with the real runner), and returns figures
@@ -24,8 +23,8 @@ use crate::design::{
 };
 use crate::lti::Controller;
 
-/// The hidden variable that selects the fake runner; its value is the pause between fake
-/// iterations in milliseconds (empty or unparsable: [`DEFAULT_PAUSE_MS`]).
+/// The environment variable the fake binary reads its pause between fake iterations from, in
+/// milliseconds (unset, empty or unparsable: [`DEFAULT_PAUSE_MS`]).
 pub const FAKE_RUNNER_ENV: &str = "HINFIX_FAKE_RUNNER";
 /// Default pause between fake iterations (ms).
 pub const DEFAULT_PAUSE_MS: u64 = 20;
@@ -40,11 +39,10 @@ pub struct FakeRunner {
 }
 
 impl FakeRunner {
-    /// The runner the environment asks for, if [`FAKE_RUNNER_ENV`] is set.
-    pub fn from_env() -> Option<FakeRunner> {
-        let v = std::env::var(FAKE_RUNNER_ENV).ok()?;
-        let ms = v.trim().parse().unwrap_or(DEFAULT_PAUSE_MS);
-        Some(FakeRunner { pause: Duration::from_millis(ms) })
+    /// The runner with the pause [`FAKE_RUNNER_ENV`] asks for.
+    pub fn from_env() -> FakeRunner {
+        let ms = std::env::var(FAKE_RUNNER_ENV).ok().and_then(|v| v.trim().parse().ok());
+        FakeRunner { pause: Duration::from_millis(ms.unwrap_or(DEFAULT_PAUSE_MS)) }
     }
 
     /// The runner tag for job expansion.

@@ -52,8 +52,8 @@ impl fmt::Display for JobId {
 pub enum RunnerTag {
     /// `design::run` (production).
     Design,
-    /// The deterministic fake runner of the test hook (`HINFIX_FAKE_RUNNER`; only in builds with
-    /// the test-only `test-fake-runner` feature).
+    /// The deterministic fake runner of the machinery tests (`campaign::fake`; only the test-only
+    /// binary examples/fake_campaign.rs runs it).
     Fake,
 }
 

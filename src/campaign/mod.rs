@@ -7,7 +7,6 @@
 //! writers ([`report`]) each consume what they need.
 pub mod claims;
 mod compare;
-#[cfg(feature = "test-fake-runner")]
 pub mod fake;
 mod jobs;
 pub mod journal;

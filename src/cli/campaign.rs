@@ -1,4 +1,4 @@
-//! `campaign run | status | report | trace`: the command-line edge of `hinfix::campaign`. All the
+//! `campaign run | status | report | trace`: the command-line edge of `crate::campaign`. All the
 //! work is in the library (spec, jobs, scheduler, journal, progress, trace, report); this file
 //! only parses arguments, wires the pieces together and maps outcomes to exit codes.
 use std::collections::{BTreeMap, HashMap};
@@ -6,19 +6,20 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use hinfix::campaign::claims::{unix_now, ClaimDir};
-use hinfix::campaign::journal::{journals_in, Follower};
-use hinfix::campaign::progress::{Display, Reporter};
-use hinfix::campaign::record::JobRecord;
-use hinfix::campaign::reduce::plant_labels;
-use hinfix::campaign::run::{campaign_dir, duplicate_ids, records_for, run_jobs};
-use hinfix::campaign::scheduler::{DesignRunner, ExecuteOptions, JobRunner};
-use hinfix::campaign::shard::{self, Shard};
-use hinfix::campaign::{
+use crate::campaign::fake::FakeRunner;
+use crate::campaign::claims::{unix_now, ClaimDir};
+use crate::campaign::journal::{journals_in, Follower};
+use crate::campaign::progress::{Display, Reporter};
+use crate::campaign::record::JobRecord;
+use crate::campaign::reduce::plant_labels;
+use crate::campaign::run::{campaign_dir, duplicate_ids, records_for, run_jobs};
+use crate::campaign::scheduler::{DesignRunner, ExecuteOptions, JobRunner};
+use crate::campaign::shard::{self, Shard};
+use crate::campaign::{
     expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
 };
 
-use hinfix::campaign::sanitise::for_terminal;
+use crate::campaign::sanitise::for_terminal;
 
 use super::{signals, EXIT_JOBS_FAILED};
 
@@ -42,7 +43,7 @@ pub struct RunArgs {
     pub campaign: CampaignFileArgs,
     /// Worker threads (one job per thread; faer is single-threaded inside a job), 1..=256.
     /// Default: the file's `defaults.threads`, else 2.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=hinfix::campaign::MAX_THREADS as i64))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::campaign::MAX_THREADS as i64))]
     pub threads: Option<u32>,
     /// Plain log lines instead of live progress bars (automatic when stderr is not a terminal).
     #[arg(long)]
@@ -115,22 +116,13 @@ struct Loaded {
     fake: Option<Box<dyn JobRunner>>,
 }
 
-/// The hidden fake runner of the machinery tests (`campaign::fake`) when its environment
-/// variable is set, in a build with the test-only `test-fake-runner` feature; always `None` in
-/// a production build.
-fn fake_runner() -> Option<Box<dyn JobRunner>> {
-    #[cfg(feature = "test-fake-runner")]
-    if let Some(f) = hinfix::campaign::fake::FakeRunner::from_env() {
-        return Some(Box::new(f));
-    }
-    None
-}
-
-fn load(a: &CampaignFileArgs) -> anyhow::Result<Loaded> {
+/// Loads the campaign file and expands its jobs for `fake` (the machinery tests' fake runner,
+/// [`crate::cli::main_with`]) or, when `None`, for the design.
+fn load(a: &CampaignFileArgs, fake: Option<FakeRunner>) -> anyhow::Result<Loaded> {
     let campaign = Campaign::load(&a.file)?;
-    // The hidden fake runner (tests of the machinery) makes jobs with different ids, so its
-    // records can never be mistaken for real ones.
-    let fake = fake_runner();
+    // The fake runner makes jobs with different ids, so its records can never be mistaken for
+    // real ones.
+    let fake = fake.map(|f| Box::new(f) as Box<dyn JobRunner>);
     let tag = if fake.is_some() { RunnerTag::Fake } else { RunnerTag::Design };
     let jobs = expand(&campaign, tag);
     let dir = campaign_dir(&a.results, &campaign.name);
@@ -160,8 +152,8 @@ fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Resul
 }
 
 /// `campaign run FILE`.
-pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
-    let l = load(&a.campaign)?;
+pub fn run(a: RunArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+    let l = load(&a.campaign, fake)?;
     std::fs::create_dir_all(&l.dir).with_context(|| format!("creating {}", l.dir.display()))?;
     let jobs = match a.shard {
         Some(s) => shard::select(&l.jobs, s),
@@ -216,7 +208,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn warn_torn(torn: &[(PathBuf, hinfix::campaign::journal::TornTail)]) {
+fn warn_torn(torn: &[(PathBuf, crate::campaign::journal::TornTail)]) {
     for (path, t) in torn {
         eprintln!("warning: {}: line {} is torn ({}); ignored", path.display(), t.line, t.reason);
     }
@@ -246,8 +238,8 @@ fn journaled(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<(Vec<JobRecord>,
 }
 
 /// `campaign status FILE`.
-pub fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let l = load(&a.campaign)?;
+pub fn status(a: StatusArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+    let l = load(&a.campaign, fake)?;
     let (records, journals) = journaled(&l, &a.extra)?;
     // job id → whether some record of it did not fail
     let mut done: HashMap<_, bool> = HashMap::new();
@@ -373,19 +365,19 @@ fn finished_records(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<Vec<JobRe
 }
 
 /// `campaign report FILE`.
-pub fn report(a: ReportArgs) -> anyhow::Result<ExitCode> {
-    let l = load(&a.campaign)?;
+pub fn report(a: ReportArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+    let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
     report_into(&l.dir, &l.campaign, &records)?;
     Ok(ExitCode::SUCCESS)
 }
 
 /// `campaign plot FILE`: figures of the journaled jobs into `<results>/<name>/plots/`.
-pub fn plot(a: PlotArgs) -> anyhow::Result<ExitCode> {
-    let l = load(&a.campaign)?;
+pub fn plot(a: PlotArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+    let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
     let reference = load_default_reference().context("reading the paper's reference table")?;
-    let s = hinfix::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;
+    let s = crate::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;
     for f in &s.files {
         println!("{}", f.display());
     }

@@ -4,7 +4,7 @@
 //!
 //! JSON keys: `closed_loop_spectral_abscissa`, `controller_spectral_abscissa` (null for nk = 0),
 //! `gamma` (‖Tzw‖∞) and `k_hinf` (‖K‖∞) — the names of the journal, the traces and
-//! [`hinfix::design::DesignOutcome`] (docs/ARCHITECTURE.md §5; builds before that wrote the SLICOT
+//! [`crate::design::DesignOutcome`] (docs/ARCHITECTURE.md §5; builds before that wrote the SLICOT
 //! oracle's `closed_loop_hinf` / `controller_hinf`) — `closed_loop_peak_freq` (where ‖Tzw‖∞
 //! peaks), `closed_loop_stable`, `controller_stable`; non-finite numbers are written
 //! as the strings "inf" / "-inf" / "nan" (as `design::float_serde`), a frequency that does not
@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use hinfix::lti::{
+use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
 };
 use serde_json::{json, Value};
@@ -58,14 +58,14 @@ impl CheckReport {
 }
 
 pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
-    let plant = Plant::load(hinfix::lti::resolve_plant(&a.plant)?)?;
+    let plant = Plant::load(crate::lti::resolve_plant(&a.plant)?)?;
     let k = Controller::load(&a.controller)?;
     k.check_fits(&plant).with_context(|| format!("controller {}", a.controller.display()))?;
     let r = evaluate(&plant, &k)?;
     if let Some(out) = &a.plot {
         let title = format!("σ-plot: {}, controller {} (order {})", plant.name, a.controller.display(), k.order());
-        let fig = hinfix::campaign::plot::sigma_figure(&plant, &k, title)?;
-        hinfix::campaign::plot::write_by_extension(&fig, out)?;
+        let fig = crate::campaign::plot::sigma_figure(&plant, &k, title)?;
+        crate::campaign::plot::write_by_extension(&fig, out)?;
         eprintln!("σ-plot written to {}", out.display());
     }
     if a.json {
@@ -85,7 +85,7 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     Ok(CheckReport { alpha_cl, alpha_k, gamma: h.value, peak_freq: h.peak_freq, k_hinf: hk.value })
 }
 
-use hinfix::design::f64_to_json as num;
+use crate::design::f64_to_json as num;
 
 fn to_json(r: &CheckReport) -> Value {
     json!({
@@ -110,7 +110,7 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     };
     let mut s = format!(
         "plant {} (n = {}), controller of order {}\n",
-        hinfix::campaign::sanitise::for_terminal(&plant.name),
+        crate::campaign::sanitise::for_terminal(&plant.name),
         plant.dims.n,
         k.order()
     );

@@ -3,7 +3,7 @@
 //! [--central-gammas 1.1,2]
 //! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
-//! `campaign check` reads, atomically and durably (`hinfix::fs_atomic`).
+//! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
 //!
 //! Every outcome writes the returned controller. Exit codes: 0 for a stabilising controller
 //! (converged, stopped by a limit, budget exhausted, stabilised only), 4 when it is NOT
@@ -15,15 +15,15 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use anyhow::Context;
-use hinfix::design::{
+use crate::design::{
     run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, DEFAULT_STALL_STARTS,
 };
-use hinfix::fs_atomic::write_atomic;
-use hinfix::lti::{resolve_plant, Controller, Plant};
-use hinfix::optim::RunControl;
+use crate::fs_atomic::write_atomic;
+use crate::lti::{resolve_plant, Controller, Plant};
+use crate::optim::RunControl;
 
 use super::{fmt_num, signals, EXIT_NOT_STABILISED};
-use hinfix::campaign::sanitise::for_terminal;
+use crate::campaign::sanitise::for_terminal;
 
 /// Arguments of `campaign design`.
 #[derive(clap::Args, Debug)]
@@ -109,14 +109,14 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         ..Default::default()
     };
     // Bad options and an unusable --out are errors before any work (and before any file is made).
-    hinfix::design::validate(&plant, &opts, init.as_ref())
+    crate::design::validate(&plant, &opts, init.as_ref())
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
     check_writable(&a.out).with_context(|| format!("--out {}", a.out.display()))?;
     let cancel = signals::install();
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
-    if hinfix::lti::mat_file::is_mat_path(&a.out) {
+    if crate::lti::is_mat_path(&a.out) {
         outcome.controller.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
     } else {
         let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";

@@ -1,11 +1,11 @@
 //! `campaign export --controller K.json|K.mat --to matlab|python`: prints the controller as
 //! ready-to-paste MATLAB (`K = ss(AK,BK,CK,DK)`) or python-control (`K = control.ss(...)`) code,
-//! with the sign convention u = K y stated in its comments (see `hinfix::lti::export`).
+//! with the sign convention u = K y stated in its comments (see `crate::lti::export`).
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use hinfix::lti::export::{export_code, ExportTarget};
-use hinfix::lti::Controller;
+use crate::lti::export::{export_code, ExportTarget};
+use crate::lti::Controller;
 
 /// Target language.
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]

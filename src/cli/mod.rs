@@ -1,5 +1,9 @@
-//! Command-line interface (clap). Each subcommand lives in its own file; errors become
-//! `anyhow` only here, at the edge, and map to documented exit codes.
+//! Command-line interface (clap) of the `campaign` binary, whose `main` is [`main`]. Each
+//! subcommand lives in its own file; errors become `anyhow` only here, at the edge, and map to
+//! documented exit codes. It sits on top of every layer and nothing in the library uses it; it is
+//! in the library (not in src/main.rs) so that the machinery tests' binary with the fake runner
+//! (examples/fake_campaign.rs, [`main_with`]) is the same command line without a second build of
+//! the crate.
 //!
 //! Exit codes: 0 success, 1 error, 2 usage error (clap), 3 some campaign jobs failed,
 //! 4 not stabilised (`design` found no (strongly) stabilising controller; `check`: the closed
@@ -8,6 +12,8 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+use crate::campaign::fake::FakeRunner;
 
 mod campaign;
 mod check;
@@ -67,15 +73,25 @@ pub(crate) fn fmt_num(x: f64, prec: usize) -> String {
     }
 }
 
-/// Parses the command line and runs it.
+/// Parses the command line and runs it: the `campaign` binary.
 pub fn main() -> ExitCode {
+    main_with(None)
+}
+
+/// [`main`], with the campaign jobs run by `fake` instead of the design when it is given: the
+/// test-only binary examples/fake_campaign.rs, which the machinery tests (scheduling, journal,
+/// kill -9, resume) run so that a campaign takes seconds. Its jobs carry
+/// [`RunnerTag::Fake`](crate::campaign::RunnerTag::Fake) in their ids and `"runner": "fake"` in
+/// their records, so they never pass for real ones. The `campaign` binary always passes `None`:
+/// no environment variable or option switches it to fake results.
+pub fn main_with(fake: Option<FakeRunner>) -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run(a) => campaign::run(a),
-        Command::Status(a) => campaign::status(a),
-        Command::Report(a) => campaign::report(a),
+        Command::Run(a) => campaign::run(a, fake),
+        Command::Status(a) => campaign::status(a, fake),
+        Command::Report(a) => campaign::report(a, fake),
         Command::Trace(a) => campaign::trace(a),
-        Command::Plot(a) => campaign::plot(a),
+        Command::Plot(a) => campaign::plot(a, fake),
         Command::Export(a) => export::run(a),
         Command::Plants(a) => plants::list(a),
         Command::Plant(a) => plants::show(a),
@@ -85,7 +101,7 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", hinfix::campaign::sanitise::for_terminal(&error_text(&e)));
+            eprintln!("error: {}", crate::campaign::sanitise::for_terminal(&error_text(&e)));
             ExitCode::FAILURE
         }
     }

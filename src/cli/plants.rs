@@ -2,10 +2,10 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
-use hinfix::campaign::report::FULL_ORDER_MAX_N;
-use hinfix::campaign::sanitise::for_terminal as term;
-use hinfix::campaign::{load_default_reference, RefMethod};
-use hinfix::lti::{self, Plant};
+use crate::campaign::report::FULL_ORDER_MAX_N;
+use crate::campaign::sanitise::for_terminal as term;
+use crate::campaign::{load_default_reference, RefMethod};
+use crate::lti::{self, Plant};
 use serde_json::{json, Value};
 
 /// Arguments of `campaign plants`.
@@ -46,7 +46,7 @@ impl Summary {
         json!({
             "name": self.name, "n": d.n, "m1": d.m1, "m2": d.m2, "p1": d.p1, "p2": d.p2,
             "open_loop_stable": self.stable(),
-            "open_loop_spectral_abscissa": hinfix::design::f64_to_json(self.alpha),
+            "open_loop_spectral_abscissa": crate::design::f64_to_json(self.alpha),
             "source": self.plant.citation,
         })
     }
@@ -109,7 +109,7 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
         let o = doc.as_object_mut().expect("plant JSON is an object");
         o.insert("file".into(), path.display().to_string().into());
         o.insert("open_loop_stable".into(), s.stable().into());
-        o.insert("open_loop_spectral_abscissa".into(), hinfix::design::f64_to_json(s.alpha));
+        o.insert("open_loop_spectral_abscissa".into(), crate::design::f64_to_json(s.alpha));
         o.insert("d22_zero".into(), s.plant.d22_is_zero().into());
         o.insert(
             "full_order_gamma".into(),

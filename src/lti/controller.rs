@@ -9,8 +9,9 @@
 use std::path::{Path, PathBuf};
 
 use faer::Mat;
-use serde_json::Value;
+use serde_json::{Map, Value};
 
+use super::mat_file::{is_mat_path, read_mat_vars, var_to_json, write_mat, MatReadError};
 use super::matrix_json::{json_shape, json_type, matrix_from_json, matrix_to_json, MatrixJsonError};
 
 /// Controller matrices (Ak, Bk, Ck, Dk).
@@ -70,7 +71,7 @@ pub enum ControllerErrorKind {
     },
     /// A `.mat` file that is not a readable level-5 MAT-file of real matrices.
     #[error("{0}")]
-    Mat(#[from] super::mat_file::MatReadError),
+    Mat(#[from] MatReadError),
     /// Not an object with AK, BK, CK, DK.
     #[error("the top level must be a JSON object with keys AK, BK, CK, DK")]
     NotObject,
@@ -127,11 +128,11 @@ impl Controller {
     /// Reads a controller file: JSON, or a MATLAB `.mat` file with `AK BK CK DK`.
     pub fn load(path: impl AsRef<Path>) -> Result<Controller, ControllerError> {
         let path = path.as_ref();
-        if super::mat_file::is_mat_path(path) {
+        if is_mat_path(path) {
             let err = |kind| ControllerError { file: path.to_path_buf(), kind };
             let bytes = crate::input::read_capped(path, crate::input::MAX_CONTROLLER_BYTES, "controller file")
                 .map_err(|e| err(ControllerErrorKind::Io(e)))?;
-            return super::mat_file::controller_from_mat(&bytes).map_err(err);
+            return controller_from_mat(&bytes).map_err(err);
         }
         let text = crate::input::read_capped_string(path, crate::input::MAX_CONTROLLER_BYTES, "controller file")
             .map_err(|e| ControllerError { file: path.to_path_buf(), kind: ControllerErrorKind::Io(e) })?;
@@ -184,8 +185,8 @@ impl Controller {
     /// `.mat`, else pretty JSON. Written to `<path>.tmp` and renamed, so no reader sees half a file.
     pub fn save(&self, path: impl AsRef<Path>) -> std::io::Result<()> {
         let path = path.as_ref();
-        let bytes = if super::mat_file::is_mat_path(path) {
-            super::mat_file::controller_to_mat(self)
+        let bytes = if is_mat_path(path) {
+            controller_to_mat(self)
         } else {
             (serde_json::to_string_pretty(&self.to_json()).map_err(std::io::Error::other)? + "\n").into_bytes()
         };
@@ -225,6 +226,33 @@ impl Controller {
         (self.order() + self.outputs()) * (self.order() + self.inputs())
     }
 }
+
+// The MAT-file form (`lti::mat_file` reads and writes the variables).
+
+/// Reads a controller from the bytes of a MAT-file holding `AK BK CK DK` (AK, BK, CK may be
+/// empty for a static gain). Shapes are checked as for a controller JSON file.
+fn controller_from_mat(bytes: &[u8]) -> Result<Controller, ControllerErrorKind> {
+    let vars = read_mat_vars(bytes)?;
+    let mut doc = Map::new();
+    for key in ["AK", "BK", "CK", "DK"] {
+        let Some(v) = vars.get(key) else { continue };
+        if let Some(i) = v.data.iter().position(|x| !x.is_finite()) {
+            let (row, col) = (i % v.rows + 1, i / v.rows + 1);
+            let problem = MatrixJsonError::NotFinite { row, col, value: v.data[i] };
+            return Err(ControllerErrorKind::Matrix { matrix: key, problem });
+        }
+        doc.insert(key.into(), var_to_json(v));
+    }
+    // `[]` (a 0×0 AK, BK, CK of a static gain) is accepted for any block without entries.
+    Controller::from_json_value(&Value::Object(doc))
+}
+
+/// The controller as a MAT-file `AK BK CK DK`.
+pub fn controller_to_mat(k: &Controller) -> Vec<u8> {
+    let vars = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
+    write_mat(&vars, "hinfix controller (u = K y: xk' = AK xk + BK y, u = CK xk + DK y)")
+}
+
 
 #[cfg(test)]
 mod tests {

@@ -1,5 +1,7 @@
-//! MATLAB level-5 MAT-files: plants (`A B1 B2 C1 C2 D11 D12 D21 D22`) and controllers
-//! (`AK BK CK DK`) in and out, so a model can come from MATLAB (or `scipy.io.savemat`) and a
+//! MATLAB level-5 MAT-files as named real matrices: reading ([`read_mat_vars`]) and writing
+//! ([`write_mat`]). This module knows nothing of plants or controllers; `plant.rs` and
+//! `controller.rs` turn their variables (`A B1 B2 C1 C2 D11 D12 D21 D22`, `AK BK CK DK`) into
+//! plants and controllers, so a model can come from MATLAB (or `scipy.io.savemat`) and a
 //! designed controller go back.
 //!
 //! Reading uses the `matfile` crate (pure Rust; uncompressed and zlib-compressed variables; it
@@ -7,29 +9,14 @@
 //! Rust crate writes MAT-files, so [`write_mat`] is a minimal level-5 writer: a 128-byte header
 //! and one uncompressed `miMATRIX` element per variable (class `mxDOUBLE_CLASS`, 2-D, real),
 //! little-endian, following MathWorks' "MAT-File Format" (level 5) document. MATLAB, Octave and
-//! `scipy.io.loadmat` read it.
-//!
-//! A plant file is turned into the same JSON document a plant JSON file holds and validated by
-//! the same code, so the checks and the error messages are the same; `dims` is inferred from the
-//! blocks' sizes: n = rows of A, m1 = columns of B1 (else of D11 or D21), m2 = columns of B2 (else
-//! D12, D22), p1 = rows of C1 (else D11, D12), p2 = rows of C2 (else D21, D22). A variable with no
-//! entries (`[]`, or a 0-wide block) stands for a zero block of the size the others imply. The
-//! plant's name is the file's stem, or the character variable `name` when the file has one
-//! (read by this module, since `matfile` skips character arrays).
-//!
-//! Values are copied bit for bit: the same plant as `.mat` and as JSON is the same plant (same
-//! fingerprint, same job ids, same designs).
+//! `scipy.io.loadmat` read it. Values are copied bit for bit.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use faer::{Mat, MatRef};
-use serde_json::{Map, Value};
+use serde_json::Value;
 
-use super::controller::{Controller, ControllerErrorKind};
-use super::matrix_json::MatrixJsonError;
-// The plant variables in file order, with the dims their rows and columns give.
-use super::plant::{Plant, PlantErrorKind, MATRICES as PLANT_VARS};
 
 /// A real 2-D variable of a MAT-file, column-major.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,7 +46,8 @@ impl MatVar {
         MatVar { rows: m.nrows(), cols: m.ncols(), data }
     }
 
-    fn is_empty(&self) -> bool {
+    /// Whether the variable has no entries (`[]`, or a 0-wide block).
+    pub(crate) fn is_empty(&self) -> bool {
         self.rows == 0 || self.cols == 0
     }
 }
@@ -132,7 +120,7 @@ fn real_f64(d: &matfile::NumericData) -> Option<Vec<f64>> {
 /// The first character variable called `name` (uncompressed `mxCHAR_CLASS`, as MATLAB's `save`
 /// without compression and `scipy.io.savemat` write it), if any. Best effort: anything unexpected
 /// gives None and the caller falls back to the file stem.
-fn read_char_var(bytes: &[u8], wanted: &str) -> Option<String> {
+pub(crate) fn read_char_var(bytes: &[u8], wanted: &str) -> Option<String> {
     let u32_at = |i: usize| bytes.get(i..i + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
     if bytes.get(126..128) != Some(b"IM") {
         return None; // big-endian or not level 5: not worth supporting for an optional name
@@ -252,120 +240,15 @@ fn element(out: &mut Vec<u8>, ty: u32, data: &[u8]) {
     out.resize(out.len() + (8 - data.len() % 8) % 8, 0);
 }
 
-const PLANT_HINT: &str =
-    " (a plant .mat file holds A B1 B2 C1 C2 D11 D12 D21 D22 as real full numeric arrays; character, cell, struct and sparse variables are not read)";
-
-/// Infers one dimension from the first non-empty variable that carries it.
-fn infer(vars: &BTreeMap<String, MatVar>, dim: &str) -> usize {
-    for (key, r, c) in PLANT_VARS {
-        let Some(v) = vars.get(key).filter(|v| !v.is_empty()) else { continue };
-        if r == dim {
-            return v.rows;
-        }
-        if c == dim {
-            return v.cols;
-        }
-    }
-    0
-}
-
 /// A variable as a JSON array of rows.
-fn var_to_json(v: &MatVar) -> Value {
+pub(crate) fn var_to_json(v: &MatVar) -> Value {
     Value::Array(
         (0..v.rows).map(|i| Value::Array((0..v.cols).map(|j| json_number(v.data[i + j * v.rows])).collect())).collect(),
     )
 }
 
-fn json_number(x: f64) -> Value {
+pub(crate) fn json_number(x: f64) -> Value {
     serde_json::Number::from_f64(x).map(Value::Number).expect("finite values were checked")
-}
-
-fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind> {
-    let bad = |i: usize| {
-        let (row, col) = (i % v.rows + 1, i / v.rows + 1);
-        PlantErrorKind::Matrix {
-            matrix: name,
-            problem: MatrixJsonError::NotFinite { row, col, value: v.data[i] },
-            hint: String::new(),
-        }
-    };
-    match v.data.iter().position(|x| !x.is_finite()) {
-        Some(i) => Err(bad(i)),
-        None => Ok(()),
-    }
-}
-
-/// The JSON plant document a plant MAT-file stands for (validated by the caller with the JSON
-/// plant checks). `stem` names the plant when the file has no `name` variable.
-fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
-    let vars = read_mat_vars(bytes)?;
-    for (key, _, _) in PLANT_VARS {
-        match vars.get(key) {
-            None => {
-                return Err(PlantErrorKind::Matrix {
-                    matrix: key,
-                    problem: MatrixJsonError::Missing,
-                    hint: PLANT_HINT.into(),
-                })
-            }
-            Some(v) => first_non_finite(key, v)?,
-        }
-    }
-    let dims: BTreeMap<&str, usize> = ["n", "m1", "m2", "p1", "p2"].into_iter().map(|d| (d, infer(&vars, d))).collect();
-    let name = read_char_var(bytes, "name").filter(|s| !s.trim().is_empty()).unwrap_or_else(|| stem.to_string());
-    let mut doc = Map::new();
-    doc.insert("name".into(), name.into());
-    doc.insert("description".into(), format!("read from the MATLAB file {stem}.mat").into());
-    doc.insert("dims".into(), serde_json::to_value(&dims).expect("dims serialise"));
-    for (key, r, c) in PLANT_VARS {
-        let v = &vars[key];
-        let value = if v.is_empty() {
-            // an empty variable is a zero block of the inferred size
-            let (rows, cols) = (dims[r], dims[c]);
-            Value::Array((0..rows).map(|_| Value::Array(vec![json_number(0.0); cols])).collect())
-        } else {
-            var_to_json(v)
-        };
-        doc.insert(key.into(), value);
-    }
-    Ok(Value::Object(doc))
-}
-
-/// Reads a plant from the bytes of a MAT-file (see the module docs).
-pub(crate) fn plant_from_mat(bytes: &[u8], path: &Path) -> Result<Plant, PlantErrorKind> {
-    let stem = path.file_stem().map_or_else(|| "plant".to_string(), |s| s.to_string_lossy().into_owned());
-    Plant::from_json_value(&plant_document(bytes, &stem)?)
-}
-
-/// The plant as a MAT-file (the nine matrices; `name` is not written, the file stem names it).
-pub fn plant_to_mat(p: &Plant) -> Vec<u8> {
-    let names = PLANT_VARS.map(|(k, _, _)| k);
-    let vars: Vec<(&str, MatRef<'_, f64>)> = names.into_iter().zip(p.matrices()).collect();
-    write_mat(&vars, &format!("hinfix plant {}", p.name))
-}
-
-/// Reads a controller from the bytes of a MAT-file holding `AK BK CK DK` (AK, BK, CK may be
-/// empty for a static gain). Shapes are checked as for a controller JSON file.
-pub(crate) fn controller_from_mat(bytes: &[u8]) -> Result<Controller, ControllerErrorKind> {
-    let vars = read_mat_vars(bytes)?;
-    let mut doc = Map::new();
-    for key in ["AK", "BK", "CK", "DK"] {
-        let Some(v) = vars.get(key) else { continue };
-        if let Some(i) = v.data.iter().position(|x| !x.is_finite()) {
-            let (row, col) = (i % v.rows + 1, i / v.rows + 1);
-            let problem = MatrixJsonError::NotFinite { row, col, value: v.data[i] };
-            return Err(ControllerErrorKind::Matrix { matrix: key, problem });
-        }
-        doc.insert(key.into(), var_to_json(v));
-    }
-    // `[]` (a 0×0 AK, BK, CK of a static gain) is accepted for any block without entries.
-    Controller::from_json_value(&Value::Object(doc))
-}
-
-/// The controller as a MAT-file `AK BK CK DK`.
-pub fn controller_to_mat(k: &Controller) -> Vec<u8> {
-    let vars = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
-    write_mat(&vars, "hinfix controller (u = K y: xk' = AK xk + BK y, u = CK xk + DK y)")
 }
 
 /// Whether a path names a MAT-file (extension `.mat`, any case).

@@ -16,7 +16,7 @@ mod hinf;
 mod interrupt;
 mod level_set_pencil;
 mod lyapunov;
-pub mod mat_file;
+mod mat_file;
 mod matrix_json;
 mod plant;
 mod plant_library;
@@ -31,7 +31,7 @@ pub use balanced_truncation::{
 };
 pub use central_controller::{CentralError, CentralProblem, GAMMA_OPT_RTOL, START_REGULARISATION};
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
-pub use controller::{Controller, ControllerError, ControllerErrorKind};
+pub use controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};
 pub use error::LtiError;
 pub use full_order::{
     full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions, Regularisation,
@@ -49,7 +49,8 @@ pub use hinf::{
 pub use interrupt::{Interrupt, Interrupted};
 pub use lyapunov::{lyapunov_residual, solve_lyapunov, stable_antistable_basis, LyapunovError, LYAPUNOV_RESIDUAL_TOL};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
-pub use plant::{Dims, Plant, PlantError, PlantErrorKind};
+pub use mat_file::{is_mat_path, read_mat_vars, write_mat, MatReadError, MatVar};
+pub use plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::abscissa_of;

@@ -13,13 +13,15 @@
 //! are kept as provenance. [`Plant::from_json_str`] validates everything and names the file, the
 //! field and the row/column of the first thing wrong.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use faer::{Mat, MatRef};
 use serde::Serialize;
-use serde_json::Value;
+use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
+use super::mat_file::{json_number, read_char_var, read_mat_vars, var_to_json, write_mat, MatReadError, MatVar};
 use super::matrix_json::{json_shape, matrix_from_json, MatrixJsonError};
 
 /// Sizes of a generalised plant.
@@ -104,7 +106,7 @@ pub enum PlantErrorKind {
     },
     /// A `.mat` file that is not a readable level-5 MAT-file of real matrices.
     #[error("{0}")]
-    Mat(#[from] super::mat_file::MatReadError),
+    Mat(#[from] MatReadError),
     /// The document is not a JSON object.
     #[error("the top level must be a JSON object")]
     NotObject,
@@ -179,7 +181,7 @@ impl Plant {
             let err = |kind| PlantError { file: path.to_path_buf(), kind };
             let bytes = crate::input::read_capped(path, crate::input::MAX_PLANT_BYTES, "plant file")
                 .map_err(|e| err(PlantErrorKind::Io(e)))?;
-            return super::mat_file::plant_from_mat(&bytes, path).map_err(err);
+            return plant_from_mat(&bytes, path).map_err(err);
         }
         let text = crate::input::read_capped_string(path, crate::input::MAX_PLANT_BYTES, "plant file")
             .map_err(|e| PlantError { file: path.to_path_buf(), kind: PlantErrorKind::Io(e) })?;
@@ -343,3 +345,97 @@ fn read_dims(v: Option<&Value>) -> Result<Dims, PlantErrorKind> {
     };
     Ok(Dims { n: get("n", 1)?, m1: get("m1", 0)?, m2: get("m2", 1)?, p1: get("p1", 0)?, p2: get("p2", 1)? })
 }
+// ---------------------------------------------------------------------------------------------
+// The MAT-file form (`lti::mat_file` reads and writes the variables).
+//
+// A plant file is turned into the same JSON document a plant JSON file holds and validated by the
+// same code, so the checks and the error messages are the same; `dims` is inferred from the
+// blocks' sizes: n = rows of A, m1 = columns of B1 (else of D11 or D21), m2 = columns of B2 (else
+// D12, D22), p1 = rows of C1 (else D11, D12), p2 = rows of C2 (else D21, D22). A variable with no
+// entries (`[]`, or a 0-wide block) stands for a zero block of the size the others imply. The
+// plant's name is the file's stem, or the character variable `name` when the file has one. Values
+// are copied bit for bit: the same plant as `.mat` and as JSON is the same plant (same
+// fingerprint, same job ids, same designs).
+
+const PLANT_HINT: &str =
+    " (a plant .mat file holds A B1 B2 C1 C2 D11 D12 D21 D22 as real full numeric arrays; character, cell, struct and sparse variables are not read)";
+
+/// Infers one dimension from the first non-empty variable that carries it.
+fn infer(vars: &BTreeMap<String, MatVar>, dim: &str) -> usize {
+    for (key, r, c) in MATRICES {
+        let Some(v) = vars.get(key).filter(|v| !v.is_empty()) else { continue };
+        if r == dim {
+            return v.rows;
+        }
+        if c == dim {
+            return v.cols;
+        }
+    }
+    0
+}
+
+fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind> {
+    let bad = |i: usize| {
+        let (row, col) = (i % v.rows + 1, i / v.rows + 1);
+        PlantErrorKind::Matrix {
+            matrix: name,
+            problem: MatrixJsonError::NotFinite { row, col, value: v.data[i] },
+            hint: String::new(),
+        }
+    };
+    match v.data.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(bad(i)),
+        None => Ok(()),
+    }
+}
+
+/// The JSON plant document a plant MAT-file stands for (validated by the caller with the JSON
+/// plant checks). `stem` names the plant when the file has no `name` variable.
+fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
+    let vars = read_mat_vars(bytes)?;
+    for (key, _, _) in MATRICES {
+        match vars.get(key) {
+            None => {
+                return Err(PlantErrorKind::Matrix {
+                    matrix: key,
+                    problem: MatrixJsonError::Missing,
+                    hint: PLANT_HINT.into(),
+                })
+            }
+            Some(v) => first_non_finite(key, v)?,
+        }
+    }
+    let dims: BTreeMap<&str, usize> = ["n", "m1", "m2", "p1", "p2"].into_iter().map(|d| (d, infer(&vars, d))).collect();
+    let name = read_char_var(bytes, "name").filter(|s| !s.trim().is_empty()).unwrap_or_else(|| stem.to_string());
+    let mut doc = Map::new();
+    doc.insert("name".into(), name.into());
+    doc.insert("description".into(), format!("read from the MATLAB file {stem}.mat").into());
+    doc.insert("dims".into(), serde_json::to_value(&dims).expect("dims serialise"));
+    for (key, r, c) in MATRICES {
+        let v = &vars[key];
+        let value = if v.is_empty() {
+            // an empty variable is a zero block of the inferred size
+            let (rows, cols) = (dims[r], dims[c]);
+            Value::Array((0..rows).map(|_| Value::Array(vec![json_number(0.0); cols])).collect())
+        } else {
+            var_to_json(v)
+        };
+        doc.insert(key.into(), value);
+    }
+    Ok(Value::Object(doc))
+}
+
+/// Reads a plant from the bytes of a MAT-file (see the module docs).
+fn plant_from_mat(bytes: &[u8], path: &Path) -> Result<Plant, PlantErrorKind> {
+    let stem = path.file_stem().map_or_else(|| "plant".to_string(), |s| s.to_string_lossy().into_owned());
+    Plant::from_json_value(&plant_document(bytes, &stem)?)
+}
+
+/// The plant as a MAT-file (the nine matrices; `name` is not written, the file stem names it).
+pub fn plant_to_mat(p: &Plant) -> Vec<u8> {
+    let names = MATRICES.map(|(k, _, _)| k);
+    let vars: Vec<(&str, MatRef<'_, f64>)> = names.into_iter().zip(p.matrices()).collect();
+    write_mat(&vars, &format!("hinfix plant {}", p.name))
+}
+
+

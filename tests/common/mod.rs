@@ -192,3 +192,34 @@ pub fn sigma_direct(sys: &hinfix::lti::StateSpace, w: f64) -> f64 {
     });
     g.singular_values().unwrap().into_iter().fold(0.0, f64::max)
 }
+
+/// The test-only `campaign` binary with the fake runner (examples/fake_campaign.rs), which
+/// `cargo test` builds next to the test executables (target/<profile>/examples/). A test run
+/// with a target filter (`cargo test --test NAME`) does not build examples, so the binary may be
+/// missing, or older than the library it should contain: both fail here with what to run,
+/// instead of testing stale code.
+pub fn fake_campaign_bin() -> std::path::PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let deps = exe.parent().unwrap(); // target/<profile>/deps
+    let name = format!("fake_campaign{}", std::env::consts::EXE_SUFFIX);
+    let bin = deps.parent().unwrap().join("examples").join(name);
+    let build = "build it with `cargo build --release --example fake_campaign` (a plain `cargo test --release` does)";
+    let built = match std::fs::metadata(&bin).and_then(|m| m.modified()) {
+        Ok(t) => t,
+        Err(_) => panic!("{} is missing: {build}", bin.display()),
+    };
+    // The library it must contain: the newest hinfix rlib of this profile.
+    let newest_lib = std::fs::read_dir(deps)
+        .unwrap()
+        .flatten()
+        .filter(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.starts_with("libhinfix-") && n.ends_with(".rlib")
+        })
+        .filter_map(|e| e.metadata().and_then(|m| m.modified()).ok())
+        .max();
+    if let Some(lib) = newest_lib {
+        assert!(built >= lib, "{} is older than the hinfix library: {build}", bin.display());
+    }
+    bin
+}
