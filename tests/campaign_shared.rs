@@ -14,7 +14,6 @@ use hinfix::campaign::summarise;
 
 mod common;
 
-
 fn scratch(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hinfix-shared-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);

@@ -282,9 +282,10 @@ fn item3_campaign_check_calls_design_validate_before_any_job() {
     let dir = scratch("validate");
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [9]\n").unwrap();
-    let (code, _, err) = output(
-        &mut fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "1"),
-    );
+    let (code, _, err) = output(&mut fake_cli(
+        &["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"],
+        "1",
+    ));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("c.toml:4:10") && err.contains("order"), "{err}");
     assert!(!dir.join("r/t/runs.jsonl").exists());
@@ -368,11 +369,14 @@ fn slow_campaign(dir: &Path) -> PathBuf {
 
 fn spawn_slow(dir: &Path) -> std::process::Child {
     let f = slow_campaign(dir);
-    fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress", "--threads", "2"], "100")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap()
+    fake_cli(
+        &["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress", "--threads", "2"],
+        "100",
+    )
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap()
 }
 
 fn signal(child: &std::process::Child, sig: i32) {
@@ -418,11 +422,12 @@ fn item5_second_ctrl_c_stops_at_once() {
     let dir = scratch("sigint2");
     let f = slow_campaign(&dir);
     // A pause of 3 s per fake iteration: the first Ctrl-C would wait for it.
-    let child = fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "3000")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let child =
+        fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "3000")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
     wait_started(&dir);
     signal(&child, libc::SIGINT);
     std::thread::sleep(Duration::from_millis(100));
@@ -446,9 +451,10 @@ fn item6_hostile_names_reach_no_output_raw() {
     std::fs::write(dir.join("evil.json"), doc.to_string()).unwrap();
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"evil.json\"\norders = [1]\n").unwrap();
-    let (code, out, err) = output(
-        &mut fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "1"),
-    );
+    let (code, out, err) = output(&mut fake_cli(
+        &["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"],
+        "1",
+    ));
     assert_eq!(code, Some(0), "{err}");
     for (what, s) in [("stdout", out.as_str()), ("stderr", err.as_str())] {
         assert!(!s.contains('\u{1b}') && !s.contains('\u{0}'), "{what}: {s:?}");

@@ -5,9 +5,8 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Context;
-use crate::campaign::fake::FakeRunner;
 use crate::campaign::claims::{unix_now, ClaimDir};
+use crate::campaign::fake::FakeRunner;
 use crate::campaign::journal::{journals_in, Follower};
 use crate::campaign::progress::{Display, Reporter};
 use crate::campaign::record::JobRecord;
@@ -18,6 +17,7 @@ use crate::campaign::shard::{self, Shard};
 use crate::campaign::{
     expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
 };
+use anyhow::Context;
 
 use crate::campaign::sanitise::for_terminal;
 

@@ -15,10 +15,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
 };
+use anyhow::Context;
 use serde_json::{json, Value};
 
 /// Arguments of `campaign check`.

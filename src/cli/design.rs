@@ -14,13 +14,13 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 
-use anyhow::Context;
 use crate::design::{
     run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, DEFAULT_STALL_STARTS,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
 use crate::optim::RunControl;
+use anyhow::Context;
 
 use super::{fmt_num, signals, EXIT_NOT_STABILISED};
 use crate::campaign::sanitise::for_terminal;

@@ -1,11 +1,11 @@
 //! `campaign plants` (the library, one line each) and `campaign plant NAME` (one in detail).
 use std::process::ExitCode;
 
-use anyhow::Context;
 use crate::campaign::report::FULL_ORDER_MAX_N;
 use crate::campaign::sanitise::for_terminal as term;
 use crate::campaign::{load_default_reference, RefMethod};
 use crate::lti::{self, Plant};
+use anyhow::Context;
 use serde_json::{json, Value};
 
 /// Arguments of `campaign plants`.

@@ -253,7 +253,6 @@ pub fn controller_to_mat(k: &Controller) -> Vec<u8> {
     write_mat(&vars, "hinfix controller (u = K y: xk' = AK xk + BK y, u = CK xk + DK y)")
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

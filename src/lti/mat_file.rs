@@ -17,7 +17,6 @@ use std::path::Path;
 use faer::{Mat, MatRef};
 use serde_json::Value;
 
-
 /// A real 2-D variable of a MAT-file, column-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MatVar {

@@ -437,5 +437,3 @@ pub fn plant_to_mat(p: &Plant) -> Vec<u8> {
     let vars: Vec<(&str, MatRef<'_, f64>)> = names.into_iter().zip(p.matrices()).collect();
     write_mat(&vars, &format!("hinfix plant {}", p.name))
 }
-
-
