@@ -21,7 +21,7 @@ use std::path::PathBuf;
 use std::rc::Rc;
 
 use faer::Mat;
-use hinfix::design::objective::ComponentCache;
+use hinfix::design::ComponentCache;
 use hinfix::design::{
     controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase,
 };

@@ -4,7 +4,7 @@
 //! (tests/common/mod.rs, `fake_campaign_bin`). `cargo test` builds it; `cargo build` and
 //! `cargo install` do not. The pause between fake iterations is read from
 //! `HINFIX_FAKE_RUNNER` (milliseconds; default 20).
-use hinfix::campaign::fake::FakeRunner;
+use hinfix::campaign::FakeRunner;
 
 fn main() -> std::process::ExitCode {
     hinfix::cli::main_with(Some(FakeRunner::from_env()))

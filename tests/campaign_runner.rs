@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Duration;
 
-use hinfix::campaign::fake::FAKE_RUNNER_ENV;
-use hinfix::campaign::journal::read_journal;
+use hinfix::campaign::read_journal;
 use hinfix::campaign::summarise;
+use hinfix::campaign::FAKE_RUNNER_ENV;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

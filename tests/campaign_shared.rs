@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::Duration;
 
-use hinfix::campaign::fake::FAKE_RUNNER_ENV;
-use hinfix::campaign::journal::{journals_in, read_journal};
-use hinfix::campaign::record::JobRecord;
 use hinfix::campaign::summarise;
+use hinfix::campaign::JobRecord;
+use hinfix::campaign::FAKE_RUNNER_ENV;
+use hinfix::campaign::{journals_in, read_journal};
 
 mod common;
 

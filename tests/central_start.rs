@@ -3,7 +3,7 @@
 //! shipped plants.
 
 use faer::Mat;
-use hinfix::design::central_start::{central_starts, reduce};
+use hinfix::design::{central_starts, reduce_controller as reduce};
 use hinfix::lti::{
     closed_loop, hankel_singular_values, hinf_norm, lyapunov_residual, resolve_plant, solve_lyapunov,
     spectral_abscissa, CentralProblem, Plant, StateSpace,

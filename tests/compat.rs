@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use hinfix::campaign::journal::{read_journal, JournalWriter};
-use hinfix::campaign::trace::{iter_message, summarise, ITER_TOPIC, RESULT_TOPIC};
+use hinfix::campaign::{iter_message, summarise, ITER_TOPIC, RESULT_TOPIC};
+use hinfix::campaign::{read_journal, JournalWriter};
 use hinfix::design::{f64_from_json, DesignIterRecord, Phase};
 use hinfix::lti::Controller;
 use serde_json::Value;

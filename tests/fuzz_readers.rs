@@ -15,8 +15,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 
-use hinfix::campaign::journal::parse_journal;
-use hinfix::campaign::record::JobRecord;
+use hinfix::campaign::parse_journal;
+use hinfix::campaign::JobRecord;
 use hinfix::campaign::{expand, Campaign, RunnerTag};
 use hinfix::design::{validate, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats};
 use hinfix::lti::{Controller, Plant};

@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use faer::Mat;
-use hinfix::design::objective::{ComponentCache, MIN_ORDER_FOR_INTERRUPT};
+use hinfix::design::{ComponentCache, MIN_ORDER_FOR_INTERRUPT};
 use hinfix::design::{ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase, SearchStop};
 use hinfix::lti::{
     closed_loop, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, hinf_norm, hinf_norm_interruptible,

@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use hinfix::campaign::plot::render::{png_bytes, svg_text, SIZE};
+use hinfix::campaign::plot::{png_bytes, svg_text, SIZE};
 use hinfix::campaign::plot::{ConvergenceFigure, GammaOrderFigure};
-use hinfix::campaign::trace::TraceIteration;
+use hinfix::campaign::TraceIteration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
 

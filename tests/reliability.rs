@@ -5,10 +5,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use hinfix::campaign::fake::FAKE_RUNNER_ENV;
-use hinfix::campaign::journal::{parse_journal, read_journal, JournalError};
-use hinfix::campaign::record::{Certificate, JobRecord, JobStatus};
+use hinfix::campaign::FAKE_RUNNER_ENV;
 use hinfix::campaign::{best_per_order, expand, Campaign, PlantMap, RunnerTag};
+use hinfix::campaign::{parse_journal, read_journal, JournalError};
+use hinfix::campaign::{Certificate, JobRecord, JobStatus};
 use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats};
 use hinfix::lti::Plant;
 use serde_json::Value;
@@ -118,7 +118,7 @@ fn same(a: f64, b: f64) -> bool {
 fn item1_non_finite_values_in_every_numeric_field_round_trip_through_the_journal() {
     let dir = scratch("nonfinite");
     let path = dir.join("runs.jsonl");
-    let (mut w, _) = hinfix::campaign::journal::JournalWriter::open(&path).unwrap();
+    let (mut w, _) = hinfix::campaign::JournalWriter::open(&path).unwrap();
     for x in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e300] {
         w.append(&all_floats(x)).unwrap();
     }
@@ -200,7 +200,7 @@ fn item1_old_journal_with_nulls_reads_and_a_corrupt_complete_last_line_is_not_de
     let good = serde_json::to_string(&all_floats(1.0)).unwrap();
     let text = format!("{good}\n{{\"schema_version\": 1, \"broken\": true}}\n");
     std::fs::write(&path, &text).unwrap();
-    match hinfix::campaign::journal::JournalWriter::open(&path) {
+    match hinfix::campaign::JournalWriter::open(&path) {
         Err(JournalError::Corrupt { line: 2, .. }) => {}
         other => panic!("expected a corrupt-line error for line 2, got {other:?}"),
     }
@@ -351,7 +351,7 @@ fn big_plant(dir: &Path, n: usize) -> PathBuf {
 #[test]
 fn item4_full_order_gamma_is_skipped_above_the_documented_n() {
     let dir = scratch("bigplant");
-    let p = big_plant(&dir, hinfix::campaign::report::FULL_ORDER_MAX_N + 1);
+    let p = big_plant(&dir, hinfix::campaign::FULL_ORDER_MAX_N + 1);
     let (code, out, err) = output(&mut cli(&["plant", p.to_str().unwrap()]));
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("skipped: n = 61 > 60"), "{out}");

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use hinfix::campaign::latex::{compare_tex, sig4, sig_figs, tables_tex};
-use hinfix::campaign::reduce::BestRow;
-use hinfix::campaign::report::{compare_rows, FullOrderRow};
+use hinfix::campaign::BestRow;
+use hinfix::campaign::{compare_rows, FullOrderRow};
+use hinfix::campaign::{compare_tex, sig4, sig_figs, tables_tex};
 use hinfix::campaign::{load_reference, REFERENCE_CSV};
 
 mod common;

@@ -256,6 +256,7 @@ impl ClaimDir {
 
 impl ClaimGuard {
     /// The claim file.
+    #[cfg(test)]
     pub fn path(&self) -> &Path {
         &self.path
     }

@@ -89,11 +89,6 @@ pub fn records_by_id(records: Vec<JobRecord>) -> HashMap<JobId, JobRecord> {
     map
 }
 
-/// The records of `jobs`, in job order (jobs without a record are left out).
-pub fn records_of_jobs(jobs: &[Job], by_id: &HashMap<JobId, JobRecord>) -> Vec<JobRecord> {
-    jobs.iter().filter_map(|j| by_id.get(&j.id).cloned()).collect()
-}
-
 /// Every record (duplicates included) whose job is one of `jobs`.
 pub fn records_for(jobs: &[Job], records: &[JobRecord]) -> Vec<JobRecord> {
     let wanted: HashSet<&JobId> = jobs.iter().map(|j| &j.id).collect();

@@ -1,28 +1,34 @@
 //! The HIFOO method: fixed-order H∞ design with strong stabilisation (docs/ALGORITHMS.md §3, §8;
 //! Gumussoy, Millstone & Overton, CDC 2008).
 //!
-//! * [`params`]: x = [vec Ak; vec Bk; vec Ck; vec Dk] ↔ controller;
-//! * [`starts`]: seeded random starts, perturbations of an initial controller, warm-start padding;
-//! * [`central_start`]: reduced-order full-order-central-controller starts;
-//! * [`objective`]: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
+//! * `params`: x = [vec Ak; vec Bk; vec Ck; vec Dk] ↔ controller;
+//! * `starts`: seeded random starts, perturbations of an initial controller, warm-start padding;
+//! * `central_start`: reduced-order full-order-central-controller starts;
+//! * `objective`: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
 //!   observer adapter;
 //! * `phases`: the optimiser options of the two phases;
 //! * `search`: the multi-start search (local searches until a budget or the stall rule, basin
 //!   hopping, gradient sampling on the best point);
 //! * [`run`]: the entry point.
-pub mod central_start;
+//!
+//! The modules are crate-private; what is API is re-exported here.
+pub(crate) mod central_start;
 mod float_serde;
-pub mod objective;
+pub(crate) mod objective;
 mod options;
 mod outcome;
-pub mod params;
+pub(crate) mod params;
 mod phases;
 mod run;
 mod search;
-pub mod starts;
+pub(crate) mod starts;
 
+pub use central_start::{central_starts, reduce as reduce_controller, CENTRAL_MAX_STATES, CENTRAL_REGULARISATIONS};
 pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
-pub use objective::{Components, DesignObjective, ObjectivePhase};
+pub use objective::{
+    ComponentCache, Components, DesignObjective, ObjectivePhase, ObserverAdapter, COMPONENT_CACHE_LEN,
+    MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
+};
 pub use options::{
     DesignOptions, ObjectiveKind, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS,
     MAX_NRAND,

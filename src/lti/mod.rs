@@ -8,7 +8,7 @@ mod central_controller;
 mod closed_loop;
 mod controller;
 mod error;
-pub mod export;
+pub(crate) mod export;
 pub(crate) mod freq_response;
 mod full_order;
 mod gradient;
@@ -33,6 +33,7 @@ pub use central_controller::{CentralError, CentralProblem, GAMMA_OPT_RTOL, START
 pub use closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};
 pub use error::LtiError;
+pub use export::{export_code, ExportTarget};
 pub use full_order::{
     full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions, Regularisation,
     FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,

@@ -1,20 +1,20 @@
 //! Figures of a campaign (`campaign plot`): `<results>/<name>/plots/`, each figure as PNG and SVG.
 //!
-//! * `gamma-vs-order_<plant>` — [`gamma_order`]: our best verified γ per n_K, the paper's HIFOO
+//! * `gamma-vs-order_<plant>` — [`GammaOrderFigure`]: our best verified γ per n_K, the paper's HIFOO
 //!   values and the full-order bound;
-//! * `convergence_<plant>_nK<k>` — [`convergence`]: the objective of the best job of each
+//! * `convergence_<plant>_nK<k>` — [`ConvergenceFigure`]: the objective of the best job of each
 //!   (plant, order) against CPU time from its MCAP trace, phases and restarts marked;
-//! * `sigma_<plant>_nK<k>` — [`sigma`]: σmax of T_zw(iω) and of K(iω) for the best controller of
+//! * `sigma_<plant>_nK<k>` — [`SigmaFigure`]: σmax of T_zw(iω) and of K(iω) for the best controller of
 //!   each (plant, order), peak marked.
 //!
 //! Like the report files, the figures are pure functions of the journal, the traces, the plants
-//! and the reference table. Drawing is `plotters` with a bundled font ([`render`]), so nothing
+//! and the reference table. Drawing is `plotters` with a bundled font (`render.rs`), so nothing
 //! outside Rust crates is needed.
 
-pub mod convergence;
-pub mod gamma_order;
-pub mod render;
-pub mod sigma;
+pub(crate) mod convergence;
+pub(crate) mod gamma_order;
+pub(crate) mod render;
+pub(crate) mod sigma;
 
 use std::path::{Path, PathBuf};
 
@@ -28,7 +28,7 @@ use crate::lti::{Controller, Plant};
 
 pub use convergence::ConvergenceFigure;
 pub use gamma_order::GammaOrderFigure;
-pub use render::{write_by_extension, write_png_and_svg, Figure};
+pub use render::{png_bytes, svg_text, write_by_extension, write_png_and_svg, Figure, SIZE};
 pub use sigma::SigmaFigure;
 
 /// Errors making a figure, naming the file.
