@@ -134,8 +134,8 @@ fn main() {
                     let opts = DesignOptions { order: r.order, eps, seed, cpumax: a.cpumax, ..Default::default() };
                     let o = run(&p, &opts, None, &mut NoDesignObserver).expect("valid options");
                     runs += 1;
-                    cpu += o.cpu_s;
-                    evals += o.evals;
+                    cpu += o.design_cpu_s;
+                    evals += o.evaluations;
                     if usable(&o) && best.as_ref().is_none_or(|b| o.gamma < b.0) {
                         best = Some((o.gamma, eps, seed, o));
                     }
@@ -228,9 +228,9 @@ fn main() {
                     o.gamma,
                     published.map_or("-".into(), |g| format!("{:.4}", o.gamma / g)),
                     status,
-                    o.cpu_s,
-                    o.evals,
-                    1e3 * o.cpu_s / o.evals.max(1) as f64
+                    o.design_cpu_s,
+                    o.evaluations,
+                    1e3 * o.design_cpu_s / o.evaluations.max(1) as f64
                 );
             }
         }

@@ -186,13 +186,13 @@ fn design_ratio(name: &str, nk: usize, cpumax: f64) {
     let eig = dense_eig_seconds(size, if size > 300 { 9 } else { 31 });
     let opts = DesignOptions { order: nk, eps: 1e-3, seed: 1, cpumax, ..DesignOptions::default() };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let ms = o.cpu_s * 1e3 / o.evals as f64;
+    let ms = o.design_cpu_s * 1e3 / o.evaluations as f64;
     println!(
         "{name:<6} n={:<4} nK={nk} γ = {:<12.6} {:>6} evals {:>7.2} s {:>9.3} ms/eval   eig({size}) {:>8.3} ms   ratio {:>6.3}",
         p.dims.n,
         o.gamma,
-        o.evals,
-        o.cpu_s,
+        o.evaluations,
+        o.design_cpu_s,
         ms,
         eig * 1e3,
         ms / (eig * 1e3)

@@ -123,7 +123,7 @@ fn run_all(jobs: Vec<Job>, threads: usize) -> Vec<(Job, DesignOutcome)> {
                     o.search.starts,
                     o.search.best_start_label(),
                     o.search.cpu_to_best_s,
-                    o.cpu_s,
+                    o.design_cpu_s,
                     o.search.stop.name()
                 );
                 out.lock().unwrap().push((i, o));
@@ -169,7 +169,7 @@ fn paper(a: &Args) {
     let (mut ok_count, mut cpu_total) = (0, 0.0);
     for (name, order, published) in &entries {
         let mine: Vec<_> = done.iter().filter(|(j, _)| j.plant.name == *name && j.opts.order == *order).collect();
-        cpu_total += mine.iter().map(|(_, o)| o.cpu_s).sum::<f64>();
+        cpu_total += mine.iter().map(|(_, o)| o.design_cpu_s).sum::<f64>();
         let best = mine
             .iter()
             .filter_map(|(j, o)| verified_gamma(&j.plant, o).map(|g| (g, j, o)))
@@ -190,7 +190,7 @@ fn paper(a: &Args) {
                     o.search.starts,
                     o.search.best_start_label(),
                     o.search.cpu_to_best_s,
-                    o.cpu_s,
+                    o.design_cpu_s,
                     o.search.stop.name()
                 );
             }
@@ -229,7 +229,7 @@ fn singles(a: &Args) {
             o.search.starts,
             o.search.best_start_label(),
             o.search.cpu_to_best_s,
-            o.cpu_s,
+            o.design_cpu_s,
             o.search.stop.name(),
             o.status
         );
@@ -309,7 +309,7 @@ fn random(a: &Args) {
         let (go, gn) = (go.unwrap_or(f64::INFINITY), gn.unwrap_or(f64::INFINITY));
         at_or_below += (gn <= go) as usize;
         better1 += (gn < go / 1.01) as usize;
-        println!("{tag:<22} {go:>12.5} {gn:>12.5} {:>9.4} {:>8.1} {:>8.1}", gn / go, oo.cpu_s, on.cpu_s);
+        println!("{tag:<22} {go:>12.5} {gn:>12.5} {:>9.4} {:>8.1} {:>8.1}", gn / go, oo.design_cpu_s, on.design_cpu_s);
     }
     println!(
         "# random: {entries} entries with a stabilising controller; new ≤ old on {at_or_below}, better by > 1 % on {better1}; {both_unstable} not stabilised by either"

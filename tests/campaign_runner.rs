@@ -135,7 +135,8 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     }
     let recs = read_journal(&t.join("runs.jsonl")).unwrap().records;
     assert_eq!(recs.len(), 1);
-    assert!(recs[0].gamma <= 1.134 * 1.01, "γ = {}", recs[0].gamma);
+    let designed = recs[0].outcome().expect("the job was designed");
+    assert!(designed.gamma <= 1.134 * 1.01, "γ = {}", designed.gamma);
     let traces: Vec<_> = std::fs::read_dir(t.join("traces")).unwrap().map(|e| e.unwrap().path()).collect();
     assert_eq!(traces.len(), 1);
     assert_eq!(traces[0].extension().unwrap(), "mcap");
@@ -143,14 +144,14 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     // The trace counts steps as the journal does (issue 15: 3 313 against 3 306); the starting
     // points of every local search (f_s and f_h) and of the final gradient sampling are extra
     // messages.
-    let search = recs[0].search.clone().expect("the record has its search summary");
+    let search = designed.search.clone();
     let slack = 2 * search.starts + 4;
-    assert_eq!(s.iterations, recs[0].iterations);
+    assert_eq!(s.iterations, designed.iterations);
     assert!(
-        s.messages > s.iterations && s.messages <= recs[0].iterations + slack,
+        s.messages > s.iterations && s.messages <= designed.iterations + slack,
         "{} vs {}",
         s.messages,
-        recs[0].iterations
+        designed.iterations
     );
     assert_eq!(s.search.as_ref(), Some(&search));
     assert!(search.starts >= 3 && search.best_start < search.starts, "{search:?}");

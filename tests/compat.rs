@@ -1,13 +1,14 @@
 //! Files of older builds stay readable (tests/fixtures/compat/README.md): a journal line and the
 //! messages of a trace written at commit 2980e60, before ‖Tzw‖∞ / ‖K‖∞ were named `gamma` /
-//! `k_hinf` everywhere (the trace's iteration messages said `hinf_cl` / `hinf_k`).
+//! `k_hinf` everywhere (the trace's iteration messages said `hinf_cl` / `hinf_k`), and a journal
+//! of commit 8ee3691, the last schema-1 build, with one job of each status.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use hinfix::campaign::{iter_message, summarise, ITER_TOPIC, RESULT_TOPIC};
-use hinfix::campaign::{read_journal, JournalWriter};
-use hinfix::design::{f64_from_json, DesignIterRecord, Phase};
+use hinfix::campaign::{read_journal, JobRecord, JobStatus, JournalWriter, SCHEMA_VERSION};
+use hinfix::design::{f64_from_json, DesignIterRecord, Phase, SearchStop};
 use hinfix::lti::Controller;
 use serde_json::Value;
 
@@ -15,8 +16,61 @@ fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/compat").join(name)
 }
 
+/// Keys of a designed job's outcome in a journal line (a failed job's line of schema 2 has only
+/// its `status`).
+const OUTCOME_KEYS: &[&str] = &[
+    "controller",
+    "gamma",
+    "k_hinf",
+    "alpha_cl",
+    "alpha_k",
+    "objective",
+    "controller_norm_active",
+    "certificate",
+    "iterations",
+    "evaluations",
+    "phases",
+    "design_cpu_s",
+    "search",
+];
+
+/// `got` equals `want`, key by key (the message names the first key that differs).
+fn assert_same_object(got: &Value, want: &Value, what: &str) {
+    let (g, w) = (got.as_object().unwrap(), want.as_object().unwrap());
+    for (k, v) in w {
+        assert_eq!(g.get(k), Some(v), "{what}: key {k}");
+    }
+    for k in g.keys() {
+        assert!(w.contains_key(k), "{what}: extra key {k}");
+    }
+}
+
+/// `record` written again, as JSON.
+fn rewritten(record: &JobRecord) -> Value {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("runs.jsonl");
+    let (mut w, _) = JournalWriter::open(&out).unwrap();
+    w.append(record).unwrap();
+    drop(w);
+    serde_json::from_str(std::fs::read_to_string(&out).unwrap().trim_end()).unwrap()
+}
+
+/// What a schema-1 line becomes when written again: the same object with `schema_version` 2,
+/// and for a failed job without the outcome keys (schema 1 wrote NaN, null and zeros there).
+fn as_schema_2(old: &Value) -> Value {
+    let mut v = old.clone();
+    let o = v.as_object_mut().unwrap();
+    o.insert("schema_version".into(), Value::from(SCHEMA_VERSION));
+    if old["status"]["kind"] == "failed" {
+        for k in OUTCOME_KEYS {
+            o.remove(*k);
+        }
+    }
+    v
+}
+
 /// The old journal line reads, its figures and controller are there, and writing the record
-/// again gives the same JSON (the journal format did not change with the typed controller).
+/// again gives the same JSON but for the schema version (a designed job's line did not change).
 #[test]
 fn journal_line_of_2980e60_reads_and_rewrites_identically() {
     let path = fixture("journal-2980e60.jsonl");
@@ -26,19 +80,107 @@ fn journal_line_of_2980e60_reads_and_rewrites_identically() {
     assert!(read.torn.is_none());
     assert_eq!(read.records.len(), 1);
     let r = &read.records[0];
-    assert_eq!(r.gamma, want["gamma"].as_f64().unwrap());
-    assert_eq!(r.k_hinf, want["k_hinf"].as_f64().unwrap());
-    assert!(r.gamma > 0.12 && r.gamma < 0.13, "HE1 n_K = 1: γ ≈ 0.1245, got {}", r.gamma);
-    let k = Controller::from_json_value(r.controller.as_ref().unwrap()).unwrap();
+    let o = r.outcome().unwrap();
+    assert_eq!(o.gamma, want["gamma"].as_f64().unwrap());
+    assert_eq!(o.k_hinf, want["k_hinf"].as_f64().unwrap());
+    assert!(o.gamma > 0.12 && o.gamma < 0.13, "HE1 n_K = 1: γ ≈ 0.1245, got {}", o.gamma);
+    let k = r.controller().unwrap();
     assert_eq!((k.order(), k.outputs(), k.inputs()), (1, 2, 1));
+    assert_eq!(want["schema_version"], 1);
+    assert_same_object(&rewritten(r), &as_schema_2(&want), "2980e60");
+}
 
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("runs.jsonl");
-    let (mut w, _) = JournalWriter::open(&out).unwrap();
-    w.append(r).unwrap();
-    drop(w);
-    let got: Value = serde_json::from_str(std::fs::read_to_string(&out).unwrap().trim_end()).unwrap();
-    assert_eq!(got, want);
+/// The journal of commit 8ee3691 (schema 1; tests/fixtures/compat/README.md): the smoke
+/// campaign and one job of each further status, a failed one included. Every line reads to the
+/// values it holds, and writes back as schema 2.
+#[test]
+fn journal_of_8ee3691_reads_every_status_to_the_same_values() {
+    let path = fixture("journal-8ee3691.jsonl");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let read = read_journal(&path).unwrap();
+    assert!(read.torn.is_none());
+    assert_eq!(read.records.len(), 28);
+    let mut kinds = BTreeMap::new();
+    for (line, r) in text.lines().zip(&read.records) {
+        let want: Value = serde_json::from_str(line).unwrap();
+        assert_eq!(want["schema_version"], 1);
+        let kind = want["status"]["kind"].as_str().unwrap();
+        *kinds.entry(kind.to_string()).or_insert(0) += 1;
+        assert_eq!(r.status().kind(), kind);
+        assert_eq!(r.job_id.0, want["job_id"].as_str().unwrap());
+        match r.outcome() {
+            None => {
+                assert_eq!(kind, "failed");
+                assert!(r.failed() && r.controller().is_none());
+                let JobStatus::Failed { error } = r.status() else { panic!("{line}") };
+                assert_eq!(error, want["status"]["error"].as_str().unwrap());
+            }
+            Some(o) => {
+                for (got, key) in
+                    [(o.gamma, "gamma"), (o.k_hinf, "k_hinf"), (o.alpha_cl, "alpha_cl"), (o.objective, "objective")]
+                {
+                    assert_eq!(got.to_bits(), f64_from_json(&want[key]).to_bits(), "{key}: {line}");
+                }
+                assert_eq!(o.iterations as u64, want["iterations"].as_u64().unwrap());
+                assert_eq!(o.evaluations as u64, want["evaluations"].as_u64().unwrap());
+                assert_eq!(o.design_cpu_s, want["design_cpu_s"].as_f64().unwrap());
+                assert_eq!(o.certificate.is_some(), !want["certificate"].is_null());
+                assert_eq!(o.controller, Controller::from_json_value(&want["controller"]).unwrap());
+                assert_eq!(serde_json::to_value(&o.search).unwrap(), want["search"]);
+            }
+        }
+        let again = rewritten(r);
+        assert_same_object(&again, &as_schema_2(&want), line);
+        if kind == "failed" {
+            assert!(OUTCOME_KEYS.iter().all(|k| again.get(*k).is_none()), "{again}");
+        }
+        // the schema-2 line reads back to the same record
+        let back: JobRecord = serde_json::from_value(again.clone()).unwrap();
+        assert_eq!(back.status(), r.status());
+        assert_same_object(&rewritten(&back), &again, line);
+    }
+    let got: Vec<(&str, i32)> = kinds.iter().map(|(k, n)| (k.as_str(), *n)).collect();
+    assert_eq!(got, [("budget_exhausted", 2), ("converged", 18), ("failed", 1), ("not_stabilised", 1), ("stopped", 6)]);
+}
+
+/// `campaign report` on the 8ee3691 journal writes the tables that build wrote (best.csv and
+/// compare.csv, stored next to the journal): reading the old format changes no result.
+#[test]
+fn report_on_the_journal_of_8ee3691_gives_its_tables() {
+    let journal = fixture("journal-8ee3691.jsonl");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (campaign, name) in [(root.join("campaigns/smoke.toml"), "smoke"), (fixture("kinds.toml"), "kinds")] {
+        let results = tempfile::tempdir().unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_campaign"))
+            .arg("report")
+            .arg(&campaign)
+            .arg("--results")
+            .arg(results.path())
+            .arg("--journal")
+            .arg(&journal)
+            .env("HINFIX_PLANTS", root.join("plants"))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        for table in ["best", "compare"] {
+            let got = std::fs::read_to_string(results.path().join(name).join(format!("{table}.csv"))).unwrap();
+            let want = std::fs::read_to_string(fixture(&format!("{table}-{name}-8ee3691.csv"))).unwrap();
+            assert_eq!(got, want, "{name}: {table}.csv");
+        }
+    }
+}
+
+/// A designed job's line from before the search summary existed (06018b1) reads, its search
+/// marked as not recorded.
+#[test]
+fn a_line_without_search_summary_reads_as_not_recorded() {
+    let text = std::fs::read_to_string(fixture("journal-2980e60.jsonl")).unwrap();
+    let mut v: Value = serde_json::from_str(&text).unwrap();
+    v.as_object_mut().unwrap().remove("search");
+    let r: JobRecord = serde_json::from_value(v).unwrap();
+    let o = r.outcome().unwrap();
+    assert_eq!(o.search.stop, SearchStop::NotRecorded);
+    assert!(o.gamma > 0.12 && o.gamma < 0.13);
 }
 
 /// Writes `messages` (topic, JSON bytes) into a new MCAP file, the way the trace writer does.

@@ -50,8 +50,8 @@ fn he1_order1_reaches_the_published_gamma() {
     assert!(o.gamma <= 0.1235 * 1.01, "γ = {}", o.gamma);
     check_recomputed(&p, &o);
     let cpu: f64 = o.phases.iter().map(|s| s.cpu_s).sum();
-    assert!(cpu <= o.cpu_s + 1e-9);
-    assert_eq!(o.evals, o.phases.iter().map(|s| s.evals).sum::<usize>());
+    assert!(cpu <= o.design_cpu_s + 1e-9);
+    assert_eq!(o.evaluations, o.phases.iter().map(|s| s.evals).sum::<usize>());
 }
 
 /// A plant with an unstable mode (λ = 1) that u cannot reach: no controller stabilises it.
@@ -136,7 +136,7 @@ fn same_seed_gives_the_same_controller_bits() {
         controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect::<Vec<_>>()
     };
     assert_eq!(bits(&a), bits(&b));
-    assert_eq!(a.evals, b.evals);
+    assert_eq!(a.evaluations, b.evaluations);
     let c = run(&p, &DesignOptions { seed: 3, ..opts }, None, &mut NoDesignObserver).unwrap();
     assert_ne!(bits(&a), bits(&c));
 }
@@ -221,7 +221,7 @@ fn tiny_budget_is_honoured() {
     let opts = DesignOptions { order: 2, eps: 1e-3, seed: 0, cpumax: 0.05, ..Default::default() };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     // one evaluation of HE1 takes well under 10 ms
-    assert!(o.cpu_s < 0.05 + 0.1, "cpu {}", o.cpu_s);
+    assert!(o.design_cpu_s < 0.05 + 0.1, "cpu {}", o.design_cpu_s);
     assert!(matches!(o.status, DesignStatus::BudgetExhausted | DesignStatus::NotStabilised { .. }), "{:?}", o.status);
 }
 
@@ -238,7 +238,7 @@ fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 5, cpumax: 1e6, maxevals: Some(4000), ..Default::default() };
     let alone = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     assert_eq!(alone.search.stop, SearchStop::Maxevals, "{:?}", alone.search);
-    assert!(alone.evals <= 4000 + 2, "{} evaluations", alone.evals);
+    assert!(alone.evaluations <= 4000 + 2, "{} evaluations", alone.evaluations);
     assert!(alone.search.starts > opts.nrand, "{:?}", alone.search);
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let load: Vec<_> = (0..2)
@@ -264,8 +264,8 @@ fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
     for o in &both {
         assert_eq!(bits(o), bits(&alone));
         assert_eq!(
-            (o.evals, o.iters, &o.search.stop, o.search.starts, o.search.best_start),
-            (alone.evals, alone.iters, &alone.search.stop, alone.search.starts, alone.search.best_start)
+            (o.evaluations, o.iterations, &o.search.stop, o.search.starts, o.search.best_start),
+            (alone.evaluations, alone.iterations, &alone.search.stop, alone.search.starts, alone.search.best_start)
         );
         assert_eq!(o.search.evals_to_best, alone.search.evals_to_best);
     }
@@ -289,6 +289,6 @@ fn continued_search_is_never_worse_than_the_first_starts_and_is_recorded() {
     check_recomputed(&p, &more);
     let s = &more.search;
     assert!(s.best_start < 15);
-    assert!(s.evals_to_best >= 1 && s.evals_to_best <= more.evals, "{s:?}");
-    assert!(s.cpu_to_best_s >= 0.0 && s.cpu_to_best_s <= more.cpu_s, "{s:?}");
+    assert!(s.evals_to_best >= 1 && s.evals_to_best <= more.evaluations, "{s:?}");
+    assert!(s.cpu_to_best_s >= 0.0 && s.cpu_to_best_s <= more.design_cpu_s, "{s:?}");
 }

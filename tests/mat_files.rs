@@ -62,7 +62,7 @@ fn same_plant_as_mat_and_json_gives_bit_identical_designs() {
     let b = run(&mat, &opts, None, &mut NoDesignObserver).unwrap();
     assert_eq!(a.controller, b.controller);
     assert_eq!(a.gamma.to_bits(), b.gamma.to_bits());
-    assert_eq!((a.iters, a.evals), (b.iters, b.evals));
+    assert_eq!((a.iterations, a.evaluations), (b.iterations, b.evaluations));
 }
 
 #[test]

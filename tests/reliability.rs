@@ -8,8 +8,10 @@ use std::time::{Duration, Instant};
 use hinfix::campaign::FAKE_RUNNER_ENV;
 use hinfix::campaign::{best_per_order, expand, Campaign, PlantMap, RunnerTag};
 use hinfix::campaign::{parse_journal, read_journal, JournalError};
-use hinfix::campaign::{Certificate, JobRecord, JobStatus};
-use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats};
+use hinfix::campaign::{JobRecord, JobStatus};
+use hinfix::design::{
+    run, Certificate, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats,
+};
 use hinfix::lti::Plant;
 use serde_json::Value;
 
@@ -72,12 +74,11 @@ fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
         alpha_k: Some(x),
         objective: x,
         controller_norm_active: false,
-        dnorm: Some(x),
-        evaldist: Some(x),
+        certificate: Some(Certificate { dnorm: x, evaldist: x }),
+        iterations: 1,
+        evaluations: 1,
         phases: vec![PhaseStats { phase: Phase::Optimisation, iters: 1, evals: 1, cpu_s: x }],
-        iters: 1,
-        evals: 1,
-        cpu_s: x,
+        design_cpu_s: x,
         search: hinfix::design::SearchSummary {
             starts: 1,
             best_start: 0,
@@ -102,8 +103,6 @@ fn all_floats(x: f64) -> JobRecord {
     r.options.hinf_tol = x;
     r.options.normtol = x;
     r.options.evaldist = x;
-    r.certificate = Some(Certificate { dnorm: x, evaldist: x });
-    r.design_cpu_s = x;
     r.cpu_s = x;
     r.wall_s = x;
     r.finished_unix_s = x;
@@ -132,30 +131,31 @@ fn item1_non_finite_values_in_every_numeric_field_round_trip_through_the_journal
     assert!(read.torn.is_none());
     assert_eq!(read.records.len(), 4);
     for (r, x) in read.records.iter().zip([f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e300]) {
+        let o = r.outcome().unwrap();
         for (name, v) in [
             ("eps", r.eps),
             ("cpumax", r.cpumax),
-            ("gamma", r.gamma),
-            ("k_hinf", r.k_hinf),
-            ("alpha_cl", r.alpha_cl),
-            ("alpha_k", r.alpha_k.unwrap()),
-            ("objective", r.objective),
-            ("dnorm", r.certificate.as_ref().unwrap().dnorm),
-            ("evaldist", r.certificate.as_ref().unwrap().evaldist),
+            ("gamma", o.gamma),
+            ("k_hinf", o.k_hinf),
+            ("alpha_cl", o.alpha_cl),
+            ("alpha_k", o.alpha_k.unwrap()),
+            ("objective", o.objective),
+            ("dnorm", o.certificate.as_ref().unwrap().dnorm),
+            ("evaldist", o.certificate.as_ref().unwrap().evaldist),
             ("options.eps", r.options.eps),
             ("options.cpumax", r.options.cpumax),
             ("options.hinf_tol", r.options.hinf_tol),
             ("options.normtol", r.options.normtol),
             ("options.evaldist", r.options.evaldist),
-            ("phases.cpu_s", r.phases[0].cpu_s),
-            ("design_cpu_s", r.design_cpu_s),
+            ("phases.cpu_s", o.phases[0].cpu_s),
+            ("design_cpu_s", o.design_cpu_s),
             ("cpu_s", r.cpu_s),
             ("wall_s", r.wall_s),
             ("finished_unix_s", r.finished_unix_s),
         ] {
             assert!(same(v, x), "{name}: wrote {x}, read {v}");
         }
-        match &r.status {
+        match &r.status() {
             JobStatus::Design(DesignStatus::NotStabilised { best_alpha }) => assert!(same(*best_alpha, x)),
             s => panic!("{s:?}"),
         }
@@ -181,7 +181,7 @@ fn item1_every_float_field_of_a_record_takes_the_string_form_and_null() {
         let mut v = base.clone();
         replace_floats(&mut v, &with);
         let r: JobRecord = serde_json::from_value(v).unwrap_or_else(|e| panic!("{with}: {e}"));
-        assert!(!r.gamma.is_finite() && !r.options.cpumax.is_finite() && !r.wall_s.is_finite());
+        assert!(!r.outcome().unwrap().gamma.is_finite() && !r.options.cpumax.is_finite() && !r.wall_s.is_finite());
     }
 }
 
@@ -193,7 +193,7 @@ fn item1_old_journal_with_nulls_reads_and_a_corrupt_complete_last_line_is_not_de
     let line = v.to_string();
     let read = parse_journal(format!("{line}\n").as_bytes(), Path::new("runs.jsonl")).unwrap();
     assert_eq!(read.records.len(), 1);
-    assert!(read.records[0].objective.is_nan());
+    assert!(read.records[0].outcome().unwrap().objective.is_nan());
 
     let dir = scratch("corrupt-last");
     let path = dir.join("runs.jsonl");
@@ -546,7 +546,7 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
     assert_eq!(v["status"]["kind"], "converged");
     v["status"]["kind"] = Value::from("optimised");
     let old: JobRecord = serde_json::from_value(v).unwrap();
-    assert_eq!(old.status, JobStatus::Design(DesignStatus::Stopped));
+    assert_eq!(old.status(), JobStatus::Design(DesignStatus::Stopped));
     let d: DesignStatus = serde_json::from_str(r#"{"kind": "optimised"}"#).unwrap();
     assert_eq!(d, DesignStatus::Stopped);
 
@@ -557,8 +557,8 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
             DesignOptions { order: 1, seed: 1, cpumax: 20.0, maxit, gradient_sampling: false, ..Default::default() };
         let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
         match o.status {
-            DesignStatus::Converged => assert!(o.dnorm.unwrap() <= opts.normtol, "{o:?}"),
-            DesignStatus::Stopped => assert!(o.dnorm.unwrap() > opts.normtol, "{o:?}"),
+            DesignStatus::Converged => assert!(o.certificate.as_ref().unwrap().dnorm <= opts.normtol, "{o:?}"),
+            DesignStatus::Stopped => assert!(o.certificate.as_ref().unwrap().dnorm > opts.normtol, "{o:?}"),
             DesignStatus::StabilisedOnly => {}
             s => panic!("maxit {maxit}: {s:?}"),
         }

@@ -18,8 +18,8 @@ use sha2::{Digest, Sha256};
 use super::jobs::{Job, RunnerTag};
 use super::scheduler::JobRunner;
 use crate::design::{
-    DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats, SearchStop,
-    SearchSummary,
+    Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats,
+    SearchStop, SearchSummary,
 };
 use crate::lti::Controller;
 
@@ -118,12 +118,11 @@ impl JobRunner for FakeRunner {
             alpha_k: (job.options.order > 0).then_some(-1.0),
             objective: gamma,
             controller_norm_active: false,
-            dnorm: Some(1e-4),
-            evaldist: Some(job.options.evaldist),
+            certificate: Some(Certificate { dnorm: 1e-4, evaldist: job.options.evaldist }),
+            iterations: iters,
+            evaluations: iters,
             phases: vec![PhaseStats { phase: Phase::Optimisation, iters, evals: iters, cpu_s: 0.0 }],
-            iters,
-            evals: iters,
-            cpu_s: 0.0,
+            design_cpu_s: 0.0,
             search: SearchSummary {
                 starts: 1,
                 best_start: 0,

@@ -107,9 +107,9 @@ impl<'a> Reporter<'a> {
                 self.line(format!(
                     "done   {}  {}  γ = {:.6}  ‖K‖∞ = {:.4}  {:.1} s",
                     self.label(*index),
-                    record.status.kind(),
-                    record.gamma,
-                    record.k_hinf,
+                    record.status().kind(),
+                    record.outcome().map_or(f64::NAN, |o| o.gamma),
+                    record.outcome().map_or(f64::NAN, |o| o.k_hinf),
                     record.cpu_s
                 ));
                 if let Some(b) = self.workers.get(*worker) {

@@ -5,12 +5,14 @@ use serde::{Deserialize, Serialize};
 
 use super::jobs::{Job, JobId, RunnerTag};
 use super::provenance::Provenance;
-use crate::design::{
-    serde_f64_or_string, serde_opt_f64_or_string, DesignOptions, DesignOutcome, DesignStatus, PhaseStats, SearchSummary,
-};
+use crate::design::{serde_f64_or_string, DesignOptions, DesignOutcome, DesignStatus};
+use crate::lti::Controller;
+use serde::ser::SerializeMap;
 
 /// Version of the journal line format. Readers refuse newer versions.
-pub const SCHEMA_VERSION: u32 = 1;
+/// 2: a failed job's line carries no outcome fields (schema 1 wrote them as NaN, `null` and
+/// zeros). Lines of schema 1 and 2 are read.
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// How a journaled job ended: the design run's own [`DesignStatus`] (one definition of the
 /// statuses, their meaning and their journal names), or a failure. Never
@@ -76,21 +78,20 @@ impl JobStatus {
     }
 }
 
-/// The optimality certificate of the final point.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Certificate {
-    /// Norm of the min-norm element of the gradient bundle.
-    #[serde(with = "serde_f64_or_string")]
-    pub dnorm: f64,
-    /// Bundle radius.
-    #[serde(with = "serde_f64_or_string")]
-    pub evaldist: f64,
-}
-
-/// One journal line.
+/// One journal line: the job (id, plant, every option, warm-start predecessor), how it ran
+/// (runner, CPU and wall seconds, provenance) and its result, the design run's own
+/// [`DesignOutcome`] or why it failed.
+///
+/// Journal form: one flat JSON object. The job's fields, then the result's: a designed job's
+/// outcome fields (`status`, `controller`, `gamma`, `k_hinf`, `alpha_cl`, `alpha_k`, `objective`,
+/// `controller_norm_active`, `certificate`, `iterations`, `evaluations`, `phases`,
+/// `design_cpu_s`, `search`) sit at the top level, as they always did; a failed job has only
+/// `"status": {"kind": "failed", "error": …}` ([`JobResult`] reads the lines of older builds).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct JobRecord {
-    /// [`SCHEMA_VERSION`].
+    /// The schema version of the line it was read from ([`SCHEMA_VERSION`] for a new record).
+    /// Always written as [`SCHEMA_VERSION`]: a record is written in this build's format.
+    #[serde(serialize_with = "write_current_schema")]
     pub schema_version: u32,
     /// The job's id.
     pub job_id: JobId,
@@ -107,7 +108,7 @@ pub struct JobRecord {
     pub eps: f64,
     /// Seed.
     pub seed: u64,
-    /// CPU budget (s).
+    /// CPU budget (CPU seconds).
     #[serde(with = "serde_f64_or_string")]
     pub cpumax: f64,
     /// Every design option (repeats order, eps, seed, cpumax).
@@ -119,42 +120,11 @@ pub struct JobRecord {
     /// Set only by the fake runner of the test hook.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runner: Option<String>,
-    /// How it ended.
-    pub status: JobStatus,
-    /// ‖Tzw‖∞ of the returned controller (as reported by the design run).
-    #[serde(with = "serde_f64_or_string")]
-    pub gamma: f64,
-    /// ‖K‖∞.
-    #[serde(with = "serde_f64_or_string")]
-    pub k_hinf: f64,
-    /// α(A_cl).
-    #[serde(with = "serde_f64_or_string")]
-    pub alpha_cl: f64,
-    /// α(Ak) (None for order 0 or failed jobs).
-    #[serde(default, with = "serde_opt_f64_or_string")]
-    pub alpha_k: Option<f64>,
-    /// Final objective value.
-    #[serde(with = "serde_f64_or_string")]
-    pub objective: f64,
-    /// ε‖K‖∞ is the active term of the objective (γ is held up by the controller-norm penalty).
-    #[serde(default)]
-    pub controller_norm_active: bool,
-    /// Certificate of the final point, if the optimisation ran.
-    pub certificate: Option<Certificate>,
-    /// Total iterations.
-    pub iterations: usize,
-    /// Total objective evaluations.
-    pub evaluations: usize,
-    /// Per-phase counters.
-    pub phases: Vec<PhaseStats>,
-    /// The multi-start search: starts made, the best one, CPU time to best, stop reason
-    /// (absent in journals written before it existed, and for failed jobs).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub search: Option<SearchSummary>,
-    /// CPU seconds as counted by the design run.
-    #[serde(with = "serde_f64_or_string")]
-    pub design_cpu_s: f64,
-    /// CPU seconds of the worker thread for the whole job.
+    /// How it ended: the design run's outcome, or the error.
+    #[serde(flatten)]
+    pub result: JobResult,
+    /// CPU seconds of the worker thread for the whole job (the design run's own count is the
+    /// outcome's `design_cpu_s`).
     #[serde(with = "serde_f64_or_string")]
     pub cpu_s: f64,
     /// Wall seconds of the whole job.
@@ -163,11 +133,59 @@ pub struct JobRecord {
     /// When it finished (Unix seconds).
     #[serde(with = "serde_f64_or_string")]
     pub finished_unix_s: f64,
-    /// The controller `{AK, BK, CK, DK}` (None for failed jobs).
-    pub controller: Option<serde_json::Value>,
     /// Where and with what it ran (absent in journals written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub provenance: Option<Provenance>,
+}
+
+fn write_current_schema<S: serde::Serializer>(_: &u32, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u32(SCHEMA_VERSION)
+}
+
+/// The result of a journaled job.
+#[derive(Debug, Clone)]
+pub enum JobResult {
+    /// `design::run` finished (never with [`DesignStatus::Interrupted`]: interrupted runs are not
+    /// journaled) and returned this.
+    Designed(Box<DesignOutcome>),
+    /// `design::run` returned an error (or panicked): no trustworthy result.
+    Failed {
+        /// The error.
+        error: String,
+    },
+}
+
+/// A designed job: the outcome's fields. A failed job: `{"status": {"kind": "failed", …}}`.
+impl Serialize for JobResult {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            JobResult::Designed(outcome) => outcome.serialize(s),
+            JobResult::Failed { error } => {
+                let mut m = s.serialize_map(Some(1))?;
+                m.serialize_entry("status", &JobStatus::Failed { error: error.clone() })?;
+                m.end()
+            }
+        }
+    }
+}
+
+/// The one place where journal lines of every version become a result. `status` decides:
+/// `failed` ignores the other outcome fields (builds before schema 2 wrote them as NaN, `null`
+/// and zeros); any other status reads the outcome ([`DesignOutcome`]'s field names are the
+/// journal's since its first version; `"optimised"` and a missing `search` read as its
+/// deserialiser says). `interrupted` is refused.
+impl<'de> Deserialize<'de> for JobResult {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let fields = serde_json::Map::<String, serde_json::Value>::deserialize(d)?;
+        let status = fields.get("status").ok_or_else(|| D::Error::missing_field("status"))?;
+        match JobStatus::deserialize(status).map_err(|e| D::Error::custom(format_args!("status: {e}")))? {
+            JobStatus::Failed { error } => Ok(JobResult::Failed { error }),
+            JobStatus::Design(_) => DesignOutcome::deserialize(serde_json::Value::Object(fields))
+                .map(|o| JobResult::Designed(Box::new(o)))
+                .map_err(D::Error::custom),
+        }
+    }
 }
 
 /// Keys whose values depend on timing, not on the computation.
@@ -185,8 +203,17 @@ impl JobRecord {
         cpu_s: f64,
         wall_s: f64,
     ) -> Option<JobRecord> {
+        let result = match result {
+            Err(error) => JobResult::Failed { error },
+            Ok(out) if out.status == DesignStatus::Interrupted => return None,
+            // A journal line must read back, and a controller is read only if it is finite.
+            Ok(out) if !out.controller.is_finite() => {
+                JobResult::Failed { error: "the design run returned a controller with a non-finite entry".into() }
+            }
+            Ok(out) => JobResult::Designed(Box::new(out)),
+        };
         let o = &job.options;
-        let mut r = JobRecord {
+        Some(JobRecord {
             schema_version: SCHEMA_VERSION,
             job_id: job.id.clone(),
             campaign: campaign.to_string(),
@@ -200,50 +227,14 @@ impl JobRecord {
             warm_from: job.warm_from.clone(),
             warm_started,
             runner: (job.runner == RunnerTag::Fake).then(|| "fake".to_string()),
-            status: JobStatus::Failed { error: String::new() },
-            gamma: f64::NAN,
-            k_hinf: f64::NAN,
-            alpha_cl: f64::NAN,
-            alpha_k: None,
-            objective: f64::NAN,
-            controller_norm_active: false,
-            certificate: None,
-            iterations: 0,
-            evaluations: 0,
-            phases: Vec::new(),
-            search: None,
-            design_cpu_s: 0.0,
+            result,
             cpu_s,
             wall_s,
             finished_unix_s: std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0.0, |d| d.as_secs_f64()),
-            controller: None,
             provenance: None,
-        };
-        match result {
-            Err(error) => r.status = JobStatus::Failed { error },
-            Ok(out) => {
-                r.status = JobStatus::of_design(out.status)?;
-                r.gamma = out.gamma;
-                r.k_hinf = out.k_hinf;
-                r.alpha_cl = out.alpha_cl;
-                r.alpha_k = out.alpha_k;
-                r.objective = out.objective;
-                r.controller_norm_active = out.controller_norm_active;
-                r.certificate = match (out.dnorm, out.evaldist) {
-                    (Some(dnorm), Some(evaldist)) => Some(Certificate { dnorm, evaldist }),
-                    _ => None,
-                };
-                r.iterations = out.iters;
-                r.evaluations = out.evals;
-                r.phases = out.phases;
-                r.search = Some(out.search);
-                r.design_cpu_s = out.cpu_s;
-                r.controller = Some(out.controller.to_json());
-            }
-        }
-        Some(r)
+        })
     }
 
     /// The record as JSON without the timing fields (also inside `phases`) and the provenance:
@@ -268,9 +259,30 @@ impl JobRecord {
         v
     }
 
+    /// The design run's outcome; `None` when the job failed.
+    pub fn outcome(&self) -> Option<&DesignOutcome> {
+        match &self.result {
+            JobResult::Designed(o) => Some(o),
+            JobResult::Failed { .. } => None,
+        }
+    }
+
+    /// The returned controller; `None` when the job failed.
+    pub fn controller(&self) -> Option<&Controller> {
+        self.outcome().map(|o| &o.controller)
+    }
+
+    /// How the job ended.
+    pub fn status(&self) -> JobStatus {
+        match &self.result {
+            JobResult::Designed(o) => JobStatus::Design(o.status.clone()),
+            JobResult::Failed { error } => JobStatus::Failed { error: error.clone() },
+        }
+    }
+
     /// Whether the job failed (no trustworthy result).
     pub fn failed(&self) -> bool {
-        matches!(self.status, JobStatus::Failed { .. })
+        matches!(self.result, JobResult::Failed { .. })
     }
 }
 

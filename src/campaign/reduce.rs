@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::record::JobRecord;
-use crate::lti::{closed_loop, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL};
+use crate::lti::{closed_loop, hinf_norm, is_stable, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
 /// them.
@@ -57,14 +57,7 @@ pub enum Verdict {
 
 /// Re-verifies one record's controller against `plant`.
 pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
-    if record.failed() {
-        return Verdict::Rejected("job failed".into());
-    }
-    let Some(doc) = record.controller.as_ref() else { return Verdict::Rejected("no controller".into()) };
-    let k = match Controller::from_json_value(doc) {
-        Ok(k) => k,
-        Err(e) => return Verdict::Rejected(format!("bad controller: {e}")),
-    };
+    let Some(k) = record.controller() else { return Verdict::Rejected("job failed".into()) };
     if let Err(e) = k.check_fits(plant) {
         return Verdict::Rejected(format!("controller does not fit the plant: {e}"));
     }
@@ -187,6 +180,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
 mod tests {
     use super::*;
     use crate::campaign::jobs::{job_id, RunnerTag};
+    use crate::campaign::record::JobResult;
     use crate::design::DesignOptions;
 
     /// ẋ = −x + w + u, z = c·x, y = x: with K = 0, ‖Tzw‖∞ = c.
@@ -256,7 +250,8 @@ mod tests {
         let p = plant("P", 1.0);
         let good = record(&p, "P", 0);
         let mut bad = good.clone();
-        bad.controller = Some(crate::lti::Controller::zeros(0, 2, 2).to_json()); // does not fit
+        let JobResult::Designed(o) = &mut bad.result else { unreachable!("a designed record") };
+        o.controller = crate::lti::Controller::zeros(0, 2, 2); // does not fit
         let rows = best_per_order(&[bad.clone(), good.clone(), bad], &map(&[&p]));
         assert_eq!((rows[0].runs, rows[0].verified, rows[0].failed), (1, 1, 0));
         assert_eq!(rows[0].job_id.as_deref(), Some(good.job_id.0.as_str()));

@@ -335,8 +335,8 @@ pub fn execute<E>(
         .build()?;
     let index_of: HashMap<&JobId, usize> = jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
     // Controllers of finished jobs (journals + this run), for warm starts.
-    let mut finished: HashMap<JobId, Option<serde_json::Value>> =
-        done.iter().map(|(id, r)| (id.clone(), r.controller.clone())).collect();
+    let mut finished: HashMap<JobId, Option<Controller>> =
+        done.iter().map(|(id, r)| (id.clone(), r.controller().cloned())).collect();
     let mut pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
     let mut stats = RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() };
     let mut first_err: Option<E> = None;
@@ -394,7 +394,7 @@ pub fn execute<E>(
                             continue;
                         }
                         let queued = index_of.get(&r.job_id).and_then(|i| pending.iter().position(|p| p == i));
-                        finished.insert(r.job_id.clone(), r.controller);
+                        finished.insert(r.job_id.clone(), r.controller().cloned());
                         if let Some(pos) = queued {
                             let index = pending.remove(pos).expect("position is in range");
                             stats.done_elsewhere += 1;
@@ -442,23 +442,7 @@ pub fn execute<E>(
                 busy_until.remove(&index);
                 idle_sweep = false;
                 let worker = free.pop().expect("a free worker");
-                let mut init = None;
-                if let Some(Some(k)) = job.warm_from.as_ref().and_then(|p| finished.get(p)) {
-                    match Controller::from_json_value(k) {
-                        Ok(k) => init = Some(k),
-                        Err(e) => emit(
-                            Ok(CampaignEvent::Warning {
-                                index: Some(index),
-                                message: format!(
-                                    "{}: predecessor's controller unusable ({e}); starting cold",
-                                    job.label()
-                                ),
-                            }),
-                            &mut first_err,
-                            &mut stats,
-                        ),
-                    }
-                }
+                let init = job.warm_from.as_ref().and_then(|p| finished.get(p)).cloned().flatten();
                 running += 1;
                 emit(Ok(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }), &mut first_err, &mut stats);
                 let tx = tx.clone();
@@ -500,7 +484,7 @@ pub fn execute<E>(
                 if record.failed() {
                     stats.failed += 1;
                 }
-                finished.insert(record.job_id.clone(), record.controller.clone());
+                finished.insert(record.job_id.clone(), record.controller().cloned());
                 emit(Ok(CampaignEvent::JobFinished { index, worker, record }), &mut first_err, &mut stats);
                 // journaled (or the journal failed and the run stops): the claim can go
                 coord.release(&jobs[index]);

@@ -212,12 +212,12 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
         Some(a) => s += &format!("   α(Ak) = {a:+.4e}\n"),
         None => s += "   (static gain)\n",
     }
-    let per_eval = if o.evals > 0 { o.cpu_s / o.evals as f64 } else { f64::NAN };
+    let per_eval = if o.evaluations > 0 { o.design_cpu_s / o.evaluations as f64 } else { f64::NAN };
     s += &format!(
         "CPU {:.2} s, {} iterations, {} evaluations ({:.3} ms/eval)\n",
-        o.cpu_s,
-        o.iters,
-        o.evals,
+        o.design_cpu_s,
+        o.iterations,
+        o.evaluations,
         1e3 * per_eval
     );
     let sr = &o.search;
@@ -229,8 +229,8 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
         sr.evals_to_best,
         sr.stop.name()
     );
-    if let (Some(d), Some(e)) = (o.dnorm, o.evaldist) {
-        s += &format!("certificate: dnorm = {d:.2e}, evaldist = {e:.2e}\n");
+    if let Some(c) = &o.certificate {
+        s += &format!("certificate: dnorm = {:.2e}, evaldist = {:.2e}\n", c.dnorm, c.evaldist);
     }
     s += &format!("controller written to {}\n", out.display());
     s

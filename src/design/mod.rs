@@ -34,8 +34,8 @@ pub use options::{
     MAX_NRAND,
 };
 pub use outcome::{
-    DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError, NoDesignObserver, Phase,
-    PhaseStats, SearchStop, SearchSummary, StartKind,
+    Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError,
+    NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary, StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};

@@ -90,6 +90,9 @@ pub enum SearchStop {
     Starts,
     /// Cancelled or stopped by the observer.
     Interrupted,
+    /// Not known: the record was journaled by a build before the search summary existed
+    /// (06018b1); never returned by a design run. See [`SearchSummary::not_recorded`].
+    NotRecorded,
 }
 
 impl SearchStop {
@@ -101,6 +104,7 @@ impl SearchStop {
             SearchStop::Stall => "stall",
             SearchStop::Starts => "starts",
             SearchStop::Interrupted => "interrupted",
+            SearchStop::NotRecorded => "not_recorded",
         }
     }
 }
@@ -157,6 +161,19 @@ pub struct SearchSummary {
 }
 
 impl SearchSummary {
+    /// The summary of a journal line written before the search summary existed: stop
+    /// [`SearchStop::NotRecorded`], no counts (0), no time (NaN).
+    pub fn not_recorded() -> SearchSummary {
+        SearchSummary {
+            starts: 0,
+            best_start: 0,
+            best_start_kind: None,
+            cpu_to_best_s: f64::NAN,
+            evals_to_best: 0,
+            stop: SearchStop::NotRecorded,
+        }
+    }
+
     /// "7 (central)": the best start's index and, if recorded, its kind.
     pub fn best_start_label(&self) -> String {
         match self.best_start_kind {
@@ -164,6 +181,18 @@ impl SearchSummary {
             None => self.best_start.to_string(),
         }
     }
+}
+
+/// The optimality certificate of a design run's final point (docs/ALGORITHMS.md §7.3): the min-norm element of the gradient
+/// bundle has norm `dnorm`, the bundle radius is `evaldist`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Certificate {
+    /// Norm of the min-norm element of the gradient bundle.
+    #[serde(with = "serde_f64_or_string")]
+    pub dnorm: f64,
+    /// Bundle radius.
+    #[serde(with = "serde_f64_or_string")]
+    pub evaldist: f64,
 }
 
 /// The result of [`crate::design::run`]. Every figure is recomputed from `controller`.
@@ -189,27 +218,27 @@ pub struct DesignOutcome {
     /// Final objective: max(γ, ε‖K‖∞) (strong) or γ (plain).
     #[serde(with = "serde_f64_or_string")]
     pub objective: f64,
-    /// Optimality certificate (dnorm, evaldist) of the final point, if the optimisation ran.
-    #[serde(default, with = "serde_opt_f64_or_string")]
-    pub dnorm: Option<f64>,
-    /// See `dnorm`.
-    #[serde(default, with = "serde_opt_f64_or_string")]
-    pub evaldist: Option<f64>,
     /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞): the
     /// controller-norm penalty, not the closed loop, sets the objective (strong stabilisation
     /// only; a smaller ε would let γ go lower).
     #[serde(default)]
     pub controller_norm_active: bool,
+    /// Optimality certificate of the final point, if the optimisation phase ran.
+    #[serde(default)]
+    pub certificate: Option<Certificate>,
+    /// Total iterations.
+    pub iterations: usize,
+    /// Total objective evaluations.
+    pub evaluations: usize,
     /// Per-phase counters.
     pub phases: Vec<PhaseStats>,
-    /// Total iterations.
-    pub iters: usize,
-    /// Total objective evaluations.
-    pub evals: usize,
-    /// Total CPU seconds of the run.
+    /// Total CPU seconds of the design run (as counted by its budget; a campaign record's
+    /// `cpu_s` is the worker thread's CPU time for the whole job).
     #[serde(with = "serde_f64_or_string")]
-    pub cpu_s: f64,
-    /// The multi-start search: starts made, the best one, time to best, stop reason.
+    pub design_cpu_s: f64,
+    /// The multi-start search: starts made, the best one, time to best, stop reason
+    /// ([`SearchSummary::not_recorded`] when read from a journal line that predates it).
+    #[serde(default = "SearchSummary::not_recorded")]
     pub search: SearchSummary,
 }
 

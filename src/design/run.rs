@@ -19,7 +19,7 @@ use super::objective::{
 };
 use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{
-    DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
+    Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
 use super::search::Search;
@@ -261,8 +261,8 @@ fn run_validated(
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
 
     let (final_x, certificate) = match &res.perf {
-        Some(b) => (b.x.clone(), (Some(b.dnorm), Some(b.evaldist))),
-        None => (res.stab.x.clone(), (None, None)),
+        Some(b) => (b.x.clone(), Some(Certificate { dnorm: b.dnorm, evaldist: b.evaldist })),
+        None => (res.stab.x.clone(), None),
     };
     let status = if interrupted {
         DesignStatus::Interrupted
@@ -282,8 +282,8 @@ fn run_validated(
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
     let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
-    let iters = res.phases.iter().map(|p| p.iters).sum();
-    let evals = res.phases.iter().map(|p| p.evals).sum();
+    let iterations = res.phases.iter().map(|p| p.iters).sum();
+    let evaluations = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {
         status,
         controller: k,
@@ -293,12 +293,11 @@ fn run_validated(
         alpha_k: fig.alpha_k,
         objective: fig.objective,
         controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
-        dnorm: certificate.0,
-        evaldist: certificate.1,
+        certificate,
+        iterations,
+        evaluations,
         phases: res.phases,
-        iters,
-        evals,
-        cpu_s: ctl.cpu_elapsed(),
+        design_cpu_s: ctl.cpu_elapsed(),
         search: res.summary,
     })
 }

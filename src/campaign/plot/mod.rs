@@ -147,8 +147,8 @@ pub fn write_plots(
         else {
             continue;
         };
-        let Some(k) = rec.controller.as_ref().and_then(|c| Controller::from_json_value(c).ok()) else { continue };
-        let fig = sigma_figure(plant, &k, format!("σ-plot: {title}"))?;
+        let Some(k) = rec.controller() else { continue };
+        let fig = sigma_figure(plant, k, format!("σ-plot: {title}"))?;
         out.files.extend(write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}")))?);
     }
     Ok(out)
