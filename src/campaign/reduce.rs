@@ -61,7 +61,7 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
     if let Err(e) = k.check_fits(plant) {
         return Verdict::Rejected(format!("controller does not fit the plant: {e}"));
     }
-    let cl = match closed_loop(plant, &k) {
+    let cl = match closed_loop(plant, k) {
         Ok(cl) => cl,
         Err(e) => return Verdict::Rejected(format!("closed loop: {e}")),
     };
