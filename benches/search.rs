@@ -343,7 +343,15 @@ fn random(a: &Args) {
         "# random: {n} problems; stabilised by old {}, prev {}, new {}; of the {entries} stabilised by any: \
          new ≤ old on {}, better by > 1 % on {}, worse by > 1 % on {}; new ≤ prev on {}, better by > 1 % on {}, \
          worse by > 1 % on {}",
-        stabilised[0], stabilised[1], stabilised[2], vs_old[0], vs_old[1], vs_old[2], vs_prev[0], vs_prev[1], vs_prev[2]
+        stabilised[0],
+        stabilised[1],
+        stabilised[2],
+        vs_old[0],
+        vs_old[1],
+        vs_old[2],
+        vs_prev[0],
+        vs_prev[1],
+        vs_prev[2]
     );
 }
 

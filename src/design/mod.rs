@@ -24,8 +24,8 @@ pub mod starts;
 pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
 pub use objective::{Components, DesignObjective, ObjectivePhase};
 pub use options::{
-    DesignOptions, ObjectiveKind, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS,
-    MAX_NRAND,
+    DesignOptions, ObjectiveKind, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES,
+    DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
     DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError, NoDesignObserver, Phase,

@@ -97,7 +97,10 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
         return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
     }
     if opts.random_scales.is_empty() {
-        return Err(opt_err("random_scales", "must have at least one scale (e.g. [1] for standard-normal starts only)"));
+        return Err(opt_err(
+            "random_scales",
+            "must have at least one scale (e.g. [1] for standard-normal starts only)",
+        ));
     }
     if let Some(bad) = opts.random_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
         return Err(opt_err("random_scales", format!("every scale must be finite and > 0, got {bad}")));
