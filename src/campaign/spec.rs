@@ -694,6 +694,24 @@ objective = "plain"
     }
 
     #[test]
+    fn search_start_keys_layer_and_bad_scales_are_located() {
+        let c = parse(
+            "name = \"t\"\n[defaults]\nrandom_scales = [1.0, 1e-3]\nopen_loop_start = false\n\
+             [[problem]]\nplant = \"HE1\"\norders = [1]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n\
+             open_loop_start = true\nrandom_scales = [0.5]\n",
+        )
+        .unwrap();
+        assert_eq!(
+            (c.problems[0].base.random_scales.clone(), c.problems[0].base.open_loop_start),
+            (vec![1.0, 1e-3], false)
+        );
+        assert_eq!((c.problems[1].base.random_scales.clone(), c.problems[1].base.open_loop_start), (vec![0.5], true));
+        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
+        assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
+        assert!(e.message.contains("random_scales"), "{e}");
+    }
+
+    #[test]
     fn unknown_key_names_line_and_column() {
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nordres = [2]\n");
         assert_eq!((e.location.line, e.location.column), (5, 1), "{e}");
