@@ -96,8 +96,8 @@ pub struct DesignOptions {
     /// Scales σ of the continued search's fresh random starts σ·ξ, ξ ~ N(0, I): the c-th fresh
     /// random start uses σ = `random_scales[c mod len]` (HIFOO's first `nrand` starts are always
     /// standard normal). Small scales reach controllers with small gains, which badly scaled
-    /// plants need to be stabilised. (Missing in a serialised record: [1], the behaviour before
-    /// this option existed; not written when [1].)
+    /// plants need to be stabilised. (Missing in a serialised record: `[1]`, the behaviour before
+    /// this option existed; not written when `[1]`.)
     #[serde(
         default = "unit_random_scale",
         with = "serde_vec_f64_or_string",
