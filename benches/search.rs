@@ -14,9 +14,11 @@
 //! * `singles`: one job each of `--single-cpumax` CPU s (ε = 1e-3, seed 1): Enns n_K = 4
 //!   (target 1.1682), AC10 n_K = 1 (stabilised, ≤ 10.874), BDT2 n_K = 1 (≤ 0.6436).
 //! * `random`: `--random` random open-loop-unstable plants (n = 4…20, seeded), n_K = 1 and 2,
-//!   ε = 1e-3, seed 1: HIFOO's search (`stall_starts = 0`) against the default search, both
-//!   with `--random-cpumax` CPU s. Counts the entries where the new search is at or below the
-//!   old one and where it is better by more than 1 %.
+//!   ε = 1e-3, seed 1, each with `--random-cpumax` CPU s: HIFOO's search (`stall_starts = 0`,
+//!   "old"), the continued search without the open-loop start and with standard-normal restarts
+//!   only (`open_loop_start = false`, `random_scales = [1]`, "prev": the default before those
+//!   starts), and the default search ("new"). Counts the stabilised problems of each, and the
+//!   entries where new is at or below old / prev, better by more than 1 %, worse by more than 1 %.
 //!
 //! Jobs run on `--threads` worker threads; budgets are thread CPU time, so a busy machine slows
 //! the wall clock, not the result.
@@ -286,33 +288,70 @@ fn random(a: &Args) {
                 plant: p.clone(),
                 opts: DesignOptions { stall_starts: 0, ..base.clone() },
             });
+            jobs.push(Job {
+                tag: format!("{tag} prev"),
+                plant: p.clone(),
+                opts: DesignOptions { open_loop_start: false, random_scales: vec![1.0], ..base.clone() },
+            });
             jobs.push(Job { tag: format!("{tag} new"), plant: p.clone(), opts: base });
         }
     }
     println!(
-        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old) vs default (new)",
+        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old), the continued search \
+         without the open-loop start and with standard-normal restarts only (prev), the default (new)",
         a.random, a.random_cpumax
     );
     let done = run_all(jobs, a.threads);
-    println!("{:<22} {:>12} {:>12} {:>9} {:>8} {:>8}", "problem", "old γ", "new γ", "new/old", "old cpu", "new cpu");
-    let (mut entries, mut at_or_below, mut better1, mut both_unstable) = (0, 0, 0, 0);
-    for pair in done.chunks(2) {
-        let [(jo, oo), (jn, on)] = pair else { continue };
-        let (go, gn) = (verified_gamma(&jo.plant, oo), verified_gamma(&jn.plant, on));
+    println!(
+        "{:<22} {:>12} {:>12} {:>12} {:>9} {:>9} {:>8} {:>8} {:>8}",
+        "problem", "old γ", "prev γ", "new γ", "new/old", "new/prev", "old cpu", "prev cpu", "new cpu"
+    );
+    let (mut entries, mut vs_old, mut vs_prev) = (0, [0usize; 3], [0usize; 3]);
+    let mut stabilised = [0usize; 3];
+    // [at or below, better by > 1 %, worse by > 1 %]
+    let tally = |t: &mut [usize; 3], new: f64, base: f64| {
+        t[0] += (new <= base) as usize;
+        t[1] += (new < base / 1.01) as usize;
+        t[2] += (new > base * 1.01) as usize;
+    };
+    for triple in done.chunks(3) {
+        let [(jo, oo), (jp, op), (jn, on)] = triple else { continue };
+        let g = [verified_gamma(&jo.plant, oo), verified_gamma(&jp.plant, op), verified_gamma(&jn.plant, on)];
+        for (s, gi) in stabilised.iter_mut().zip(&g) {
+            *s += gi.is_some() as usize;
+        }
         let tag = jo.tag.trim_end_matches(" old");
-        if let (None, None) = (go, gn) {
-            both_unstable += 1;
-            println!("{tag:<22} {:>12} {:>12}", "unstable", "unstable");
+        if g.iter().all(Option::is_none) {
+            println!("{tag:<22} {:>12} {:>12} {:>12}", "unstable", "unstable", "unstable");
             continue;
         }
         entries += 1;
-        let (go, gn) = (go.unwrap_or(f64::INFINITY), gn.unwrap_or(f64::INFINITY));
-        at_or_below += (gn <= go) as usize;
-        better1 += (gn < go / 1.01) as usize;
-        println!("{tag:<22} {go:>12.5} {gn:>12.5} {:>9.4} {:>8.1} {:>8.1}", gn / go, oo.design_cpu_s, on.design_cpu_s);
+        let [go, gp, gn] = g.map(|x| x.unwrap_or(f64::INFINITY));
+        tally(&mut vs_old, gn, go);
+        tally(&mut vs_prev, gn, gp);
+        println!(
+            "{tag:<22} {go:>12.5} {gp:>12.5} {gn:>12.5} {:>9.4} {:>9.4} {:>8.1} {:>8.1} {:>8.1}",
+            gn / go,
+            gn / gp,
+            oo.design_cpu_s,
+            op.design_cpu_s,
+            on.design_cpu_s
+        );
     }
+    let n = done.len() / 3;
     println!(
-        "# random: {entries} entries with a stabilising controller; new ≤ old on {at_or_below}, better by > 1 % on {better1}; {both_unstable} not stabilised by either"
+        "# random: {n} problems; stabilised by old {}, prev {}, new {}; of the {entries} stabilised by any: \
+         new ≤ old on {}, better by > 1 % on {}, worse by > 1 % on {}; new ≤ prev on {}, better by > 1 % on {}, \
+         worse by > 1 % on {}",
+        stabilised[0],
+        stabilised[1],
+        stabilised[2],
+        vs_old[0],
+        vs_old[1],
+        vs_old[2],
+        vs_prev[0],
+        vs_prev[1],
+        vs_prev[2]
     );
 }
 

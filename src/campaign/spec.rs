@@ -83,6 +83,8 @@ macro_rules! with_design_settings {
             max_starts: Option<Spanned<usize>>,
             hop_scales: Option<Spanned<Vec<f64>>>,
             central_gammas: Option<Spanned<Vec<f64>>>,
+            random_scales: Option<Spanned<Vec<f64>>>,
+            open_loop_start: Option<bool>,
             $($tail)*
         }
     };
@@ -392,6 +394,8 @@ struct Layered {
     stall_starts: Setting<usize>,
     hop_scales: Setting<Vec<f64>>,
     central_gammas: Setting<Vec<f64>>,
+    random_scales: Setting<Vec<f64>>,
+    open_loop_start: Option<bool>,
 }
 
 impl Layered {
@@ -413,6 +417,8 @@ impl Layered {
             stall_starts: layer(&p.stall_starts, &d.stall_starts),
             hop_scales: layer(&p.hop_scales, &d.hop_scales),
             central_gammas: layer(&p.central_gammas, &d.central_gammas),
+            random_scales: layer(&p.random_scales, &d.random_scales),
+            open_loop_start: p.open_loop_start.or(d.open_loop_start),
         }
     }
 
@@ -442,6 +448,12 @@ impl Layered {
         if let Some((x, _)) = &self.central_gammas {
             o.central_gammas = x.clone();
         }
+        if let Some((x, _)) = &self.random_scales {
+            o.random_scales = x.clone();
+        }
+        if let Some(b) = self.open_loop_start {
+            o.open_loop_start = b;
+        }
         if let Some(k) = self.objective {
             o.objective = k;
         }
@@ -470,6 +482,7 @@ impl Layered {
             "stall_starts" => span(&self.stall_starts),
             "hop_scales" => span(&self.hop_scales),
             "central_gammas" => span(&self.central_gammas),
+            "random_scales" => span(&self.random_scales),
             _ => None,
         }
     }
@@ -678,6 +691,24 @@ objective = "plain"
         assert_eq!(rea2.base.nrand, 2);
         assert_eq!(rea2.base.objective, ObjectiveKind::Plain);
         assert_eq!(rea2.base.cpumax, 5.0);
+    }
+
+    #[test]
+    fn search_start_keys_layer_and_bad_scales_are_located() {
+        let c = parse(
+            "name = \"t\"\n[defaults]\nrandom_scales = [1.0, 1e-3]\nopen_loop_start = false\n\
+             [[problem]]\nplant = \"HE1\"\norders = [1]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n\
+             open_loop_start = true\nrandom_scales = [0.5]\n",
+        )
+        .unwrap();
+        assert_eq!(
+            (c.problems[0].base.random_scales.clone(), c.problems[0].base.open_loop_start),
+            (vec![1.0, 1e-3], false)
+        );
+        assert_eq!((c.problems[1].base.random_scales.clone(), c.problems[1].base.open_loop_start), (vec![0.5], true));
+        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
+        assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
+        assert!(e.message.contains("random_scales"), "{e}");
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--max-starts N] [--hop-scales 0.01,0.1,1]
-//! [--central-gammas 1.1,2]
+//! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start]
 //! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
@@ -66,6 +66,15 @@ pub struct DesignArgs {
     /// (one hop per size, then one random start, in turn). "none": random starts only.
     #[arg(long, value_name = "R,R,...", default_value = "0.01,0.1,1")]
     pub hop_scales: String,
+    /// Scales σ of the continued search's fresh random starts σ·N(0, I), comma-separated, used in
+    /// turn (the first --nrand starts are always standard normal). Small scales reach small
+    /// gains, which badly scaled plants need to be stabilised.
+    #[arg(long, value_name = "S,S,...", default_value = "1,0.1,0.01")]
+    pub random_scales: String,
+    /// Do not make the open-loop start K = 0 (by default one more first start after the random
+    /// ones: Bk, Ck, Dk = 0 and Ak a stable diagonal).
+    #[arg(long)]
+    pub no_open_loop_start: bool,
     /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
     /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
     /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.
@@ -105,6 +114,8 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         max_starts: a.max_starts.map(|n| n as usize),
         hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
         central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,
+        random_scales: parse_scales(&a.random_scales, "--random-scales")?,
+        open_loop_start: !a.no_open_loop_start,
         objective: if a.no_strong { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
         ..Default::default()
     };

@@ -28,6 +28,23 @@ pub const DEFAULT_STALL_STARTS: usize = 60;
 /// Default of [`DesignOptions::hop_scales`].
 pub const DEFAULT_HOP_SCALES: [f64; 3] = [1e-2, 1e-1, 1.0];
 
+/// Default of [`DesignOptions::random_scales`].
+pub const DEFAULT_RANDOM_SCALES: [f64; 3] = [1.0, 1e-1, 1e-2];
+
+/// [`DesignOptions::random_scales`] of a record that does not have the field (builds before it
+/// existed): standard-normal random starts only.
+fn unit_random_scale() -> Vec<f64> {
+    vec![1.0]
+}
+
+fn is_unit_random_scale(v: &[f64]) -> bool {
+    v == [1.0]
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
 /// Default of [`DesignOptions::central_gammas`].
 pub const DEFAULT_CENTRAL_GAMMAS: [f64; 2] = [1.1, 2.0];
 
@@ -76,6 +93,22 @@ pub struct DesignOptions {
     /// Empty: random starts only. (Missing in a serialised record: empty.)
     #[serde(default, with = "serde_vec_f64_or_string")]
     pub hop_scales: Vec<f64>,
+    /// Scales σ of the continued search's fresh random starts σ·ξ, ξ ~ N(0, I): the c-th fresh
+    /// random start uses σ = `random_scales[c mod len]` (HIFOO's first `nrand` starts are always
+    /// standard normal). Small scales reach controllers with small gains, which badly scaled
+    /// plants need to be stabilised. (Missing in a serialised record: `[1]`, the behaviour before
+    /// this option existed; not written when `[1]`.)
+    #[serde(
+        default = "unit_random_scale",
+        with = "serde_vec_f64_or_string",
+        skip_serializing_if = "is_unit_random_scale"
+    )]
+    pub random_scales: Vec<f64>,
+    /// Make the open-loop start K = 0 (`design::starts::open_loop_controller`) one more first
+    /// start, after the `nrand` starts and before the central-controller starts. (Missing in a
+    /// serialised record: false; not written when false.)
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub open_loop_start: bool,
     /// Levels γ = f·γ_opt (factors f > 1 of the full-order optimum) of the reduced-order
     /// central-controller starts: for each f, the full-order H∞ central controller at that level,
     /// reduced to `order` by balanced truncation, is one more first start, made after the `nrand`
@@ -117,6 +150,8 @@ impl Default for DesignOptions {
             stall_rtol: 1e-6,
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
+            random_scales: DEFAULT_RANDOM_SCALES.to_vec(),
+            open_loop_start: true,
             central_gammas: DEFAULT_CENTRAL_GAMMAS.to_vec(),
             objective: ObjectiveKind::Strong,
             hinf_tol: crate::lti::DEFAULT_HINF_TOL,

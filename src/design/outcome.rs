@@ -113,12 +113,15 @@ impl SearchStop {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StartKind {
-    /// A standard-normal random point (a first start or a fresh start of the continued search).
+    /// A random point: a standard-normal first start, or a fresh start of the continued search
+    /// (scaled by `random_scales`).
     Random,
     /// The initial controller or one of its perturbations.
     Init,
     /// A reduced-order full-order-central-controller start (`central_gammas`).
     Central,
+    /// The open-loop start K = 0 (`open_loop_start`).
+    OpenLoop,
     /// A basin-hopping perturbation of the best point.
     Hop,
     /// HIFOO's gradient-sampling stabilisation fallback.
@@ -132,6 +135,7 @@ impl StartKind {
             StartKind::Random => "random",
             StartKind::Init => "init",
             StartKind::Central => "central",
+            StartKind::OpenLoop => "open_loop",
             StartKind::Hop => "hop",
             StartKind::GradientSampling => "gradient_sampling",
         }

@@ -23,7 +23,7 @@ use super::outcome::{
 };
 use super::params::{controller_to_x, ControllerShape};
 use super::search::Search;
-use super::starts::{pad_controller, padding_diagonal, perturbed_starts, random_starts};
+use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
 
 /// Designs a controller of order `opts.order` for `plant` (HIFOO, strong stabilisation unless
 /// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds and
@@ -95,6 +95,15 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     }
     if let Some(bad) = opts.hop_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
         return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
+    }
+    if opts.random_scales.is_empty() {
+        return Err(opt_err(
+            "random_scales",
+            "must have at least one scale (e.g. [1] for standard-normal starts only)",
+        ));
+    }
+    if let Some(bad) = opts.random_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+        return Err(opt_err("random_scales", format!("every scale must be finite and > 0, got {bad}")));
     }
     if let Some(bad) = opts.central_gammas.iter().find(|f| !(f.is_finite() && **f > 1.0)) {
         return Err(opt_err("central_gammas", format!("every factor of gamma_opt must be finite and > 1, got {bad}")));
@@ -225,6 +234,10 @@ fn run_validated(
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let mut first = starting_points(plant, opts, init, shape, &mut rng);
     let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
+    if opts.open_loop_start {
+        first.push(controller_to_x(&open_loop_controller(plant, shape.nk)));
+        kinds.push(StartKind::OpenLoop);
+    }
     for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
         first.push(controller_to_x(&k));
         kinds.push(StartKind::Central);

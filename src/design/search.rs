@@ -8,17 +8,19 @@
 //! inverse-Hessian approximation — restarting BFGS is itself useful on nonsmooth functions.
 //!
 //! # The starts
-//! 1. The first starts, as HIFOO 3.5: `nrand` standard-normal points, or an initial controller
-//!    and `nrand` perturbations of it ([`super::starts`]). They are always made (unless a budget
-//!    ends the run first).
+//! 1. The first starts: as HIFOO 3.5, `nrand` standard-normal points, or an initial controller
+//!    and `nrand` perturbations of it ([`super::starts`]); then the open-loop start K = 0
+//!    (`open_loop_start`) and the central-controller starts (`central_gammas`). They are always
+//!    made (unless a budget ends the run first).
 //! 2. If none of them was stabilised and gradient sampling is on: gradient sampling on f_s
 //!    (fvalquit = 0) from the point with the smallest f_s (HIFOO's fallback), then BFGS on f_h
 //!    from its end point if stable.
 //! 3. The continued search (`stall_starts > 0`): further local searches, cycling through one
 //!    basin-hopping perturbation x* + ξ ∘ (‖x*‖·r) of the best point x* for each r in
-//!    `hop_scales`, then one fresh standard-normal start. x* is the best point of f_h, or of f_s
-//!    while no stable point has been found: stabilisation is restarted, never given up, until a
-//!    budget ends the run (the stall rule applies only once a stable point is known, or when no
+//!    `hop_scales`, then one fresh random start σ·ξ, ξ ~ N(0, I), with σ cycling through
+//!    `random_scales` (small σ: small gains, see `starts::open_loop_controller`). x* is the best
+//!    point of f_h, or of f_s while no stable point has been found: stabilisation is restarted,
+//!    never given up, until a budget ends the run (the stall rule applies only once a stable point is known, or when no
 //!    budget — cpumax, maxevals, max_starts — is finite).
 //!
 //! # When it stops
@@ -51,7 +53,7 @@ use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::DesignOptions;
 use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
 use super::phases::{bfgs_options, gradsamp_options, optim_error};
-use super::starts::{perturb, random_starts};
+use super::starts::{perturb, scaled_random_start};
 
 /// Share of the CPU and evaluation budgets kept for the final gradient sampling (when enabled).
 pub const GS_RESERVE: f64 = 0.1;
@@ -91,7 +93,7 @@ pub(crate) struct SearchResult {
     /// The search summary (time to best filled in by the caller's adapter).
     pub summary: SearchSummary,
     /// True if a budget ended the run before HIFOO's first starts (the `nrand` random or init
-    /// starts, not the central-controller ones) were all made.
+    /// starts, not the open-loop or central-controller ones) were all made.
     pub truncated: bool,
 }
 
@@ -279,12 +281,18 @@ impl Search<'_, '_, '_> {
     }
 
     /// The start of continued local search number `j` (0-based after the first starts).
+    /// The c-th fresh random start (c counts them) is at scale `random_scales[c mod len]`.
     fn next_start(&mut self, st: &State<'_>, j: usize, nvar: usize) -> (Vec<f64>, StartKind) {
         let scales = &st.opts.hop_scales;
         let centre = st.perf.as_ref().or(st.stab.as_ref()).filter(|b| b.x.iter().all(|v| v.is_finite()));
-        match (j % (scales.len() + 1), centre) {
+        let cycle = scales.len() + 1;
+        match (j % cycle, centre) {
             (i, Some(c)) if i < scales.len() => (perturb(&c.x, scales[i], self.rng), StartKind::Hop),
-            _ => (random_starts(nvar, 1, self.rng).remove(0), StartKind::Random),
+            _ => {
+                let sigmas = &st.opts.random_scales;
+                let sigma = sigmas[(j / cycle) % sigmas.len()];
+                (scaled_random_start(nvar, sigma, self.rng), StartKind::Random)
+            }
         }
     }
 
@@ -351,9 +359,13 @@ impl Search<'_, '_, '_> {
             stop = s;
         }
         let stop = stop.unwrap_or(SearchStop::Starts);
-        // HIFOO's own first starts (random or init): the extra central-controller starts are
+        // HIFOO's own first starts (random or init): the extra open-loop and central starts are
         // like the continued search, a budget may end the run before them without truncating it.
-        let hifoo_starts = first_kinds.iter().take(first.len()).filter(|k| **k != StartKind::Central).count();
+        let hifoo_starts = first_kinds
+            .iter()
+            .take(first.len())
+            .filter(|k| !matches!(k, StartKind::Central | StartKind::OpenLoop))
+            .count();
         let truncated = k < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
 
         // Gradient sampling from the best stable point, under the whole budget.

@@ -60,6 +60,32 @@ pub fn perturb(x: &[f64], r: f64, rng: &mut dyn RngCore) -> Vec<f64> {
         .collect()
 }
 
+/// `nvar`-vector σ·ξ, ξ ~ N(0, I): a random start at scale σ (σ = 1: HIFOO's standard-normal
+/// start, the same draws as [`random_starts`]).
+pub fn scaled_random_start(nvar: usize, sigma: f64, rng: &mut dyn RngCore) -> Vec<f64> {
+    let mut x = random_starts(nvar, 1, rng).remove(0);
+    if sigma != 1.0 {
+        x.iter_mut().for_each(|v| *v *= sigma);
+    }
+    x
+}
+
+/// The open-loop start of order `nk`: K = 0 (Dk = 0, Bk = 0, Ck = 0) with Ak = d·I, d from
+/// [`padding_diagonal`] (the order-0 zero controller padded to `nk`). Its closed loop is the open
+/// loop plus decoupled modes at d < 0, ‖K‖∞ = 0, and it uses no random numbers.
+///
+/// Why: on a badly scaled plant (AC10: ‖A‖ ≈ 2·10⁷, one unstable pair 0.10 ± 19.8j) a
+/// standard-normal controller is far inside a destabilised region, while small gains stabilise;
+/// relative perturbations of a large point never get near K = 0. From K = 0 exactly, Bk and Ck
+/// stay 0 under any gradient method (Tzw and the closed-loop spectrum depend on them only through
+/// the products Ck·(sI − Ak)⁻¹·Bk, whose gradients vanish when both are 0), so this start
+/// optimises Dk (and Ak); the basin hops of the continued search make Bk, Ck non-zero.
+pub fn open_loop_controller(plant: &Plant, nk: usize) -> Controller {
+    let (m, p) = (plant.dims.m2, plant.dims.p2);
+    let k0 = Controller { ak: Mat::zeros(0, 0), bk: Mat::zeros(0, p), ck: Mat::zeros(m, 0), dk: Mat::zeros(m, p) };
+    pad_controller(&k0, nk, padding_diagonal(plant, &k0)).expect("any order ≥ 0 pads an order-0 controller")
+}
+
 /// x_init followed by `nrand` relative perturbations x_init + ξ ∘ (‖x_init‖ · r_i),
 /// r = logspace(−3, −1, nrand).
 pub fn perturbed_starts(x_init: &[f64], nrand: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
