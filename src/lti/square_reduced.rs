@@ -109,10 +109,6 @@ impl ColMajor {
         &self.data[j * self.n..(j + 1) * self.n]
     }
 
-    fn col_mut(&mut self, j: usize) -> &mut [f64] {
-        &mut self.data[j * self.n..(j + 1) * self.n]
-    }
-
     fn row(&self, i: usize) -> Vec<f64> {
         (0..self.n).map(|j| self.at(i, j)).collect()
     }
@@ -129,8 +125,8 @@ impl ColMajor {
     /// `first_col` are zero in rows r.. and are skipped on the left; rows before `first_row` are
     /// zero in columns r.. and are skipped on the right. Left: t = X[r.., :]ᵀv,
     /// X[r.., :] −= β v tᵀ; right: z = X[:, r..] v, X[:, r..] −= β z vᵀ: four level-2 passes
-    /// through faer's matrix–vector and rank-one kernels (SIMD chosen at run time; issue 13: about
-    /// 1.6× faster than the hand-written loops at n = 83). For the skew-symmetric G and Q the
+    /// through faer's matrix–vector and rank-one kernels (SIMD chosen at run time) instead of
+    /// hand-written loops (issue 13). For the skew-symmetric G and Q the
     /// identity P X P = X + β(v yᵀ − y vᵀ), y = Xv, would save a pass, but it was tried and lost
     /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low).
     fn reflect_two_sided(
