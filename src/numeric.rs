@@ -8,15 +8,16 @@ use faer::MatRef;
 /// Σᵢ aᵢbᵢ, summed left to right (over the shorter length if the lengths differ).
 ///
 /// The summation order is part of the result's rounding, and the optimiser's iterates depend on
-/// it bit for bit (same seed ⇒ same path), so it must not be changed casually. The frequency
-/// response's Hessenberg solves use [`dot_four_lanes`] instead, where vectorisation matters.
+/// it bit for bit (same seed ⇒ same path), so it must not be changed casually. The H∞ level-set
+/// reduction uses [`dot_four_lanes`] instead, where vectorisation matters.
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// Σ xᵢyᵢ with four partial sums (lets the compiler vectorise the reduction), the remainder
-/// added last. A different rounding from [`dot`], used where speed matters: the Hessenberg
-/// solves of `lti::freq_response` (reproducible on one machine like any other rounding).
+/// added last. A different rounding from [`dot`]: used where speed matters and no iterate path
+/// depends on the bits (the Householder reflections of the H∞ level-set reduction,
+/// `lti::square_reduced`).
 pub(crate) fn dot_four_lanes(x: &[f64], y: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));

@@ -12,7 +12,6 @@ use faer::linalg::householder;
 use faer::{c64, Conj, Mat, MatRef, Par};
 
 use super::StateSpace;
-use crate::numeric::dot_four_lanes;
 
 /// G(iω) evaluator for one system (reusable buffers).
 pub(crate) struct FreqResponse {
@@ -21,18 +20,13 @@ pub(crate) struct FreqResponse {
     p: usize,
     /// Upper Hessenberg H, row-major.
     h: Vec<f64>,
-    /// B̃ = QᵀB, column-major n×m.
+    /// B̃ = QᵀB, row-major n×m.
     bt: Vec<f64>,
-    /// C̃ = CQ, row-major p×n.
-    ct: Vec<f64>,
+    /// C̃ = CQ (p×n).
+    ct: Mat<f64>,
     d: Mat<f64>,
-    /// iωI − H during the elimination, row-major, real and imaginary parts apart (so that the
-    /// row operations vectorise).
-    work_re: Vec<f64>,
-    work_im: Vec<f64>,
-    /// Right-hand sides / solution, column-major n×m, real and imaginary parts apart.
-    rhs_re: Vec<f64>,
-    rhs_im: Vec<f64>,
+    work: Vec<c64>,
+    rhs: Vec<c64>,
     /// The last G(iω), p×m.
     g: Mat<c64>,
 }
@@ -88,20 +82,17 @@ impl FreqResponse {
                 h[i * n + j] = hm[(i, j)];
             }
         }
-        let btv = (0..n * m).map(|k| bt[(k % n, k / n)]).collect();
-        let ctv = (0..p * n).map(|k| ct[(k / n, k % n)]).collect();
+        let btv = (0..n * m).map(|k| bt[(k / m, k % m)]).collect();
         FreqResponse {
             n,
             m,
             p,
             h,
             bt: btv,
-            ct: ctv,
+            ct,
             d: sys.d.clone(),
-            work_re: vec![0.0; n * n],
-            work_im: vec![0.0; n * n],
-            rhs_re: vec![0.0; n * m],
-            rhs_im: vec![0.0; n * m],
+            work: vec![c64::new(0.0, 0.0); n * n],
+            rhs: vec![c64::new(0.0, 0.0); n * m],
             g: Mat::zeros(p, m),
         }
     }
@@ -118,78 +109,63 @@ impl FreqResponse {
             return self.g.as_ref();
         }
         // T = iωI − H (upper Hessenberg, row-major), rhs = B̃.
-        let (tr, ti) = (&mut self.work_re, &mut self.work_im);
-        let (xr, xi) = (&mut self.rhs_re, &mut self.rhs_im);
+        let t = &mut self.work;
+        let x = &mut self.rhs;
         for i in 0..n {
             let lo = i.saturating_sub(1);
             for j in lo..n {
-                tr[i * n + j] = -self.h[i * n + j];
-                ti[i * n + j] = 0.0;
+                t[i * n + j] = c64::new(-self.h[i * n + j], 0.0);
             }
-            ti[i * n + i] = w;
+            t[i * n + i].im += w;
         }
-        xr.copy_from_slice(&self.bt);
-        xi.iter_mut().for_each(|v| *v = 0.0);
+        for (xk, &b) in x[..n * m].iter_mut().zip(&self.bt[..n * m]) {
+            *xk = c64::new(b, 0.0);
+        }
         // Elimination with adjacent-row pivoting: after step k rows k+1.. are Hessenberg again.
         for k in 0..n.saturating_sub(1) {
             let (r0, r1) = (k * n, (k + 1) * n);
-            let norm0 = tr[r0 + k] * tr[r0 + k] + ti[r0 + k] * ti[r0 + k];
-            let norm1 = tr[r1 + k] * tr[r1 + k] + ti[r1 + k] * ti[r1 + k];
-            if norm1 > norm0 {
+            if t[r1 + k].norm_sqr() > t[r0 + k].norm_sqr() {
                 for j in k..n {
-                    tr.swap(r0 + j, r1 + j);
-                    ti.swap(r0 + j, r1 + j);
+                    t.swap(r0 + j, r1 + j);
                 }
                 for c in 0..m {
-                    xr.swap(c * n + k, c * n + k + 1);
-                    xi.swap(c * n + k, c * n + k + 1);
+                    x.swap(k * m + c, (k + 1) * m + c);
                 }
             }
-            let piv = c64::new(tr[r0 + k], ti[r0 + k]);
+            let piv = t[r0 + k];
             if piv == c64::new(0.0, 0.0) {
                 continue; // singular; caught in the back substitution
             }
-            let l = c64::new(tr[r1 + k], ti[r1 + k]) / piv;
+            let l = t[r1 + k] / piv;
             if l != c64::new(0.0, 0.0) {
-                tr[r1 + k] = 0.0;
-                ti[r1 + k] = 0.0;
-                let (t0r, t1r) = tr.split_at_mut(r1);
-                let (t0i, t1i) = ti.split_at_mut(r1);
-                let (a_r, a_i) = (&t0r[r0 + k + 1..r0 + n], &t0i[r0 + k + 1..r0 + n]);
-                let (b_r, b_i) = (&mut t1r[k + 1..n], &mut t1i[k + 1..n]);
-                for (((br, bi), &ar), &ai) in b_r.iter_mut().zip(b_i.iter_mut()).zip(a_r).zip(a_i) {
-                    *br -= l.re * ar - l.im * ai;
-                    *bi -= l.re * ai + l.im * ar;
+                t[r1 + k] = c64::new(0.0, 0.0);
+                for j in k + 1..n {
+                    let v = t[r0 + j];
+                    t[r1 + j] -= l * v;
                 }
                 for c in 0..m {
-                    let (vr, vi) = (xr[c * n + k], xi[c * n + k]);
-                    xr[c * n + k + 1] -= l.re * vr - l.im * vi;
-                    xi[c * n + k + 1] -= l.re * vi + l.im * vr;
+                    let v = x[k * m + c];
+                    x[(k + 1) * m + c] -= l * v;
                 }
             }
         }
-        for c in 0..m {
-            let (colr, coli) = (&mut xr[c * n..(c + 1) * n], &mut xi[c * n..(c + 1) * n]);
-            for k in (0..n).rev() {
-                let piv = c64::new(tr[k * n + k], ti[k * n + k]);
-                let (dr, di) = complex_dot(
-                    &tr[k * n + k + 1..(k + 1) * n],
-                    &ti[k * n + k + 1..(k + 1) * n],
-                    &colr[k + 1..],
-                    &coli[k + 1..],
-                );
-                let s = c64::new(colr[k] - dr, coli[k] - di);
-                let x = if piv == c64::new(0.0, 0.0) { c64::new(f64::INFINITY, 0.0) } else { s / piv };
-                colr[k] = x.re;
-                coli[k] = x.im;
+        for k in (0..n).rev() {
+            let piv = t[k * n + k];
+            for c in 0..m {
+                let mut s = x[k * m + c];
+                for j in k + 1..n {
+                    s -= t[k * n + j] * x[j * m + c];
+                }
+                x[k * m + c] = if piv == c64::new(0.0, 0.0) { c64::new(f64::INFINITY, 0.0) } else { s / piv };
             }
         }
         for i in 0..p {
-            let crow = &self.ct[i * n..(i + 1) * n];
             for c in 0..m {
-                let re = dot_four_lanes(crow, &xr[c * n..(c + 1) * n]);
-                let im = dot_four_lanes(crow, &xi[c * n..(c + 1) * n]);
-                self.g[(i, c)] += c64::new(re, im);
+                let mut s = self.g[(i, c)];
+                for k in 0..n {
+                    s += x[k * m + c] * self.ct[(i, k)];
+                }
+                self.g[(i, c)] = s;
             }
         }
         self.g.as_ref()
@@ -205,11 +181,6 @@ impl FreqResponse {
             f64::INFINITY
         }
     }
-}
-
-/// Σ tₖxₖ for complex vectors given by their real and imaginary parts: (Re, Im).
-fn complex_dot(tr: &[f64], ti: &[f64], xr: &[f64], xi: &[f64]) -> (f64, f64) {
-    (dot_four_lanes(tr, xr) - dot_four_lanes(ti, xi), dot_four_lanes(tr, xi) + dot_four_lanes(ti, xr))
 }
 
 /// Largest singular value of a small complex matrix (closed forms for vectors and 2-column or

@@ -30,6 +30,7 @@ use faer::linalg::matmul::matmul;
 use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
 
 use super::spectral::eigenvalues;
+use crate::numeric::dot_four_lanes;
 
 /// The eigenvalues μ = λ² of H² (one per pair ±λ of H) and a bound on their absolute error.
 pub(crate) struct SquaredSpectrum {
@@ -37,6 +38,11 @@ pub(crate) struct SquaredSpectrum {
     /// ≈ c·ε·‖H²‖_F: rounding in the formation of H², the reduction and the QR.
     pub abs_error: f64,
 }
+
+/// From this size n on, the reduction's reflections use faer's kernels (issue 13: CM4's
+/// evaluations −35 %); below it the hand-written loops, whose rounding the small plants' design
+/// results (the smoke campaign's table) were obtained with.
+const FAER_KERNELS_FROM: usize = 30;
 
 /// Safety factor on ε‖M‖_F in [`SquaredSpectrum::abs_error`] (the reduction applies 3n
 /// orthogonal transformations; their rounding grows like √n in practice).
@@ -119,6 +125,38 @@ impl ColMajor {
 
     fn view_mut(&mut self) -> MatMut<'_, f64> {
         MatMut::from_column_major_slice_mut(&mut self.data, self.n, self.n)
+    }
+
+    /// X ← P X P by hand-written loops, for small n ([`FAER_KERNELS_FROM`]): the same
+    /// arithmetic as before issue 13's third pass, so that small plants' results (the smoke
+    /// campaign's) stay bit for bit what they were.
+    fn reflect_two_sided_loops(
+        &mut self,
+        r: usize,
+        v: &[f64],
+        beta: f64,
+        first_col: usize,
+        first_row: usize,
+        w: &mut [f64],
+    ) {
+        let len = v.len();
+        for c in first_col..self.n {
+            let seg = &mut self.data[c * self.n + r..c * self.n + r + len];
+            let s = beta * dot_four_lanes(v, seg);
+            if s != 0.0 {
+                axpy(-s, v, seg);
+            }
+        }
+        // Right: w = X[first_row.., r..] v; X[first_row.., r..] −= β w vᵀ.
+        let w = &mut w[first_row..];
+        w.iter_mut().for_each(|t| *t = 0.0);
+        for (k, &vk) in v.iter().enumerate() {
+            axpy(vk, &self.col(r + k)[first_row..], w);
+        }
+        for (k, &vk) in v.iter().enumerate() {
+            let n = self.n;
+            axpy(-beta * vk, w, &mut self.data[(r + k) * n + first_row..(r + k + 1) * n]);
+        }
     }
 
     /// X ← P X P for P = I − β v vᵀ acting on indices r..n (v.len() = n − r). Columns before
@@ -204,9 +242,15 @@ impl SkewHamiltonian {
     /// diag(P, P) similarity at step j (P acting on j+1..n). Q(:, 0..j) = 0 and, by
     /// skew-symmetry, Q(0..j, :) = 0, so Q's update is confined to its trailing block.
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, j: usize, w: &mut [f64]) {
-        self.a.reflect_two_sided(r, v, beta, j, 0, w);
-        self.g.reflect_two_sided(r, v, beta, 0, 0, w);
-        self.q.reflect_two_sided(r, v, beta, j, j, w);
+        if self.a.n >= FAER_KERNELS_FROM {
+            self.a.reflect_two_sided(r, v, beta, j, 0, w);
+            self.g.reflect_two_sided(r, v, beta, 0, 0, w);
+            self.q.reflect_two_sided(r, v, beta, j, j, w);
+        } else {
+            self.a.reflect_two_sided_loops(r, v, beta, j, 0, w);
+            self.g.reflect_two_sided_loops(r, v, beta, 0, 0, w);
+            self.q.reflect_two_sided_loops(r, v, beta, j, j, w);
+        }
     }
 
     /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the full matrix M
@@ -240,7 +284,7 @@ impl SkewHamiltonian {
 /// The Householder vector (v₀ = 1) and β of P = I − β v vᵀ with P x = ∓‖x‖ e₁ (LAPACK `dlarfg`
 /// convention); `None` when x is already a multiple of e₁.
 fn householder(x: &[f64], v: &mut [f64]) -> Option<f64> {
-    let tail = MatRef::from_column_major_slice(&x[1..], x.len() - 1, 1).norm_l2();
+    let tail = x[1..].iter().fold(0.0f64, |s, &t| s.hypot(t));
     if tail == 0.0 {
         return None;
     }
@@ -252,6 +296,13 @@ fn householder(x: &[f64], v: &mut [f64]) -> Option<f64> {
         *vi = xi * scale;
     }
     Some((alpha - x0) / alpha)
+}
+
+/// y += a·x.
+fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
+    }
 }
 
 #[cfg(test)]
