@@ -10,7 +10,9 @@
 //! * `--only N`: just the H∞ norm at order N, 200 times (for a profiler);
 //! * `--design-cpumax S`: CPU budget of each design run of the last table (default 20, as in
 //!   issue 13's `campaign design --order 1 --eps 1e-3 --seed 1 --cpumax 20`); `--no-design`
-//!   skips that table.
+//!   skips that table;
+//! * `--design-only [NAMES]`: just the last table, optionally only the plants in the
+//!   comma-separated NAMES (e.g. `BDT2,CM4`; for a profiler).
 //!
 //! The last table is machine-independent: CPU ms per objective evaluation over a whole design run
 //! (`cpu_s / evals` of the outcome) divided by the CPU time of one dense eigenvalue solve (faer,
@@ -205,6 +207,15 @@ fn main() {
     let dump = args.iter().position(|a| a == "--dump").and_then(|i| args.get(i + 1)).map(PathBuf::from);
     let only: Option<usize> =
         args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
+    let design_only: Option<Vec<String>> = args.iter().position(|a| a == "--design-only").map(|i| {
+        args.get(i + 1)
+            .filter(|s| !s.starts_with("--"))
+            .map_or(Vec::new(), |s| s.split(',').map(String::from).collect())
+    });
+    if let Some(names) = &design_only {
+        design_table(&args, names);
+        return;
+    }
 
     for (family, make) in [
         ("random stable (A = M/√n − 1.2 I)", random_stable as fn(usize, usize, usize, u64) -> StateSpace),
@@ -251,6 +262,11 @@ fn main() {
     if args.iter().any(|a| a == "--no-design") {
         return;
     }
+    design_table(&args, &[]);
+}
+
+/// The design-run table (module docs) for the plants `names` (all three if empty).
+fn design_table(args: &[String], names: &[String]) {
     let cpumax: f64 = args
         .iter()
         .position(|a| a == "--design-cpumax")
@@ -260,6 +276,8 @@ fn main() {
     println!();
     println!("Design run (order nK, ε = 1e-3, seed 1, cpumax {cpumax} s): ms per evaluation / one dense eig of size 2(n + nK)");
     for (name, nk) in [("HE1", 1), ("BDT2", 1), ("CM4", 1)] {
-        design_ratio(name, nk, cpumax);
+        if names.is_empty() || names.iter().any(|n| n == name) {
+            design_ratio(name, nk, cpumax);
+        }
     }
 }

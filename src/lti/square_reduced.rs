@@ -26,7 +26,8 @@
 //! Written by hand: no Rust crate has a structure-preserving Hamiltonian eigensolver (faer's
 //! Hessenberg QR does the final n×n step).
 
-use faer::{c64, Mat, MatRef};
+use faer::linalg::matmul::matmul;
+use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
 
 use super::spectral::eigenvalues;
 use crate::numeric::dot_four_lanes;
@@ -37,6 +38,11 @@ pub(crate) struct SquaredSpectrum {
     /// ≈ c·ε·‖H²‖_F: rounding in the formation of H², the reduction and the QR.
     pub abs_error: f64,
 }
+
+/// From this size n on, the reduction's reflections use faer's kernels (issue 13: CM4's
+/// evaluations −35 %); below it the hand-written loops, whose rounding the small plants' design
+/// results (the smoke campaign's table) were obtained with.
+const FAER_KERNELS_FROM: usize = 30;
 
 /// Safety factor on ε‖M‖_F in [`SquaredSpectrum::abs_error`] (the reduction applies 3n
 /// orthogonal transformations; their rounding grows like √n in practice).
@@ -109,21 +115,33 @@ impl ColMajor {
         &self.data[j * self.n..(j + 1) * self.n]
     }
 
-    fn col_mut(&mut self, j: usize) -> &mut [f64] {
-        &mut self.data[j * self.n..(j + 1) * self.n]
-    }
-
     fn row(&self, i: usize) -> Vec<f64> {
         (0..self.n).map(|j| self.at(i, j)).collect()
     }
 
-    /// X ← P X P for P = I − β v vᵀ acting on indices r..r+len. Columns before `first_col` are
-    /// zero in rows r.. and are skipped on the left; rows before `first_row` are zero in
-    /// columns r.. and are skipped on the right.
-    fn reflect_two_sided(&mut self, r: usize, v: &[f64], beta: f64, first_col: usize, first_row: usize, w: &mut [f64]) {
+    fn view(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&self.data, self.n, self.n)
+    }
+
+    fn view_mut(&mut self) -> MatMut<'_, f64> {
+        MatMut::from_column_major_slice_mut(&mut self.data, self.n, self.n)
+    }
+
+    /// X ← P X P by hand-written loops, for small n ([`FAER_KERNELS_FROM`]): the same
+    /// arithmetic as before issue 13's third pass, so that small plants' results (the smoke
+    /// campaign's) stay bit for bit what they were.
+    fn reflect_two_sided_loops(
+        &mut self,
+        r: usize,
+        v: &[f64],
+        beta: f64,
+        first_col: usize,
+        first_row: usize,
+        w: &mut [f64],
+    ) {
         let len = v.len();
         for c in first_col..self.n {
-            let seg = &mut self.col_mut(c)[r..r + len];
+            let seg = &mut self.data[c * self.n + r..c * self.n + r + len];
             let s = beta * dot_four_lanes(v, seg);
             if s != 0.0 {
                 axpy(-s, v, seg);
@@ -136,8 +154,54 @@ impl ColMajor {
             axpy(vk, &self.col(r + k)[first_row..], w);
         }
         for (k, &vk) in v.iter().enumerate() {
-            axpy(-beta * vk, w, &mut self.col_mut(r + k)[first_row..]);
+            let n = self.n;
+            axpy(-beta * vk, w, &mut self.data[(r + k) * n + first_row..(r + k + 1) * n]);
         }
+    }
+
+    /// X ← P X P for P = I − β v vᵀ acting on indices r..n (v.len() = n − r). Columns before
+    /// `first_col` are zero in rows r.. and are skipped on the left; rows before `first_row` are
+    /// zero in columns r.. and are skipped on the right. Left: t = X[r.., :]ᵀv,
+    /// X[r.., :] −= β v tᵀ; right: z = X[:, r..] v, X[:, r..] −= β z vᵀ: four level-2 passes
+    /// through faer's matrix–vector and rank-one kernels (SIMD chosen at run time) instead of
+    /// hand-written loops (issue 13). For the skew-symmetric G and Q the
+    /// identity P X P = X + β(v yᵀ − y vᵀ), y = Xv, would save a pass, but it was tried and lost
+    /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low).
+    fn reflect_two_sided(
+        &mut self,
+        r: usize,
+        v: &[f64],
+        beta: f64,
+        first_col: usize,
+        first_row: usize,
+        buf: &mut [f64],
+    ) {
+        let (n, len) = (self.n, v.len());
+        let vc = MatRef::from_column_major_slice(v, len, 1);
+        let nc = n - first_col;
+        let t = &mut buf[..nc];
+        matmul(
+            MatMut::from_column_major_slice_mut(t, nc, 1),
+            Accum::Replace,
+            self.view().submatrix(r, first_col, len, nc).transpose(),
+            vc,
+            1.0,
+            Par::Seq,
+        );
+        let t = MatRef::from_row_major_slice(&buf[..nc], 1, nc);
+        matmul(self.view_mut().submatrix_mut(r, first_col, len, nc), Accum::Add, vc, t, -beta, Par::Seq);
+        let nr = n - first_row;
+        let z = &mut buf[..nr];
+        matmul(
+            MatMut::from_column_major_slice_mut(z, nr, 1),
+            Accum::Replace,
+            self.view().submatrix(first_row, r, nr, len),
+            vc,
+            1.0,
+            Par::Seq,
+        );
+        let z = MatRef::from_column_major_slice(&buf[..nr], nr, 1);
+        matmul(self.view_mut().submatrix_mut(first_row, r, nr, len), Accum::Add, z, vc.transpose(), -beta, Par::Seq);
     }
 }
 
@@ -178,9 +242,15 @@ impl SkewHamiltonian {
     /// diag(P, P) similarity at step j (P acting on j+1..n). Q(:, 0..j) = 0 and, by
     /// skew-symmetry, Q(0..j, :) = 0, so Q's update is confined to its trailing block.
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, j: usize, w: &mut [f64]) {
-        self.a.reflect_two_sided(r, v, beta, j, 0, w);
-        self.g.reflect_two_sided(r, v, beta, 0, 0, w);
-        self.q.reflect_two_sided(r, v, beta, j, j, w);
+        if self.a.n >= FAER_KERNELS_FROM {
+            self.a.reflect_two_sided(r, v, beta, j, 0, w);
+            self.g.reflect_two_sided(r, v, beta, 0, 0, w);
+            self.q.reflect_two_sided(r, v, beta, j, j, w);
+        } else {
+            self.a.reflect_two_sided_loops(r, v, beta, j, 0, w);
+            self.g.reflect_two_sided_loops(r, v, beta, 0, 0, w);
+            self.q.reflect_two_sided_loops(r, v, beta, j, j, w);
+        }
     }
 
     /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the full matrix M
