@@ -16,8 +16,6 @@
 //! are an addition to the random ones, never a reason for a run to fail. The computation is
 //! deterministic (no random numbers), so it does not change the reproducibility of a run.
 
-use faer::Mat;
-
 use crate::lti::{
     balanced_truncation, coprime_factor_truncation, dc_gain, spectral_abscissa, CentralProblem, Controller, Plant,
     StateSpace,
@@ -67,7 +65,7 @@ pub fn reduce(plant: &Plant, k: &Controller, nk: usize) -> Vec<Controller> {
     if nk == 0 {
         let Some(dk) = dc_gain(&sys) else { return Vec::new() };
         let (m, p) = (dk.nrows(), dk.ncols());
-        return vec![Controller { ak: Mat::zeros(0, 0), bk: Mat::zeros(0, p), ck: Mat::zeros(m, 0), dk }];
+        return vec![Controller { dk, ..Controller::zeros(0, m, p) }];
     }
     let mut reduced = Vec::new();
     if let Ok(r) = balanced_truncation(&sys, nk) {

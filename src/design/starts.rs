@@ -81,8 +81,7 @@ pub fn scaled_random_start(nvar: usize, sigma: f64, rng: &mut dyn RngCore) -> Ve
 /// the products Ck·(sI − Ak)⁻¹·Bk, whose gradients vanish when both are 0), so this start
 /// optimises Dk (and Ak); the basin hops of the continued search make Bk, Ck non-zero.
 pub fn open_loop_controller(plant: &Plant, nk: usize) -> Controller {
-    let (m, p) = (plant.dims.m2, plant.dims.p2);
-    let k0 = Controller { ak: Mat::zeros(0, 0), bk: Mat::zeros(0, p), ck: Mat::zeros(m, 0), dk: Mat::zeros(m, p) };
+    let k0 = Controller::zeros(0, plant.dims.m2, plant.dims.p2);
     pad_controller(&k0, nk, padding_diagonal(plant, &k0)).expect("any order ≥ 0 pads an order-0 controller")
 }
 

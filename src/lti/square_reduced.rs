@@ -167,6 +167,7 @@ impl ColMajor {
     /// hand-written loops (issue 13). For the skew-symmetric G and Q the
     /// identity P X P = X + β(v yᵀ − y vᵀ), y = Xv, would save a pass, but it was tried and lost
     /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low).
+    /// Below n = [`FAER_KERNELS_FROM`] it runs [`Self::reflect_two_sided_loops`] instead.
     fn reflect_two_sided(
         &mut self,
         r: usize,
@@ -176,6 +177,9 @@ impl ColMajor {
         first_row: usize,
         buf: &mut [f64],
     ) {
+        if self.n < FAER_KERNELS_FROM {
+            return self.reflect_two_sided_loops(r, v, beta, first_col, first_row, buf);
+        }
         let (n, len) = (self.n, v.len());
         let vc = MatRef::from_column_major_slice(v, len, 1);
         let nc = n - first_col;
@@ -242,15 +246,9 @@ impl SkewHamiltonian {
     /// diag(P, P) similarity at step j (P acting on j+1..n). Q(:, 0..j) = 0 and, by
     /// skew-symmetry, Q(0..j, :) = 0, so Q's update is confined to its trailing block.
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, j: usize, w: &mut [f64]) {
-        if self.a.n >= FAER_KERNELS_FROM {
-            self.a.reflect_two_sided(r, v, beta, j, 0, w);
-            self.g.reflect_two_sided(r, v, beta, 0, 0, w);
-            self.q.reflect_two_sided(r, v, beta, j, j, w);
-        } else {
-            self.a.reflect_two_sided_loops(r, v, beta, j, 0, w);
-            self.g.reflect_two_sided_loops(r, v, beta, 0, 0, w);
-            self.q.reflect_two_sided_loops(r, v, beta, j, j, w);
-        }
+        self.a.reflect_two_sided(r, v, beta, j, 0, w);
+        self.g.reflect_two_sided(r, v, beta, 0, 0, w);
+        self.q.reflect_two_sided(r, v, beta, j, j, w);
     }
 
     /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the full matrix M
