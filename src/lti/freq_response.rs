@@ -11,6 +11,7 @@ use faer::linalg::evd::hessenberg;
 use faer::linalg::householder;
 use faer::{c64, Conj, Mat, MatRef, Par};
 
+use super::hessenberg_qr::hessenberg_eigenvalues;
 use super::StateSpace;
 
 /// G(iω) evaluator for one system (reusable buffers).
@@ -97,6 +98,22 @@ impl FreqResponse {
         }
     }
 
+    /// The eigenvalues of A (the poles), from the Hessenberg form H by our Francis QR
+    /// (`hessenberg_qr.rs`). H is an orthogonal similarity of A by the same backward-stable
+    /// reduction that faer's eigensolver starts with, so they are as accurate as faer's, for one
+    /// Hessenberg reduction instead of two when the response is needed anyway (issue 13). `None`
+    /// if the QR does not converge.
+    pub(crate) fn poles(&self) -> Option<Vec<c64>> {
+        let n = self.n;
+        let mut h = vec![0.0; n * n];
+        for i in 0..n {
+            for j in i.saturating_sub(1)..n {
+                h[i + j * n] = self.h[i * n + j];
+            }
+        }
+        hessenberg_eigenvalues(&mut h, n).ok()
+    }
+
     /// G(iω) (p×m); D for ω = +∞. Entries are +∞ if iωI − H is exactly singular.
     pub(crate) fn eval(&mut self, w: f64) -> MatRef<'_, c64> {
         let (n, m, p) = (self.n, self.m, self.p);
@@ -181,6 +198,15 @@ impl FreqResponse {
             f64::INFINITY
         }
     }
+}
+
+/// The eigenvalues of a finite square matrix by [`FreqResponse::new`]'s Hessenberg reduction and
+/// our Francis QR: bit for bit [`FreqResponse::poles`] of any system with this A, so the
+/// stability decision and the H∞ norm's poles agree exactly. `None` if the QR does not converge.
+pub(crate) fn hessenberg_qr_eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
+    let n = a.nrows();
+    let sys = StateSpace { a: a.to_owned(), b: Mat::zeros(n, 0), c: Mat::zeros(0, n), d: Mat::zeros(0, 0) };
+    FreqResponse::new(&sys).poles()
 }
 
 /// Largest singular value of a small complex matrix (closed forms for vectors and 2-column or

@@ -25,9 +25,9 @@ use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
 
 use super::closed_loop::ClosedLoop;
-use super::hinf::{hinf_norm_with_poles, HinfNorm};
+use super::hinf::{hinf_norm_of_finite, HinfNorm};
 use super::interrupt::Interrupt;
-use super::spectral::{eigenvalues, rightmost_eigen};
+use super::spectral::rightmost_eigen;
 use super::{Controller, LtiError, Plant, StateSpace};
 
 /// Gradient with respect to (Ak, Bk, Ck, Dk), same shapes as the controller.
@@ -143,9 +143,7 @@ pub(crate) fn hinf_with_vectors(
     if !sys.is_finite() {
         return Ok(None);
     }
-    stop.poll()?;
-    let Some(poles) = eigenvalues(sys.a.as_ref()) else { return Ok(None) };
-    let norm = hinf_norm_with_poles(sys, &poles, tol, hints, stop)?;
+    let norm = hinf_norm_of_finite(sys, tol, hints, stop)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }

@@ -61,6 +61,7 @@
 use faer::{c64, Mat};
 
 use super::freq_response::FreqResponse;
+use super::hessenberg_qr::HESSENBERG_QR_FROM;
 use super::interrupt::{Interrupt, Interrupted};
 use super::level_set_pencil::pencil_crossings;
 use super::spectral::eigenvalues;
@@ -139,10 +140,31 @@ pub fn hinf_norm_near_interruptible(
     if !sys.is_finite() {
         return Ok(HinfNorm::UNSTABLE);
     }
+    hinf_norm_of_finite(sys, tol, hints, stop)
+}
+
+/// [`hinf_norm_near_interruptible`] for finite data, with the poles computed here: from order
+/// [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one Hessenberg
+/// reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver (the rounding
+/// the small plants' results were obtained with). An eigensolver failure counts as unstable.
+pub(crate) fn hinf_norm_of_finite(
+    sys: &StateSpace,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+) -> Result<HinfNorm, Interrupted> {
     stop.poll()?;
-    match eigenvalues(sys.a.as_ref()) {
-        Some(poles) => hinf_norm_with_poles(sys, &poles, tol, hints, stop),
-        None => Ok(HinfNorm::UNSTABLE),
+    if sys.order() >= HESSENBERG_QR_FROM {
+        let fr = FreqResponse::new(sys);
+        match fr.poles() {
+            Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, stop),
+            None => Ok(HinfNorm::UNSTABLE),
+        }
+    } else {
+        match eigenvalues(sys.a.as_ref()) {
+            Some(poles) => hinf_norm_from(sys, &poles, None, tol, hints, stop),
+            None => Ok(HinfNorm::UNSTABLE),
+        }
     }
 }
 
@@ -171,14 +193,15 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
     tol: f64,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
-    hinf_norm_with_poles(sys, poles, tol, &[], stop)
+    hinf_norm_from(sys, poles, None, tol, &[], stop)
 }
 
-/// [`hinf_norm_near_interruptible`] when the poles (eigenvalues of A) are already known (shared
-/// with the stability test). The data must be finite.
-pub(crate) fn hinf_norm_with_poles(
+/// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
+/// evaluator `fr` of `sys` if given. The data must be finite.
+fn hinf_norm_from(
     sys: &StateSpace,
     poles: &[c64],
+    fr: Option<FreqResponse>,
     tol: f64,
     hints: &[f64],
     stop: Interrupt<'_>,
@@ -192,7 +215,7 @@ pub(crate) fn hinf_norm_with_poles(
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
     stop.poll()?;
-    let mut fr = FreqResponse::new(sys);
+    let mut fr = fr.unwrap_or_else(|| FreqResponse::new(sys));
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
 

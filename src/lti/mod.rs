@@ -12,6 +12,7 @@ pub(crate) mod export;
 pub(crate) mod freq_response;
 mod full_order;
 mod gradient;
+mod hessenberg_qr;
 mod hinf;
 mod interrupt;
 mod level_set_pencil;

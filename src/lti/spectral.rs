@@ -27,6 +27,9 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{self, ComputeEigenvectors};
 use faer::{c64, Mat, MatRef, Par};
 
+use super::freq_response::hessenberg_qr_eigenvalues;
+use super::hessenberg_qr::HESSENBERG_QR_FROM;
+
 /// Lower bound on the cosine |uᴴv|/(‖u‖‖v‖) between left and right eigenvectors used in the
 /// gradient (the reciprocal of the largest eigenvalue condition number we trust); ≈ 1000 ε.
 pub const MIN_EIGVEC_COSINE: f64 = 1e-13;
@@ -55,7 +58,9 @@ pub fn is_stable(spectral_abscissa: f64) -> bool {
     spectral_abscissa < 0.0
 }
 
-/// Eigenvalues of a real square matrix; `None` on non-finite input or failure.
+/// Eigenvalues of a real square matrix; `None` on non-finite input or failure. From n =
+/// [`HESSENBERG_QR_FROM`] on by a Hessenberg reduction and our Francis QR (`hessenberg_qr.rs`,
+/// faster than faer's `evd_real` and exactly the poles the H∞ norm uses), below it by faer.
 pub(crate) fn eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
     let n = a.nrows();
     if n == 0 {
@@ -63,6 +68,9 @@ pub(crate) fn eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
     }
     if !crate::numeric::all_finite(a) {
         return None;
+    }
+    if n >= HESSENBERG_QR_FROM {
+        return hessenberg_qr_eigenvalues(a);
     }
     let mut wr = faer::diag::Diag::<f64>::zeros(n);
     let mut wi = faer::diag::Diag::<f64>::zeros(n);

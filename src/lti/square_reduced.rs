@@ -29,6 +29,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
 
+use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
 use super::spectral::eigenvalues;
 use crate::numeric::dot_four_lanes;
 
@@ -80,6 +81,10 @@ pub(crate) fn skew_hamiltonian_eigenvalues(
     let n = a.nrows();
     let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
     blocks.pvl_reduce();
+    if n >= HESSENBERG_QR_FROM {
+        // W's leading block is already Hessenberg: no second reduction (issue 13).
+        return hessenberg_eigenvalues(&mut blocks.a.data, n).ok();
+    }
     let w = Mat::from_fn(n, n, |i, j| if i <= j + 1 { blocks.a.at(i, j) } else { 0.0 });
     eigenvalues(w.as_ref())
 }
@@ -166,7 +171,10 @@ impl ColMajor {
     /// through faer's matrix–vector and rank-one kernels (SIMD chosen at run time) instead of
     /// hand-written loops (issue 13). For the skew-symmetric G and Q the
     /// identity P X P = X + β(v yᵀ − y vᵀ), y = Xv, would save a pass, but it was tried and lost
-    /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low).
+    /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low), and so
+    /// did the general fused form P X P = X − v(βt)ᵀ − (βz − β²(vᵀz)v)vᵀ with t = Xᵀv, z = Xv
+    /// (three passes instead of four; issue 13, fourth pass, 5.4e-4 too low on the same fixture):
+    /// on badly scaled X the rounding of the scalar vᵀXv spreads over the whole trailing block.
     /// Below n = [`FAER_KERNELS_FROM`] it runs [`Self::reflect_two_sided_loops`] instead.
     fn reflect_two_sided(
         &mut self,
@@ -226,10 +234,11 @@ impl SkewHamiltonian {
         let n = self.a.n;
         let mut v = vec![0.0; n];
         let mut w = vec![0.0; n];
+        let fast_norm = n >= FAER_KERNELS_FROM;
         for j in 0..n.saturating_sub(1) {
             let r = j + 1;
             let len = n - r;
-            if let Some(beta) = householder(&self.q.col(j)[r..n], &mut v[..len]) {
+            if let Some(beta) = householder(&self.q.col(j)[r..n], &mut v[..len], fast_norm) {
                 self.reflect(r, &v[..len], beta, j, &mut w);
             }
             let (a, b) = (self.a.at(r, j), self.q.at(r, j));
@@ -237,7 +246,7 @@ impl SkewHamiltonian {
                 let rho = a.hypot(b);
                 self.rotate(r, a / rho, b / rho);
             }
-            if let Some(beta) = householder(&self.a.col(j)[r..n], &mut v[..len]) {
+            if let Some(beta) = householder(&self.a.col(j)[r..n], &mut v[..len], fast_norm) {
                 self.reflect(r, &v[..len], beta, j, &mut w);
             }
         }
@@ -281,8 +290,14 @@ impl SkewHamiltonian {
 
 /// The Householder vector (v₀ = 1) and β of P = I − β v vᵀ with P x = ∓‖x‖ e₁ (LAPACK `dlarfg`
 /// convention); `None` when x is already a multiple of e₁.
-fn householder(x: &[f64], v: &mut [f64]) -> Option<f64> {
-    let tail = x[1..].iter().fold(0.0f64, |s, &t| s.hypot(t));
+/// From n = [`FAER_KERNELS_FROM`] on (`fast_norm`) the tail's norm is faer's (scaled, SIMD)
+/// instead of a `hypot` fold (libm's hypot was 2 % of a BDT2 design run).
+fn householder(x: &[f64], v: &mut [f64], fast_norm: bool) -> Option<f64> {
+    let tail = if fast_norm {
+        MatRef::from_column_major_slice(&x[1..], x.len() - 1, 1).norm_l2()
+    } else {
+        x[1..].iter().fold(0.0f64, |s, &t| s.hypot(t))
+    };
     if tail == 0.0 {
         return None;
     }
