@@ -310,5 +310,7 @@ fn ac10_order1_is_stabilised_from_a_cold_start() {
     assert!(!matches!(o.status, DesignStatus::NotStabilised { .. }), "{:?}", o.status);
     assert_eq!(o.search.stop, SearchStop::Maxevals, "{:?}", o.search);
     check_recomputed(&p, &o);
-    assert!(o.gamma.is_finite() && o.gamma < 30.0, "γ = {}", o.gamma);
+    // The search in plant-scaled variables (`variable_scaling`, default) reaches 11.37 here; in the
+    // raw variables (`variable_scaling = false`) it reached 15.68.
+    assert!(o.gamma.is_finite() && o.gamma < 12.0, "γ = {}", o.gamma);
 }
