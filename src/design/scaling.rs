@@ -16,10 +16,13 @@
 //! s_y,j = 1/‖row j of C2·T‖₂, rounded to the nearest power of two (so x ↔ x̃ is exact in
 //! floating point both ways; a zero channel gets 1).
 //!
-//! A plant whose channels are *alike* — within each group every norm within a factor √2 of the
-//! group's geometric mean (every SISO plant) — is not scaled at all (d = 1: the search is exactly
-//! the unscaled one). Only plants with channels of different sizes, which the unscaled search
-//! handles badly, change.
+//! A plant whose channels are *alike* — within each group the largest norm at most
+//! [`MAX_UNSCALED_SPREAD`] = 2¹⁰ times the smallest (every SISO plant; HE1, REA2, Enns, AC8) — is
+//! not scaled at all (d = 1: the search is exactly the unscaled one). Only plants whose channels
+//! differ by more than three orders of magnitude (AC10: 2·10⁵ between its measurements; BDT2:
+//! 10⁴ between its controls) change. Measured on AC8 (measurement norms 128× apart), scaling all
+//! plants would hurt: n_K = 1 at 20 000 evaluations, seeds 1 and 2, reached γ 2.016 and 2.020
+//! scaled against 1.650 and 1.651 unscaled (issue 12a's note).
 //!
 //! The objective is the same function of the controller in either coordinates; only the
 //! optimiser's view changes: its steps, its initial inverse Hessian (the identity), the basin
@@ -44,16 +47,21 @@ fn reciprocal_scale(v: f64) -> f64 {
     }
 }
 
-/// Whether the channels of one group are alike: every norm is within a factor √2 of the group's
-/// geometric mean (zero or non-finite norms are ignored).
+/// Largest ratio of two channel norms within a group (controls, or measurements) for which the
+/// plant is searched unscaled (module docs).
+pub const MAX_UNSCALED_SPREAD: f64 = 1024.0;
+
+/// Whether the channels of one group are alike: largest / smallest norm ≤ [`MAX_UNSCALED_SPREAD`]
+/// (zero or non-finite norms are ignored).
 fn alike(norms: &[f64]) -> bool {
-    let logs: Vec<f64> = norms.iter().filter(|v| v.is_finite() && **v > 0.0).map(|v| v.log2()).collect();
-    let mean = logs.iter().sum::<f64>() / logs.len().max(1) as f64;
-    logs.iter().all(|l| (l - mean).abs() < 0.5)
+    let ok = || norms.iter().copied().filter(|v| v.is_finite() && *v > 0.0);
+    let (lo, hi) = (ok().fold(f64::INFINITY, f64::min), ok().fold(0.0, f64::max));
+    !(hi > MAX_UNSCALED_SPREAD * lo)
 }
 
 /// The channel scales (s_u over the m controls, s_y over the p measurements) of `plant`
-/// (module docs), `None` if the plant's channels are alike (within a factor √2 in each group).
+/// (module docs), `None` if the plant's channels are alike (spread ≤ [`MAX_UNSCALED_SPREAD`]
+/// in each group).
 pub fn channel_scales(plant: &Plant) -> Option<(Vec<f64>, Vec<f64>)> {
     let n = plant.dims.n;
     let zero = Mat::<f64>::zeros(n, n);
@@ -111,10 +119,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn scales_are_powers_of_two_and_alike_means_within_root_two() {
+    fn scales_are_powers_of_two_and_alike_means_within_the_spread() {
         assert_eq!([5.0, 0.3, 1.0, 0.0, f64::NAN].map(reciprocal_scale), [0.25, 4.0, 1.0, 1.0, 1.0]);
-        assert!(alike(&[3.0, 3.0]) && alike(&[5.0]) && alike(&[0.0, 2.0, 2.5]) && alike(&[]));
-        assert!(!alike(&[1.0, 2.1]) && !alike(&[0.05, 5e3]));
+        assert!(alike(&[3.0, 3.0]) && alike(&[5.0]) && alike(&[0.0, 2.0, 2000.0]) && alike(&[]));
+        assert!(!alike(&[1.0, 1025.0]) && !alike(&[0.05, 5e3]));
     }
 
     #[test]
