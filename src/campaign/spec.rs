@@ -712,6 +712,14 @@ objective = "plain"
             (vec![1.0, 1e-3], false)
         );
         assert_eq!((c.problems[1].base.random_scales.clone(), c.problems[1].base.open_loop_start), (vec![0.5], true));
+        let c = parse(
+            "name = \"t\"\n[defaults]\nvariable_scaling = true\n[[problem]]\nplant = \"HE1\"\norders = [1]\n\
+             [[problem]]\nplant = \"REA2\"\norders = [1]\nvariable_scaling = false\n",
+        )
+        .unwrap();
+        assert_eq!((c.problems[0].base.variable_scaling, c.problems[1].base.variable_scaling), (true, false));
+        let e = err("name = \"t\"\n[defaults]\nvariable_scaling = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
+        assert!(e.message.contains("variable_scaling") || e.location.line == 3, "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
         assert!(e.message.contains("random_scales"), "{e}");
