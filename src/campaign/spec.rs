@@ -85,6 +85,7 @@ macro_rules! with_design_settings {
             central_gammas: Option<Spanned<Vec<f64>>>,
             random_scales: Option<Spanned<Vec<f64>>>,
             open_loop_start: Option<bool>,
+            variable_scaling: Option<bool>,
             $($tail)*
         }
     };
@@ -396,6 +397,7 @@ struct Layered {
     central_gammas: Setting<Vec<f64>>,
     random_scales: Setting<Vec<f64>>,
     open_loop_start: Option<bool>,
+    variable_scaling: Option<bool>,
 }
 
 impl Layered {
@@ -419,6 +421,7 @@ impl Layered {
             central_gammas: layer(&p.central_gammas, &d.central_gammas),
             random_scales: layer(&p.random_scales, &d.random_scales),
             open_loop_start: p.open_loop_start.or(d.open_loop_start),
+            variable_scaling: p.variable_scaling.or(d.variable_scaling),
         }
     }
 
@@ -453,6 +456,9 @@ impl Layered {
         }
         if let Some(b) = self.open_loop_start {
             o.open_loop_start = b;
+        }
+        if let Some(b) = self.variable_scaling {
+            o.variable_scaling = b;
         }
         if let Some(k) = self.objective {
             o.objective = k;
@@ -706,6 +712,14 @@ objective = "plain"
             (vec![1.0, 1e-3], false)
         );
         assert_eq!((c.problems[1].base.random_scales.clone(), c.problems[1].base.open_loop_start), (vec![0.5], true));
+        let c = parse(
+            "name = \"t\"\n[defaults]\nvariable_scaling = true\n[[problem]]\nplant = \"HE1\"\norders = [1]\n\
+             [[problem]]\nplant = \"REA2\"\norders = [1]\nvariable_scaling = false\n",
+        )
+        .unwrap();
+        assert_eq!((c.problems[0].base.variable_scaling, c.problems[1].base.variable_scaling), (true, false));
+        let e = err("name = \"t\"\n[defaults]\nvariable_scaling = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
+        assert!(e.message.contains("variable_scaling") || e.location.line == 3, "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
         assert!(e.message.contains("random_scales"), "{e}");

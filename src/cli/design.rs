@@ -1,7 +1,7 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--max-starts N] [--hop-scales 0.01,0.1,1]
 //! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start]
-//! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
+//! [--variable-scaling] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
 //!
@@ -75,6 +75,11 @@ pub struct DesignArgs {
     /// ones: Bk, Ck, Dk = 0 and Ak a stable diagonal).
     #[arg(long)]
     pub no_open_loop_start: bool,
+    /// Search in controller variables scaled by the plant's control and measurement channel
+    /// sizes (powers of two; no change for a plant whose channels are within 2^10 of each other).
+    /// Plants whose channels differ by orders of magnitude (AC10) need it; off by default.
+    #[arg(long)]
+    pub variable_scaling: bool,
     /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
     /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
     /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.
@@ -116,6 +121,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,
         random_scales: parse_scales(&a.random_scales, "--random-scales")?,
         open_loop_start: !a.no_open_loop_start,
+        variable_scaling: a.variable_scaling,
         objective: if a.no_strong { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
         ..Default::default()
     };

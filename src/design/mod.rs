@@ -7,6 +7,7 @@
 //! * `objective`: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
 //!   observer adapter;
 //! * `phases`: the optimiser options of the two phases;
+//! * `scaling`: plant-scaled controller variables x = d ∘ x̃ for the search;
 //! * `search`: the multi-start search (local searches until a budget or the stall rule, basin
 //!   hopping, gradient sampling on the best point);
 //! * [`run`]: the entry point.
@@ -20,6 +21,7 @@ mod outcome;
 pub(crate) mod params;
 mod phases;
 mod run;
+pub(crate) mod scaling;
 mod search;
 pub(crate) mod starts;
 
@@ -39,4 +41,5 @@ pub use outcome::{
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};
+pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{GS_RESERVE, TIME_TO_BEST_RTOL};

@@ -139,6 +139,9 @@ pub struct DesignObjective<'p> {
     /// Told the CPU seconds of every complete closed-loop evaluation where `stop` applies (large
     /// plants), so the run can hold back what recomputing its result will cost.
     on_eval_cpu: Option<Rc<dyn Fn(f64)>>,
+    /// Variable scaling d: the objective's x is x̃ with controller parameters d ∘ x̃
+    /// (`design::scaling`); `None`: x are the parameters.
+    scaling: Option<Rc<[f64]>>,
 }
 
 impl<'p> DesignObjective<'p> {
@@ -165,6 +168,23 @@ impl<'p> DesignObjective<'p> {
             stop: None,
             abandoned: Cell::new(false),
             on_eval_cpu: None,
+            scaling: None,
+        }
+    }
+
+    /// Takes x as scaled variables x̃ with controller parameters d ∘ x̃ (`design::scaling`);
+    /// gradients are then with respect to x̃ (d ∘ ∇ₓ). `None`: unscaled.
+    pub fn with_scaling(mut self, d: Option<Rc<[f64]>>) -> Self {
+        assert!(d.as_ref().is_none_or(|d| d.len() == self.shape.nvar()), "scaling length must be nvar");
+        self.scaling = d;
+        self
+    }
+
+    /// The controller at the objective's variables `x` (scaled if [`Self::with_scaling`]).
+    fn controller(&self, x: &[f64]) -> Controller {
+        match &self.scaling {
+            Some(d) => self.shape.controller(&super::scaling::from_scaled(x, Some(d))),
+            None => self.shape.controller(x),
         }
     }
 
@@ -189,6 +209,7 @@ impl<'p> DesignObjective<'p> {
         DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache())
             .with_interrupt(o.stop.clone())
             .with_eval_cpu_report(o.on_eval_cpu.clone())
+            .with_scaling(o.scaling.clone())
     }
 
     /// True if the stop hook applies to this plant and has fired.
@@ -326,11 +347,16 @@ impl Objective for DesignObjective<'_> {
     }
 
     fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        let k = self.shape.controller(x);
+        let k = self.controller(x);
         self.abandoned.set(false);
         let (c, grad) = self.components(&k, true);
         match grad {
-            Some(gk) if c.f.is_finite() => self.shape.write_x(&gk, g),
+            Some(gk) if c.f.is_finite() => {
+                self.shape.write_x(&gk, g);
+                if let Some(d) = &self.scaling {
+                    g.iter_mut().zip(d.iter()).for_each(|(v, s)| *v *= s);
+                }
+            }
             _ => g.iter_mut().for_each(|v| *v = f64::NAN),
         }
         if !self.abandoned.get() {
@@ -345,7 +371,7 @@ impl Objective for DesignObjective<'_> {
     /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13).
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
         if self.phase == ObjectivePhase::Performance && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION {
-            let lb = self.performance_lower_bound(&self.shape.controller(x));
+            let lb = self.performance_lower_bound(&self.controller(x));
             if lb >= threshold {
                 g.iter_mut().for_each(|v| *v = f64::NAN);
                 return lb;
@@ -448,14 +474,14 @@ impl Observer for ObserverAdapter<'_, '_> {
         let mut c = match cached {
             Some(c) => c,
             None if wants => {
-                let (c, _) = obj.components(&obj.shape.controller(rec.x), false);
+                let (c, _) = obj.components(&obj.controller(rec.x), false);
                 obj.cache.borrow_mut().update(rec.x, c);
                 c
             }
             None => Components::UNKNOWN,
         };
         if wants && c.alpha_cl.is_nan() && obj.phase == ObjectivePhase::Performance && !obj.stop_fired() {
-            let k = obj.shape.controller(rec.x);
+            let k = obj.controller(rec.x);
             c.alpha_cl = closed_loop(obj.plant, &k).map(|cl| spectral_abscissa(cl.a.as_ref())).unwrap_or(f64::INFINITY);
             obj.cache.borrow_mut().update(rec.x, c);
         }

@@ -22,6 +22,7 @@ use super::outcome::{
     Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
+use super::scaling::{from_scaled, to_scaled, variable_scaling};
 use super::search::Search;
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
 
@@ -242,6 +243,12 @@ fn run_validated(
         first.push(controller_to_x(&k));
         kinds.push(StartKind::Central);
     }
+    // The search runs on x̃ = x / d (`design::scaling`); its starts are the same controllers.
+    let scaling: Option<std::rc::Rc<[f64]>> =
+        if opts.variable_scaling { variable_scaling(plant, shape).map(Into::into) } else { None };
+    if let Some(d) = scaling.as_deref() {
+        first.iter_mut().for_each(|x| *x = to_scaled(x, Some(d)));
+    }
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
     let stab_obj = DesignObjective::new(
         plant,
@@ -256,7 +263,7 @@ fn run_validated(
     // sub-budget of the search is checked between evaluations.
     let stop_ctl = ctl.clone();
     let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
-    let mut stab_obj = stab_obj.with_interrupt(Some(Rc::clone(&stop)));
+    let mut stab_obj = stab_obj.with_interrupt(Some(Rc::clone(&stop))).with_scaling(scaling.clone());
     // On large plants, hold back the largest evaluation seen from the CPU budget: the returned
     // controller's figures (about one evaluation) are computed after the search, and should end
     // near cpumax, not one evaluation after it. (Small plants never report: their runs are
@@ -266,7 +273,8 @@ fn run_validated(
     let mut perf_obj =
         DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache)
             .with_interrupt(Some(stop))
-            .with_eval_cpu_report(Some(report));
+            .with_eval_cpu_report(Some(report))
+            .with_scaling(scaling.clone());
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
     let res =
         Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
@@ -291,7 +299,7 @@ fn run_validated(
         DesignStatus::Stopped
     };
 
-    let k = shape.controller(&final_x);
+    let k = shape.controller(&from_scaled(&final_x, scaling.as_deref()));
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
     let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });

@@ -54,6 +54,7 @@ pub use mat_file::{is_mat_path, read_mat_vars, write_mat, MatReadError, MatVar};
 pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
 pub use plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
+pub(crate) use riccati::balance_scaling;
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::abscissa_of;
 pub(crate) use spectral::eigenvalues as eigenvalues_of;

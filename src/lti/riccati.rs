@@ -261,7 +261,7 @@ pub(crate) fn sign_iteration(mut z: Mat<f64>) -> Result<(Mat<f64>, usize, f64), 
 /// Benner's symplectic balancing). Scaling state i by f multiplies column i of A by f and row i
 /// by 1/f (each appearing twice in H), the off-diagonal row/column i of G by 1/f and of Q by f,
 /// and their diagonal entries by 1/f² and f².
-fn balance_scaling(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
+pub(crate) fn balance_scaling(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
     let n = a.nrows();
     let mut a = a.to_owned();
     let mut g = g.to_owned();
@@ -281,7 +281,9 @@ fn balance_scaling(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -
             down4 += g[(i, i)].powi(2);
             let cost = |f: f64| up2 * f * f + down2 / (f * f) + up4 * f.powi(4) + down4 / f.powi(4);
             let base = cost(1.0);
-            if base == 0.0 || !base.is_finite() {
+            // One side empty: the cost falls monotonically towards f = 0 or ∞ (a decoupled
+            // state, which LAPACK isolates by permutation): leave that coordinate alone.
+            if base == 0.0 || !base.is_finite() || up2 + up4 == 0.0 || down2 + down4 == 0.0 {
                 continue;
             }
             // Walk by factors of two while the cost keeps dropping.
