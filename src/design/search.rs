@@ -30,7 +30,10 @@
 //! `stall_starts` consecutive local searches have not lowered the best objective by at least
 //! `stall_rtol`·|best| (f_h once a stable point exists; before that, f_s, whose improvements count
 //! at least `stall_rtol` in absolute terms near 0, and only if no budget is finite).
-//! `stall_starts = 0` is HIFOO's search.
+//! `stall_starts = 0` is HIFOO's search. With `spend_budget` (the default) the stall rule ends
+//! only runs that no budget bounds: a run with a finite `cpumax`, `maxevals` or `max_starts`
+//! goes on until that budget ends it, since more local searches can only lower the best
+//! objective, and on small plants the stall rule used to end a 60-s job after 1–4 s.
 //!
 //! # Gradient sampling on the incumbent
 //! If gradient sampling is on, [`GS_RESERVE`] of each budget (CPU and evaluations) is kept for
@@ -344,9 +347,11 @@ impl Search<'_, '_, '_> {
                     break;
                 }
                 // Stabilisation is never given up while a budget bounds the run: the stall rule
-                // applies once a stable point is known (or when nothing else would end the run).
+                // applies once a stable point is known (or when nothing else would end the run),
+                // and with `spend_budget` only when nothing else would end the run.
                 let bounded = search_ctl.cpumax().is_finite() || opts.maxevals.is_some() || opts.max_starts.is_some();
-                if st.stall >= opts.stall_starts && (st.stabilised || !bounded) {
+                let stall_ends = !bounded || (st.stabilised && !opts.spend_budget);
+                if st.stall >= opts.stall_starts && stall_ends {
                     stop = Some(SearchStop::Stall);
                     break;
                 }
