@@ -86,6 +86,7 @@ macro_rules! with_design_settings {
             random_scales: Option<Spanned<Vec<f64>>>,
             open_loop_start: Option<bool>,
             spend_budget: Option<bool>,
+            continue_at_maxit: Option<bool>,
             $($tail)*
         }
     };
@@ -398,6 +399,7 @@ struct Layered {
     random_scales: Setting<Vec<f64>>,
     open_loop_start: Option<bool>,
     spend_budget: Option<bool>,
+    continue_at_maxit: Option<bool>,
 }
 
 impl Layered {
@@ -422,6 +424,7 @@ impl Layered {
             random_scales: layer(&p.random_scales, &d.random_scales),
             open_loop_start: p.open_loop_start.or(d.open_loop_start),
             spend_budget: p.spend_budget.or(d.spend_budget),
+            continue_at_maxit: p.continue_at_maxit.or(d.continue_at_maxit),
         }
     }
 
@@ -459,6 +462,9 @@ impl Layered {
         }
         if let Some(b) = self.spend_budget {
             o.spend_budget = b;
+        }
+        if let Some(b) = self.continue_at_maxit {
+            o.continue_at_maxit = b;
         }
         if let Some(k) = self.objective {
             o.objective = k;

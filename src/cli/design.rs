@@ -1,6 +1,6 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--stop-on-stall] [--max-starts N] [--hop-scales 0.01,0.1,1]
-//! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start]
+//! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start] [--no-continue-at-maxit]
 //! [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
@@ -66,6 +66,10 @@ pub struct DesignArgs {
     /// runs without any budget.
     #[arg(long)]
     pub stop_on_stall: bool,
+    /// Do not resume the best point's local search when BFGS stopped it at its iteration limit
+    /// (by default the next continued start is that point itself, with a fresh BFGS).
+    #[arg(long)]
+    pub no_continue_at_maxit: bool,
     /// Largest number of local searches (first starts included; deterministic).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub max_starts: Option<u64>,
@@ -119,6 +123,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         stall_starts: a.stall_starts,
         stall_rtol: a.stall_rtol,
         spend_budget: !a.stop_on_stall,
+        continue_at_maxit: !a.no_continue_at_maxit,
         max_starts: a.max_starts.map(|n| n as usize),
         hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
         central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,

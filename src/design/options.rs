@@ -92,6 +92,12 @@ pub struct DesignOptions {
     /// false, the behaviour before this option existed; not written when false.)
     #[serde(default, skip_serializing_if = "is_false")]
     pub spend_budget: bool,
+    /// Resume a cut local search: when the f_h local search that produced the best point ended
+    /// on `maxit` (not at a minimiser), the next continued start is that point itself, with a
+    /// fresh BFGS (the first starts are unchanged). (Missing in a serialised record: false, the
+    /// behaviour before this option existed; not written when false.)
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub continue_at_maxit: bool,
     /// Largest number of local searches (first starts included); `None`: no limit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_starts: Option<usize>,
@@ -157,6 +163,7 @@ impl Default for DesignOptions {
             stall_starts: DEFAULT_STALL_STARTS,
             stall_rtol: 1e-6,
             spend_budget: true,
+            continue_at_maxit: true,
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
             random_scales: DEFAULT_RANDOM_SCALES.to_vec(),
@@ -191,6 +198,7 @@ mod tests {
             format!("stall_starts {},", d.stall_starts),
             format!("stall_rtol {:e},", d.stall_rtol),
             format!("spend_budget {},", d.spend_budget),
+            format!("continue_at_maxit {},", d.continue_at_maxit),
             format!("maxit {},", d.maxit),
             format!("normtol {:e},", d.normtol),
             format!("evaldist {:e},", d.evaldist),

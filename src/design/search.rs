@@ -22,6 +22,12 @@
 //!    point of f_h, or of f_s while no stable point has been found: stabilisation is restarted,
 //!    never given up, until a budget ends the run (the stall rule applies only once a stable point is known, or when no
 //!    budget — cpumax, maxevals, max_starts — is finite).
+//!    If the f_h local search that produced the current best point ended on `maxit` rather than at a
+//!    minimiser, the next start is that point itself (`continue_at_maxit`, recorded as a hop of
+//!    size 0): its local search goes on with a fresh inverse-Hessian approximation instead of
+//!    being left unfinished. This uses no random numbers and leaves the cycle's draws unchanged.
+//!    It matters for many variables (Enns n_K = 8, 81 variables: local searches of ~1000
+//!    iterations; the best after 60 CPU s went from 1.1317 to 1.1299 with longer searches).
 //!
 //! # When it stops
 //! Before each new local search (and within one, between evaluations) the run stops on the CPU
@@ -134,6 +140,9 @@ struct State<'s> {
     stab: Option<Best>,
     stabilised: bool,
     stall: usize,
+    /// The f_h local search that produced `perf` ended on `maxit` (not at a minimiser): the next
+    /// continued start resumes it (`continue_at_maxit`).
+    perf_cut: bool,
 }
 
 impl State<'_> {
@@ -166,8 +175,19 @@ impl State<'_> {
         if r.f.is_finite() && r.f < old {
             self.perf =
                 Some(Best { x: r.x.clone(), f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from: from.to_vec() });
+            self.perf_cut = r.termination == Termination::MaxIters;
         }
         better
+    }
+
+    /// The start that resumes the incumbent's local search if `maxit` cut it (and
+    /// `continue_at_maxit`): the incumbent itself, once.
+    fn take_continuation(&mut self) -> Option<Vec<f64>> {
+        if !(self.opts.continue_at_maxit && self.perf_cut) {
+            return None;
+        }
+        self.perf_cut = false;
+        self.perf.as_ref().map(|b| b.x.clone())
     }
 }
 
@@ -317,8 +337,10 @@ impl Search<'_, '_, '_> {
             stab: None,
             stabilised: false,
             stall: 0,
+            perf_cut: false,
         };
         let mut k = 0usize; // local searches made
+        let mut cycle = 0usize; // continued starts drawn from the hop / random cycle
         let mut gs_fallback_done = false;
         let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
         let mut stop = None;
@@ -355,7 +377,13 @@ impl Search<'_, '_, '_> {
                     stop = Some(SearchStop::Stall);
                     break;
                 }
-                let (x0, kind) = self.next_start(&st, k - first.len() - gs_fallback_done as usize, nvar);
+                let (x0, kind) = match st.take_continuation() {
+                    Some(x) => (x, StartKind::Hop),
+                    None => {
+                        cycle += 1;
+                        self.next_start(&st, cycle - 1, nvar)
+                    }
+                };
                 kinds.push(kind);
                 self.local(&mut st, &x0, k, search_ctl)?
             };
