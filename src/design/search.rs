@@ -27,7 +27,8 @@
 //!    size 0): its local search goes on with a fresh inverse-Hessian approximation instead of
 //!    being left unfinished. This uses no random numbers and leaves the cycle's draws unchanged.
 //!    It matters for many variables: Enns n_K = 8 (81 variables; ε = 1e-3, seed 1, 60 CPU s) ended
-//!    at 1.13167 without it and at 1.13112 with it (with `maxit = 3000` instead: 1.12986).
+//!    at 1.13167 without it and at 1.13112 and 1.13144 (two runs) with it; with `maxit = 3000`
+//!    instead, 1.12986.
 //!
 //! # When it stops
 //! Before each new local search (and within one, between evaluations) the run stops on the CPU
