@@ -561,6 +561,8 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
             cpumax: 20.0,
             maxit,
             spend_budget: false,
+            // maxit bounds each local search only if cut searches are not resumed.
+            continue_at_maxit: false,
             gradient_sampling: false,
             ..Default::default()
         };
