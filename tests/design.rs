@@ -333,3 +333,32 @@ fn ac10_order1_scaled_search_gets_below_12_in_3000_evaluations() {
     check_recomputed(&p, &o);
     assert!(o.gamma.is_finite() && o.gamma < 12.0, "γ = {}", o.gamma);
 }
+
+/// A bounded run spends its budget (`spend_budget`, the default): the stall rule does not end it,
+/// the budget does, and since the path up to the stall is the same, it can only end lower. With
+/// `spend_budget = false` the stall rule ends it; a run without any budget is still ended by the
+/// stall rule.
+#[test]
+fn bounded_run_spends_its_budget_and_the_stall_rule_ends_unbounded_runs() {
+    let p = plant("REA2");
+    let base = DesignOptions {
+        order: 1,
+        eps: 1e-3,
+        seed: 1,
+        cpumax: f64::INFINITY,
+        stall_starts: 2,
+        gradient_sampling: false,
+        ..Default::default()
+    };
+    let bounded = DesignOptions { max_starts: Some(20), ..base.clone() };
+    let spent = run(&p, &bounded, None, &mut NoDesignObserver).unwrap();
+    assert_eq!((spent.search.starts, spent.search.stop), (20, SearchStop::Starts), "{:?}", spent.search);
+    let stalled = run(&p, &DesignOptions { spend_budget: false, ..bounded }, None, &mut NoDesignObserver).unwrap();
+    assert_eq!(stalled.search.stop, SearchStop::Stall, "{:?}", stalled.search);
+    assert!(stalled.search.starts < 20, "{:?}", stalled.search);
+    assert!(spent.objective <= stalled.objective, "{} > {}", spent.objective, stalled.objective);
+    check_recomputed(&p, &spent);
+    let unbounded = run(&p, &base, None, &mut NoDesignObserver).unwrap();
+    assert_eq!(unbounded.search.stop, SearchStop::Stall, "{:?}", unbounded.search);
+    assert_eq!(bits(&unbounded), bits(&stalled), "the same path, ended by the same stall");
+}

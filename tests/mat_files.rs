@@ -48,13 +48,14 @@ fn scipy_plant_files_equal_the_json_plant_bit_for_bit() {
 fn same_plant_as_mat_and_json_gives_bit_identical_designs() {
     let json = he1_json();
     let mat = Plant::load(fixture("HE1.mat")).unwrap();
-    // Short deterministic runs (iteration limits, not the CPU budget, end them).
+    // Short deterministic runs (iteration limits and the stall rule, not the CPU budget, end them).
     let opts = DesignOptions {
         order: 1,
         seed: 3,
         nrand: 1,
         maxit: 40,
         cpumax: 60.0,
+        spend_budget: false,
         gradient_sampling: false,
         ..Default::default()
     };
@@ -150,7 +151,20 @@ fn command_line_designs_into_mat_checks_plots_and_exports_it() {
     let k = dir.path().join("K.mat");
     let plant = fixture("HE1.mat");
     let (k_s, plant_s) = (k.to_str().unwrap(), plant.to_str().unwrap());
-    cli(&["design", "--plant", plant_s, "--order", "1", "--cpumax", "2", "--nrand", "1", "--out", k_s]);
+    cli(&[
+        "design",
+        "--plant",
+        plant_s,
+        "--order",
+        "1",
+        "--cpumax",
+        "2",
+        "--nrand",
+        "1",
+        "--stop-on-stall",
+        "--out",
+        k_s,
+    ]);
     let kk = Controller::load(&k).unwrap();
     assert_eq!((kk.order(), kk.outputs(), kk.inputs()), (1, 2, 1));
     let svg = dir.path().join("sigma.svg");

@@ -41,7 +41,7 @@ fn check_svg(text: &str, what: &str) {
 fn every_figure_kind_is_rendered_for_a_small_real_campaign() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("c.toml");
-    std::fs::write(&file, "name = \"p\"\n[defaults]\neps = [1e-3]\nseeds = 1\ncpumax = 2.0\nnrand = 1\n[[problem]]\nplant = \"REA2\"\norders = [1, 2]\n").unwrap();
+    std::fs::write(&file, "name = \"p\"\n[defaults]\neps = [1e-3]\nseeds = 1\ncpumax = 2.0\nnrand = 1\nspend_budget = false\n[[problem]]\nplant = \"REA2\"\norders = [1, 2]\n").unwrap();
     let results = dir.path().join("r");
     let run = |args: &[&str]| {
         let out = Command::new(BIN)

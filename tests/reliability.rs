@@ -497,6 +497,7 @@ fn item7_design_and_check_exit_4_when_not_stabilised() {
         "0",
         "--cpumax",
         "2",
+        "--stop-on-stall",
         "--nrand",
         "1",
         "--out",
@@ -518,6 +519,7 @@ fn item7_design_and_check_exit_4_when_not_stabilised() {
         "0",
         "--cpumax",
         "5",
+        "--stop-on-stall",
         "--out",
         good.to_str().unwrap(),
     ]));
@@ -553,8 +555,17 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
     // A real run: the status says whether the certificate was met.
     let p = Plant::load(format!("{PLANTS}/REA2.json")).unwrap();
     for maxit in [2, 1000] {
-        let opts =
-            DesignOptions { order: 1, seed: 1, cpumax: 20.0, maxit, gradient_sampling: false, ..Default::default() };
+        let opts = DesignOptions {
+            order: 1,
+            seed: 1,
+            cpumax: 20.0,
+            maxit,
+            spend_budget: false,
+            // maxit bounds each local search only if cut searches are not resumed.
+            continue_at_maxit: false,
+            gradient_sampling: false,
+            ..Default::default()
+        };
         let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
         match o.status {
             DesignStatus::Converged => assert!(o.certificate.as_ref().unwrap().dnorm <= opts.normtol, "{o:?}"),
@@ -572,7 +583,8 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
 fn item7_controller_norm_term_is_flagged() {
     let p = Plant::load(format!("{PLANTS}/REA2.json")).unwrap();
     for (eps, active) in [(1e3, true), (1e-6, false)] {
-        let opts = DesignOptions { order: 0, eps, seed: 0, cpumax: 5.0, nrand: 1, ..Default::default() };
+        let opts =
+            DesignOptions { order: 0, eps, seed: 0, cpumax: 5.0, nrand: 1, spend_budget: false, ..Default::default() };
         let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
         assert!(o.gamma.is_finite(), "{o:?}");
         assert_eq!(o.controller_norm_active, active, "ε = {eps}: γ = {}, ε‖K‖∞ = {}", o.gamma, eps * o.k_hinf);
@@ -590,6 +602,7 @@ fn item7_controller_norm_term_is_flagged() {
         "1e3",
         "--cpumax",
         "5",
+        "--stop-on-stall",
         "--nrand",
         "1",
         "--out",
@@ -676,6 +689,7 @@ fn item9_error_texts() {
         "1e300",
         "--cpumax",
         "2",
+        "--stop-on-stall",
         "--nrand",
         "1",
         "--out",

@@ -86,6 +86,8 @@ macro_rules! with_design_settings {
             random_scales: Option<Spanned<Vec<f64>>>,
             open_loop_start: Option<bool>,
             variable_scaling: Option<bool>,
+            spend_budget: Option<bool>,
+            continue_at_maxit: Option<bool>,
             $($tail)*
         }
     };
@@ -398,6 +400,8 @@ struct Layered {
     random_scales: Setting<Vec<f64>>,
     open_loop_start: Option<bool>,
     variable_scaling: Option<bool>,
+    spend_budget: Option<bool>,
+    continue_at_maxit: Option<bool>,
 }
 
 impl Layered {
@@ -422,6 +426,8 @@ impl Layered {
             random_scales: layer(&p.random_scales, &d.random_scales),
             open_loop_start: p.open_loop_start.or(d.open_loop_start),
             variable_scaling: p.variable_scaling.or(d.variable_scaling),
+            spend_budget: p.spend_budget.or(d.spend_budget),
+            continue_at_maxit: p.continue_at_maxit.or(d.continue_at_maxit),
         }
     }
 
@@ -459,6 +465,12 @@ impl Layered {
         }
         if let Some(b) = self.variable_scaling {
             o.variable_scaling = b;
+        }
+        if let Some(b) = self.spend_budget {
+            o.spend_budget = b;
+        }
+        if let Some(b) = self.continue_at_maxit {
+            o.continue_at_maxit = b;
         }
         if let Some(k) = self.objective {
             o.objective = k;
@@ -723,6 +735,24 @@ objective = "plain"
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
         assert!(e.message.contains("random_scales"), "{e}");
+    }
+
+    #[test]
+    fn spend_budget_layers_and_a_wrong_type_is_located() {
+        let c = parse(
+            "name = \"t\"\n[defaults]\nspend_budget = false\n[[problem]]\nplant = \"HE1\"\norders = [1]\n\
+             [[problem]]\nplant = \"REA2\"\norders = [1]\nspend_budget = true\n[[problem]]\nplant = \"Enns\"\n\
+             orders = [1]\n",
+        )
+        .unwrap();
+        let spend: Vec<bool> = c.problems.iter().map(|p| p.base.spend_budget).collect();
+        assert_eq!(spend, [false, true, false]);
+        assert!(
+            parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap().problems[0].base.spend_budget
+        );
+        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nspend_budget = 1\n");
+        assert_eq!(e.location.line, 5, "{e}");
+        assert!(e.message.contains("bool"), "{e}");
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
-//! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--max-starts N] [--hop-scales 0.01,0.1,1]
-//! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start]
+//! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--stop-on-stall] [--max-starts N] [--hop-scales 0.01,0.1,1]
+//! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start] [--no-continue-at-maxit]
 //! [--variable-scaling] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
@@ -51,14 +51,25 @@ pub struct DesignArgs {
     #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub nrand: usize,
     /// After the first starts, keep starting local searches (basin hops of the best point and
-    /// random starts) until this many in a row have not improved the best objective by
-    /// --stall-rtol, or a budget ends the run. While no stabilising controller is found, only a
-    /// budget ends it. 0: HIFOO's search (the first starts only).
+    /// random starts) until a budget ends the run. The stall rule — this many local searches in
+    /// a row have not improved the best objective by --stall-rtol — ends runs without any budget
+    /// (--cpumax inf and no --maxevals, --max-starts), or with --stop-on-stall any run once a
+    /// stabilising controller is found. 0: HIFOO's search (the first starts only).
     #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS, allow_negative_numbers = true)]
     pub stall_starts: usize,
     /// Relative improvement that resets the stall count.
     #[arg(long, value_name = "R", default_value_t = 1e-6, allow_negative_numbers = true)]
     pub stall_rtol: f64,
+    /// Let the stall rule end the run even when a budget (--cpumax, --maxevals, --max-starts)
+    /// bounds it. By default a bounded run spends its budget: once a stabilising controller is
+    /// found, the continued search goes on until a budget ends it, and the stall rule ends only
+    /// runs without any budget.
+    #[arg(long)]
+    pub stop_on_stall: bool,
+    /// Do not resume the best point's local search when BFGS stopped it at its iteration limit
+    /// (by default the next continued start is that point itself, with a fresh BFGS).
+    #[arg(long)]
+    pub no_continue_at_maxit: bool,
     /// Largest number of local searches (first starts included; deterministic).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub max_starts: Option<u64>,
@@ -116,6 +127,8 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         nrand: a.nrand,
         stall_starts: a.stall_starts,
         stall_rtol: a.stall_rtol,
+        spend_budget: !a.stop_on_stall,
+        continue_at_maxit: !a.no_continue_at_maxit,
         max_starts: a.max_starts.map(|n| n as usize),
         hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
         central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,

@@ -75,7 +75,8 @@ pub struct DesignOptions {
     pub nrand: usize,
     /// Stall rule of the continued search (see [`crate::design`], "Search"): after the first
     /// starts, new local searches are started until `stall_starts` consecutive ones have not
-    /// improved the best objective by a relative `stall_rtol` (or a budget ends the run).
+    /// improved the best objective by a relative `stall_rtol` (or a budget ends the run; with
+    /// `spend_budget`, the rule ends only runs that no budget bounds).
     /// 0 = HIFOO 3.5's search: only the first starts. (Missing in a serialised record: 0, the
     /// behaviour before this option existed.)
     #[serde(default)]
@@ -84,6 +85,19 @@ pub struct DesignOptions {
     /// `stall_starts`).
     #[serde(with = "serde_f64_or_string")]
     pub stall_rtol: f64,
+    /// Spend the budget: when a budget bounds the run (`cpumax` finite, `maxevals` or
+    /// `max_starts` set), the stall rule does not end it once a stable point is known; the
+    /// continued search goes on until the budget ends it. The stall rule still ends runs without
+    /// any budget. false: the stall rule ends bounded runs too. (Missing in a serialised record:
+    /// false, the behaviour before this option existed; not written when false.)
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub spend_budget: bool,
+    /// Resume a cut local search: when the f_h local search that produced the best point ended
+    /// on `maxit` (not at a minimiser), the next continued start is that point itself, with a
+    /// fresh BFGS (the first starts are unchanged). (Missing in a serialised record: false, the
+    /// behaviour before this option existed; not written when false.)
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub continue_at_maxit: bool,
     /// Largest number of local searches (first starts included); `None`: no limit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_starts: Option<usize>,
@@ -156,6 +170,8 @@ impl Default for DesignOptions {
             nrand: 3,
             stall_starts: DEFAULT_STALL_STARTS,
             stall_rtol: 1e-6,
+            spend_budget: true,
+            continue_at_maxit: true,
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
             random_scales: DEFAULT_RANDOM_SCALES.to_vec(),
@@ -190,6 +206,8 @@ mod tests {
             format!("nrand {},", d.nrand),
             format!("stall_starts {},", d.stall_starts),
             format!("stall_rtol {:e},", d.stall_rtol),
+            format!("spend_budget {},", d.spend_budget),
+            format!("continue_at_maxit {},", d.continue_at_maxit),
             format!("maxit {},", d.maxit),
             format!("normtol {:e},", d.normtol),
             format!("evaldist {:e},", d.evaldist),
