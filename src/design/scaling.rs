@@ -33,7 +33,7 @@
 //! AC10 (balanced measurement rows of norms 0.33 and 9.9·10⁴) the gains from y₁ and y₂ of a good
 //! first-order controller differ by ~10⁴; from the same start, BFGS in x stalls after ~20
 //! iterations (γ 14.6, or not stabilised) where BFGS in x̃ goes on to γ ≈ 10.2–13.3, and one
-//! 300-CPU-s job reaches 10.890 against 16.90 unscaled. On BDT2 n_K = 1 (controls 10⁴ apart) the
+//! 300-CPU-s job reaches 10.047 against 17.57 unscaled. On BDT2 n_K = 1 (controls 10⁴ apart) the
 //! same job reached 0.897 scaled against 0.596 unscaled — not understood yet — so the option is
 //! off by default.
 
