@@ -274,8 +274,8 @@ impl<'p> DesignObjective<'p> {
         }
         let hook = self.stop.as_deref().filter(|_| self.plant.dims.n + k.order() >= MIN_ORDER_FOR_INTERRUPT);
         let stop = hook.map_or(Interrupt::NEVER, Interrupt::new);
-        // Warm start at the last peak (Benner & Mitchell 2018): the mode-based test frequencies
-        // are skipped; the level-set certification is unchanged.
+        // Warm start at the last peak (Benner & Mitchell 2018), in addition to the mode-based test
+        // frequencies (`lti::hinf_norm_near`); the level-set certification is unchanged.
         let hint = [self.peak_hint.get()];
         let cpu0 = hook.map(|_| thread_cpu_time());
         let (gamma, g_cl) = match closed_loop_hinf_grad_near_interruptible(self.plant, k, self.hinf_tol, &hint, stop) {

@@ -113,9 +113,10 @@ pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
 }
 
 /// [`hinf_norm`] warm-started at `hints`, frequencies where the peak is expected (e.g. the peak
-/// of a nearby system, as in an optimisation). With hints, the mode-based test frequencies are
-/// skipped; the result is certified by the same level-set test, so it is as reliable as without
-/// (only the cost differs: a hint away from the peak costs more level-set iterations).
+/// of a nearby system, as in an optimisation). The hints are evaluated in addition to the
+/// mode-based test frequencies, never instead of them: started from a hinted local peak alone,
+/// the level-set test can miss a slightly higher peak elsewhere (its crossings at that level are a
+/// near-tangent pair) and the norm came out up to 6.6e-4 low.
 pub fn hinf_norm_near(sys: &StateSpace, tol: f64, hints: &[f64]) -> HinfNorm {
     match hinf_norm_near_interruptible(sys, tol, hints, Interrupt::NEVER) {
         Ok(h) => h,
@@ -226,9 +227,10 @@ fn hinf_norm_from(
         best.offer(w, fr.sigma_max(w));
         tested.push(w);
     }
-    if hints.is_empty() {
-        mode_frequencies(poles, &mut fr, &mut best, &mut tested, stop)?;
-    }
+    // Always, hints or not: a hint sits on the previous peak, and a peak elsewhere that is only a
+    // little higher has a near-tangent pair of crossings at the level γ_L would then stop at, which
+    // the imaginary-axis test can miss (AC4 in `tests/hinf_regression.rs`: 6.6e-4 low).
+    mode_frequencies(poles, &mut fr, &mut best, &mut tested, stop)?;
     stop.poll()?;
     refine(&mut fr, &mut best, &tested);
     if !best.gamma.is_finite() {
@@ -247,7 +249,13 @@ fn hinf_norm_from(
             break;
         }
         let before = best.gamma;
-        let mut mids: Vec<f64> = Vec::with_capacity(ws.len());
+        let mut mids: Vec<f64> = Vec::with_capacity(ws.len() + 2);
+        // σ(∞) = σmax(D) < γ, so an odd count means a crossing was lost, and it may lie in any
+        // interval: also look in [0, w₁] (NN5 in `tests/hinf_regression.rs`: the crossing just
+        // above ω = 0 was lost, 1.5e-4 low) and above the last one.
+        if ws.len() % 2 == 1 && ws[0] > 0.0 {
+            mids.push(0.5 * ws[0]);
+        }
         if ws.len() == 1 {
             mids.push(ws[0]);
         }
@@ -255,8 +263,6 @@ fn hinf_norm_from(
             let (a, b) = (pair[0], pair[1]);
             mids.push(if a > 0.0 { (a * b).sqrt() } else { 0.5 * b });
         }
-        // σ(∞) = σmax(D) < γ, so an odd count means a crossing was lost (e.g. far beyond the
-        // others): also look above the last one.
         if ws.len() % 2 == 1 {
             let last = ws[ws.len() - 1];
             if last > 0.0 && last.is_finite() {
@@ -453,7 +459,11 @@ impl<'s> Hamiltonian<'s> {
     /// `None` if the eigensolver failed.
     fn crossings(&self, gamma: f64) -> Option<Vec<f64>> {
         let kappa = gamma * gamma / ((gamma - self.sigma_d) * (gamma + self.sigma_d));
-        let mut ws = if kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND {
+        // Below order HESSENBERG_QR_FROM always the pencil (unsquared, so crossings close to
+        // ω = 0 or tangent pairs keep their accuracy; cheap at that size): the squared spectrum
+        // lost real crossings on AC4 closed loops of order 6 (`tests/hinf_regression.rs`).
+        let explicit = self.sys.order() >= HESSENBERG_QR_FROM;
+        let mut ws = if explicit && kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND {
             let [f, g, k] = self.explicit_hamiltonian(gamma);
             let sq = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref())?;
             squared_crossings(&sq)
