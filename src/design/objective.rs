@@ -36,9 +36,9 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_tracked_interruptible, controller_abscissa_grad,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad,
     controller_hinf_grad, hinf_lower_bound, spectral_abscissa, Controller, ControllerGradient, Interrupt, LtiError,
-    PeakHints, Plant,
+    Plant,
 };
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
@@ -129,10 +129,9 @@ pub struct DesignObjective<'p> {
     eps: f64,
     hinf_tol: f64,
     cache: Rc<RefCell<ComponentCache>>,
-    /// Peak frequencies of ‖Tzw‖∞ at the last finite performance evaluation (empty: none yet;
-    /// `lti::PeakHints`: the last peak alone below 30 closed-loop states), where the next norm
-    /// starts and where σmax(Tzw(iω)) gives a line search's trial point a cheap lower bound of f.
-    peak_hints: RefCell<PeakHints>,
+    /// Peak frequency of ‖Tzw‖∞ at the last finite performance evaluation (NaN: none yet), where
+    /// σmax(Tzw(iω)) gives a line search's trial point a cheap lower bound of f.
+    peak_hint: Cell<f64>,
     /// Polled inside long evaluations (module docs).
     stop: Option<StopHook>,
     /// Whether the last evaluation was abandoned because `stop` fired.
@@ -165,7 +164,7 @@ impl<'p> DesignObjective<'p> {
             eps,
             hinf_tol,
             cache,
-            peak_hints: RefCell::new(PeakHints::default()),
+            peak_hint: Cell::new(f64::NAN),
             stop: None,
             abandoned: Cell::new(false),
             on_eval_cpu: None,
@@ -275,17 +274,17 @@ impl<'p> DesignObjective<'p> {
         }
         let hook = self.stop.as_deref().filter(|_| self.plant.dims.n + k.order() >= MIN_ORDER_FOR_INTERRUPT);
         let stop = hook.map_or(Interrupt::NEVER, Interrupt::new);
-        // Warm start at the last peaks (Benner & Mitchell 2018): the mode-based test frequencies
-        // are skipped; the level-set certification is unchanged. The hints are replaced by the
-        // peaks this norm found (only when it is finite).
+        // Warm start at the last peak (Benner & Mitchell 2018): the mode-based test frequencies
+        // are skipped; the level-set certification is unchanged.
+        let hint = [self.peak_hint.get()];
         let cpu0 = hook.map(|_| thread_cpu_time());
-        let mut hints = self.peak_hints.borrow_mut();
-        let result = closed_loop_hinf_grad_tracked_interruptible(self.plant, k, self.hinf_tol, &mut hints, stop);
-        drop(hints);
-        let (gamma, g_cl) = match result {
+        let (gamma, g_cl) = match closed_loop_hinf_grad_near_interruptible(self.plant, k, self.hinf_tol, &hint, stop) {
             Ok((norm, g)) => {
                 if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
                     report(thread_cpu_time() - t0);
+                }
+                if norm.value.is_finite() {
+                    self.peak_hint.set(norm.peak_freq);
                 }
                 (norm.value, Some(g))
             }
@@ -315,7 +314,7 @@ impl<'p> DesignObjective<'p> {
 
 impl DesignObjective<'_> {
     /// A lower bound of the performance objective at `k` without any eigenvalue computation of
-    /// the closed loop: max(σmax(Tzw(iω)) at ω = ∞ and the last peak frequencies, ε‖K‖∞) (‖K‖∞ is
+    /// the closed loop: max(σmax(Tzw(iω)) at ω = ∞ and the last peak frequency, ε‖K‖∞) (‖K‖∞ is
     /// of the small controller, computed in full). +∞ for an ill-posed loop. Exact: f(k) ≥ it
     /// whether or not the loop is stable (f = +∞ when it is not).
     fn performance_lower_bound(&self, k: &Controller) -> f64 {
@@ -325,7 +324,7 @@ impl DesignObjective<'_> {
             lb = self.eps * norm.value;
         }
         match closed_loop(self.plant, k) {
-            Ok(cl) => lb.max(hinf_lower_bound(&cl, self.peak_hints.borrow().freqs())),
+            Ok(cl) => lb.max(hinf_lower_bound(&cl, &[self.peak_hint.get()])),
             Err(_) => f64::INFINITY,
         }
     }
@@ -367,7 +366,7 @@ impl Objective for DesignObjective<'_> {
     }
 
     /// In the performance phase, a trial point whose cheap lower bound
-    /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and at the last peaks, ε‖K‖∞) already
+    /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and at the last peak, ε‖K‖∞) already
     /// reaches `threshold` is rejected
     /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13).
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {

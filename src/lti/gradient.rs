@@ -25,8 +25,8 @@ use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
 
 use super::closed_loop::ClosedLoop;
-use super::hinf::{hinf_norm_of_finite, hinf_norm_tracked_interruptible, HinfNorm, PeakHints};
-use super::interrupt::{Interrupt, Interrupted};
+use super::hinf::{hinf_norm_of_finite, HinfNorm};
+use super::interrupt::Interrupt;
 use super::spectral::rightmost_eigen;
 use super::step_stats::{for_order, timed, Step};
 use super::{Controller, LtiError, Plant, StateSpace};
@@ -99,30 +99,8 @@ pub fn closed_loop_hinf_grad_near_interruptible(
     hints: &[f64],
     stop: Interrupt<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_with(plant, k, |sys| hinf_norm_of_finite(sys, tol, hints, &mut Vec::new(), stop), stop)
-}
-
-/// [`closed_loop_hinf_grad_near_interruptible`] warm-started at `hints`, which are then replaced
-/// by the peaks found ([`PeakHints`]; the hints of the next evaluation at a nearby controller).
-pub fn closed_loop_hinf_grad_tracked_interruptible(
-    plant: &Plant,
-    k: &Controller,
-    tol: f64,
-    hints: &mut PeakHints,
-    stop: Interrupt<'_>,
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_with(plant, k, |sys| hinf_norm_tracked_interruptible(sys, tol, hints, stop), stop)
-}
-
-/// The closed loop's norm by `norm` (given finite data) and its gradient.
-fn closed_loop_hinf_grad_with(
-    plant: &Plant,
-    k: &Controller,
-    norm: impl FnOnce(&StateSpace) -> Result<HinfNorm, Interrupted>,
-    stop: Interrupt<'_>,
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, norm, stop)? else {
+    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, hints, stop)? else {
         return Ok((HinfNorm::UNSTABLE, nan_like(k)));
     };
     Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
@@ -131,8 +109,7 @@ fn closed_loop_hinf_grad_with(
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let norm = |s: &StateSpace| hinf_norm_of_finite(s, tol, &[], &mut Vec::new(), Interrupt::NEVER);
-    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, norm, Interrupt::NEVER) else {
+    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -157,17 +134,17 @@ pub(crate) struct PeakVectors {
     pub b: Vec<c64>,
 }
 
-/// Norm (by `norm`, called with finite data) and gradient vectors; `Ok(None)` if unstable (or
-/// not finite); `Err` once `stop` fires.
+/// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `stop` fires.
 pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
-    norm: impl FnOnce(&StateSpace) -> Result<HinfNorm, Interrupted>,
+    tol: f64,
+    hints: &[f64],
     stop: Interrupt<'_>,
 ) -> Result<Option<(HinfNorm, PeakVectors)>, LtiError> {
     if !sys.is_finite() {
         return Ok(None);
     }
-    let norm = norm(sys)?;
+    let norm = hinf_norm_of_finite(sys, tol, hints, stop)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }

@@ -57,29 +57,6 @@
 //!
 //! If the Hamiltonian eigensolver fails or the iteration limit is hit, the best lower bound γ_L
 //! found so far is returned (it is an attained value of σmax(G(iω))).
-//!
-//! # Warm start from several peaks (large systems)
-//! In an optimisation the next system is close to the last one, so its peak is near one of the
-//! last one's peaks (Benner & Mitchell, "Faster and more accurate computation of the H∞ norm via
-//! optimization", SIAM J. Sci. Comput. 40 (2018)). A converged H∞ design has several peaks of
-//! nearly equal height (the minimiser equalises them: CM4's closed loop has a comb of lightly
-//! damped modes ~2 rad/s apart), and which of them is highest changes from one trial point to the
-//! next: with only the last peak as a hint, the first level-set test then finds the other peak's
-//! crossings and a second (or third) test follows, each as costly as the rest of the evaluation
-//! (issue 13: CM4, 1.52 tests per norm). [`PeakHints`] therefore carries, from order
-//! [`HESSENBERG_QR_FROM`] on, up to [`MAX_PEAK_HINTS`] local peaks within [`PEAK_HINT_BAND`] of
-//! the norm (the hints, the mode-based test frequencies, the midpoints of crossing intervals and
-//! the refined peaks) to the next
-//! computation, which evaluates σmax at all of them and refines around the best. Hints only add
-//! genuine values of σmax(G(iω)) to γ_L, and the level-set certification is unchanged, so the
-//! result is as reliable as without them; below order [`HESSENBERG_QR_FROM`] the hint is the
-//! last peak alone, as before, so small systems compute bit for bit what they did.
-//!
-//! Measured (issue 13, `cargo bench --bench lti -- --design-only BDT2,CM4 --steps`, one run
-//! each under load): level-set tests per closed-loop norm 1.35 → 1.19 on BDT2, 1.52 → 1.42 on
-//! CM4, at no extra σmax evaluations. Also refining the runner-up hints (up to 3 within 1e-3,
-//! or 1 within 1e-4 of γ_L) was tried and dropped: it saved few further tests (CM4 1.36–1.40)
-//! for 1.6–3× the σmax evaluations (BDT2: 45 → 73–135 per norm), a net loss.
 
 use faer::{c64, Mat};
 
@@ -105,10 +82,6 @@ pub(crate) const MAX_POLE_TEST_FREQS: usize = 100;
 /// squared method's eigenvalue errors grow like κ²: 1e6 lost a real peak (issue 13); with 1e3 the
 /// property family of `tests/hinf_property.rs` and the SLICOT fixtures pass.
 pub const MAX_EXPLICIT_HAMILTONIAN_COND: f64 = 1e3;
-/// At most this many peak frequencies are carried by [`PeakHints`] (module docs).
-pub const MAX_PEAK_HINTS: usize = 8;
-/// Local peaks with σmax ≥ (1 − this)·‖G‖∞ are carried by [`PeakHints`].
-pub const PEAK_HINT_BAND: f64 = 1e-2;
 /// Absolute tolerance of the refinement in log ω. Near a peak of relative half-width ζ (the
 /// damping of the mode behind it), σmax falls off like ½(δω/(ζω))², so locating it to 1e-10 in
 /// log ω keeps γ_L within tol/10 = 1e-11 of the top for ζ down to ~1e-5: the first level-set test
@@ -130,44 +103,6 @@ pub struct HinfNorm {
 impl HinfNorm {
     /// The norm of an unstable system.
     pub const UNSTABLE: HinfNorm = HinfNorm { value: f64::INFINITY, peak_freq: f64::NAN };
-}
-
-/// Peak frequencies carried from one H∞ computation to the next on a nearby system (module docs,
-/// "Warm start from several peaks"). Empty: no warm start (the mode-based test frequencies).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct PeakHints {
-    freqs: Vec<f64>,
-}
-
-impl PeakHints {
-    /// The hint frequencies (rad/s), the last peak first.
-    pub fn freqs(&self) -> &[f64] {
-        &self.freqs
-    }
-
-    /// Replaces the hints by what the computation of `norm` on a system of order `order` found:
-    /// below order [`HESSENBERG_QR_FROM`] its peak alone; from it on also the local peaks
-    /// `found` (frequency, σmax) within [`PEAK_HINT_BAND`] of the norm, one per peak (frequencies
-    /// within a relative 1e-3 count as one), the highest first, at most [`MAX_PEAK_HINTS`].
-    fn update(&mut self, order: usize, norm: HinfNorm, found: &[(f64, f64)]) {
-        self.freqs.clear();
-        self.freqs.push(norm.peak_freq);
-        if order < HESSENBERG_QR_FROM {
-            return;
-        }
-        let floor = (1.0 - PEAK_HINT_BAND) * norm.value;
-        let mut cands: Vec<(f64, f64)> =
-            found.iter().copied().filter(|&(w, s)| w.is_finite() && w > 0.0 && s >= floor).collect();
-        cands.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.total_cmp(&b.0)));
-        for (w, _) in cands {
-            if self.freqs.len() >= MAX_PEAK_HINTS {
-                break;
-            }
-            if self.freqs.iter().all(|&h| !((w - h).abs() <= 1e-3 * w)) {
-                self.freqs.push(w);
-            }
-        }
-    }
 }
 
 /// ‖sys‖∞ to relative tolerance `tol` (use [`DEFAULT_HINF_TOL`]); +∞ if unstable.
@@ -206,38 +141,17 @@ pub fn hinf_norm_near_interruptible(
     if !sys.is_finite() {
         return Ok(HinfNorm::UNSTABLE);
     }
-    hinf_norm_of_finite(sys, tol, hints, &mut Vec::new(), stop)
-}
-
-/// [`hinf_norm_near_interruptible`] warm-started at `hints`, which are then replaced by the
-/// peaks this computation found (for the next computation on a nearby system; module docs).
-/// The hints are left alone if the norm is not finite.
-pub fn hinf_norm_tracked_interruptible(
-    sys: &StateSpace,
-    tol: f64,
-    hints: &mut PeakHints,
-    stop: Interrupt<'_>,
-) -> Result<HinfNorm, Interrupted> {
-    if !sys.is_finite() {
-        return Ok(HinfNorm::UNSTABLE);
-    }
-    let mut found = Vec::new();
-    let norm = hinf_norm_of_finite(sys, tol, &hints.freqs.clone(), &mut found, stop)?;
-    if norm.value.is_finite() {
-        hints.update(sys.order(), norm, &found);
-    }
-    Ok(norm)
+    hinf_norm_of_finite(sys, tol, hints, stop)
 }
 
 /// [`hinf_norm_near_interruptible`] for finite data, with the poles computed here: from order
 /// [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one Hessenberg
+/// reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver (the rounding
 /// the small plants' results were obtained with). An eigensolver failure counts as unstable.
-/// The local peaks met (frequency, σmax) are appended to `found`.
 pub(crate) fn hinf_norm_of_finite(
     sys: &StateSpace,
     tol: f64,
     hints: &[f64],
-    found: &mut Vec<(f64, f64)>,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
     stop.poll()?;
@@ -246,12 +160,12 @@ pub(crate) fn hinf_norm_of_finite(
             if sys.order() >= HESSENBERG_QR_FROM {
                 let fr = FreqResponse::new(sys);
                 match fr.poles() {
-                    Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, found, stop),
+                    Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, stop),
                     None => Ok(HinfNorm::UNSTABLE),
                 }
             } else {
                 match timed(Step::Poles, || eigenvalues(sys.a.as_ref())) {
-                    Some(poles) => hinf_norm_from(sys, &poles, None, tol, hints, found, stop),
+                    Some(poles) => hinf_norm_from(sys, &poles, None, tol, hints, stop),
                     None => Ok(HinfNorm::UNSTABLE),
                 }
             }
@@ -288,20 +202,17 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
     tol: f64,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
-    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, None, tol, &[], &mut Vec::new(), stop)))
+    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, None, tol, &[], stop)))
 }
 
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
-/// evaluator `fr` of `sys` if given; the local peaks met are appended to `found`. The data must
-/// be finite.
-#[allow(clippy::too_many_arguments)]
+/// evaluator `fr` of `sys` if given. The data must be finite.
 fn hinf_norm_from(
     sys: &StateSpace,
     poles: &[c64],
     fr: Option<FreqResponse>,
     tol: f64,
     hints: &[f64],
-    found: &mut Vec<(f64, f64)>,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
     let tol = if tol.is_nan() { DEFAULT_HINF_TOL } else { tol.max(MIN_HINF_TOL) };
@@ -321,17 +232,14 @@ fn hinf_norm_from(
     let mut tested: Vec<f64> = vec![0.0];
     for &w in &hints {
         stop.poll()?;
-        let s = fr.sigma_max(w);
-        best.offer(w, s);
+        best.offer(w, fr.sigma_max(w));
         tested.push(w);
-        found.push((w, s));
     }
     if hints.is_empty() {
-        mode_frequencies(poles, &mut fr, &mut best, &mut tested, found, stop)?;
+        mode_frequencies(poles, &mut fr, &mut best, &mut tested, stop)?;
     }
     stop.poll()?;
     refine(&mut fr, &mut best, &tested);
-    found.push((best.freq, best.gamma));
     if !best.gamma.is_finite() {
         return Ok(HinfNorm { value: f64::INFINITY, peak_freq: best.freq });
     }
@@ -365,16 +273,13 @@ fn hinf_norm_from(
             }
         }
         for &w in &mids {
-            let s = fr.sigma_max(w);
-            best.offer(w, s);
-            found.push((w, s));
+            best.offer(w, fr.sigma_max(w));
         }
         let mut all = ws.clone();
         all.extend(&mids);
         all.sort_by(f64::total_cmp);
         stop.poll()?;
         refine(&mut fr, &mut best, &all);
-        found.push((best.freq, best.gamma));
         if !(best.gamma >= before * (1.0 + 0.1 * tol)) {
             break; // no progress: the crossings were spurious
         }
@@ -383,14 +288,12 @@ fn hinf_norm_from(
 }
 
 /// Offers σmax at one test frequency per mode, least damped first (at most
-/// [`MAX_POLE_TEST_FREQS`]; module docs, step 2), and records them in `tested` and, with their
-/// values, in `found`.
+/// [`MAX_POLE_TEST_FREQS`]; module docs, step 2), and records them in `tested`.
 fn mode_frequencies(
     poles: &[c64],
     fr: &mut FreqResponse,
     best: &mut Best,
     tested: &mut Vec<f64>,
-    found: &mut Vec<(f64, f64)>,
     stop: Interrupt<'_>,
 ) -> Result<(), Interrupted> {
     let mut modes: Vec<(f64, f64)> = poles
@@ -406,10 +309,8 @@ fn mode_frequencies(
     modes.truncate(MAX_POLE_TEST_FREQS);
     for &(_, w) in &modes {
         stop.poll()?;
-        let s = fr.sigma_max(w);
-        best.offer(w, s);
+        best.offer(w, fr.sigma_max(w));
         tested.push(w);
-        found.push((w, s));
     }
     Ok(())
 }
@@ -627,73 +528,4 @@ fn squared_crossings(sq: &SquaredSpectrum) -> Vec<f64> {
         .filter(|m| m.re <= thr * thr + e && m.im.abs() <= 2.0 * thr * m.norm().sqrt() + e)
         .map(|m| (-m.re).max(0.0).sqrt())
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// n/2 lightly damped modes (ζ = 0.01) at 1.5^i rad/s with peaks of nearly equal height
-    /// (1 + 1e-3·((7i) mod 5), plus the other modes' small tails): many competing peaks, as in
-    /// CM4's closed loop. Single input and output.
-    fn comb(n: usize) -> StateSpace {
-        let k = n / 2;
-        let mut a = Mat::<f64>::zeros(n, n);
-        let mut b = Mat::<f64>::zeros(n, 1);
-        let mut c = Mat::<f64>::zeros(1, n);
-        for i in 0..k {
-            let w = 1.5f64.powi(i as i32);
-            let z = 0.01;
-            a[(2 * i, 2 * i + 1)] = 1.0;
-            a[(2 * i + 1, 2 * i)] = -w * w;
-            a[(2 * i + 1, 2 * i + 1)] = -2.0 * z * w;
-            b[(2 * i + 1, 0)] = 1.0;
-            c[(0, 2 * i + 1)] = 2.0 * z * w * (1.0 + 1e-3 * ((i * 7) % 5) as f64);
-        }
-        StateSpace { a, b, c, d: Mat::zeros(1, 1) }
-    }
-
-    #[test]
-    fn tracked_norm_matches_and_carries_the_peaks() {
-        let sys = comb(40);
-        let cold = hinf_norm(&sys, DEFAULT_HINF_TOL);
-        let mut hints = PeakHints::default();
-        let first = hinf_norm_tracked_interruptible(&sys, DEFAULT_HINF_TOL, &mut hints, Interrupt::NEVER).unwrap();
-        assert!((first.value - cold.value).abs() <= 1e-9 * cold.value, "{first:?} vs {cold:?}");
-        let h = hints.freqs().to_vec();
-        assert_eq!(h[0], first.peak_freq);
-        assert!(h.len() >= 2 && h.len() <= MAX_PEAK_HINTS, "{h:?}");
-        // Every hint is a frequency where σmax is within the band of the norm, and they are
-        // distinct peaks.
-        let mut fr = FreqResponse::new(&sys);
-        for (i, &w) in h.iter().enumerate() {
-            assert!(fr.sigma_max(w) >= (1.0 - PEAK_HINT_BAND) * first.value, "hint {w}");
-            assert!(h[..i].iter().all(|&v| (v - w).abs() > 1e-3 * w), "{h:?}");
-        }
-        // Warm-started again on a slightly changed system: the same value as a cold start.
-        let mut sys2 = sys.clone();
-        sys2.c[(0, 9)] *= 1.03;
-        let warm = hinf_norm_tracked_interruptible(&sys2, DEFAULT_HINF_TOL, &mut hints, Interrupt::NEVER).unwrap();
-        let cold2 = hinf_norm(&sys2, DEFAULT_HINF_TOL);
-        assert!((warm.value - cold2.value).abs() <= 1e-9 * cold2.value, "{warm:?} vs {cold2:?}");
-    }
-
-    #[test]
-    fn small_systems_carry_only_the_last_peak() {
-        let sys = comb(10);
-        let mut hints = PeakHints::default();
-        let norm = hinf_norm_tracked_interruptible(&sys, DEFAULT_HINF_TOL, &mut hints, Interrupt::NEVER).unwrap();
-        assert_eq!(hints.freqs(), &[norm.peak_freq]);
-        // Bit for bit the single-hint computation.
-        let near = hinf_norm_near(&sys, DEFAULT_HINF_TOL, &[norm.peak_freq]);
-        let again = hinf_norm_tracked_interruptible(&sys, DEFAULT_HINF_TOL, &mut hints, Interrupt::NEVER).unwrap();
-        assert_eq!(near, again);
-        // An unstable system leaves the hints alone.
-        let mut bad = sys.clone();
-        bad.a[(1, 1)] = 1.0;
-        let before = hints.clone();
-        let r = hinf_norm_tracked_interruptible(&bad, DEFAULT_HINF_TOL, &mut hints, Interrupt::NEVER).unwrap();
-        assert!(r.value.is_infinite());
-        assert_eq!(hints, before);
-    }
 }

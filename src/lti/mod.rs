@@ -42,14 +42,12 @@ pub use full_order::{
 };
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, closed_loop_hinf_grad_near,
-    closed_loop_hinf_grad_near_interruptible, closed_loop_hinf_grad_tracked_interruptible, controller_abscissa_grad,
-    controller_hinf_grad, ControllerGradient,
+    closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad, controller_hinf_grad, ControllerGradient,
 };
 pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
-    hinf_lower_bound, hinf_norm, hinf_norm_interruptible, hinf_norm_near, hinf_norm_near_interruptible,
-    hinf_norm_tracked_interruptible, HinfNorm, PeakHints, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND,
-    MAX_LEVEL_SET_ITERS, MAX_PEAK_HINTS, MIN_HINF_TOL, PEAK_HINT_BAND,
+    hinf_lower_bound, hinf_norm, hinf_norm_interruptible, hinf_norm_near, hinf_norm_near_interruptible, HinfNorm,
+    DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use interrupt::{Interrupt, Interrupted};
 pub use lyapunov::{lyapunov_residual, solve_lyapunov, stable_antistable_basis, LyapunovError, LYAPUNOV_RESIDUAL_TOL};
