@@ -12,7 +12,10 @@
 //!   issue 13's `campaign design --order 1 --eps 1e-3 --seed 1 --cpumax 20`); `--no-design`
 //!   skips that table;
 //! * `--design-only [NAMES]`: just the last table, optionally only the plants in the
-//!   comma-separated NAMES (e.g. `BDT2,CM4`; for a profiler).
+//!   comma-separated NAMES (e.g. `BDT2,CM4`; for a profiler);
+//! * `--steps`: after each design run of the last table, the H∞ steps it took (`lti::step_stats`:
+//!   norms, explicit and pencil level-set tests per norm, and the thread-CPU time of each step;
+//!   the timing adds two clock reads per step).
 //!
 //! The last table is machine-independent: CPU ms per objective evaluation over a whole design run
 //! (`cpu_s / evals` of the outcome) divided by the CPU time of one dense eigenvalue solve (faer,
@@ -27,6 +30,7 @@ use hinfix::design::ComponentCache;
 use hinfix::design::{
     controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase,
 };
+use hinfix::lti::step_stats::{self, Step};
 use hinfix::lti::{
     hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL,
 };
@@ -181,13 +185,16 @@ fn dense_eig_seconds(size: usize, reps: usize) -> f64 {
 }
 
 /// One design run (order `nk`, ε = 1e-3, seed 1, budget `cpumax`): CPU ms per evaluation and its
-/// ratio to one dense eigensolve of size 2(n + nK).
-fn design_ratio(name: &str, nk: usize, cpumax: f64) {
+/// ratio to one dense eigensolve of size 2(n + nK); with `steps`, the H∞ steps it took.
+fn design_ratio(name: &str, nk: usize, cpumax: f64, steps: bool) {
     let p = plant(name);
     let size = 2 * (p.dims.n + nk);
     let eig = dense_eig_seconds(size, if size > 300 { 9 } else { 31 });
     let opts = DesignOptions { order: nk, eps: 1e-3, seed: 1, cpumax, ..DesignOptions::default() };
+    step_stats::reset();
+    step_stats::set_timing(steps);
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap_or_else(|e| panic!("{name}: {e}"));
+    step_stats::set_timing(false);
     let ms = o.design_cpu_s * 1e3 / o.evaluations as f64;
     println!(
         "{name:<6} n={:<4} nK={nk} γ = {:<12.6} {:>6} evals {:>7.2} s {:>9.3} ms/eval   eig({size}) {:>8.3} ms   ratio {:>6.3}",
@@ -199,6 +206,40 @@ fn design_ratio(name: &str, nk: usize, cpumax: f64) {
         eig * 1e3,
         ms / (eig * 1e3)
     );
+    if steps {
+        print_steps(&step_stats::snapshot(), o.evaluations, o.design_cpu_s);
+    }
+}
+
+/// The step table of `--steps` (module docs), for the small (order < 30: the controller's own
+/// norm on large plants) and the large systems.
+fn print_steps(s: &step_stats::StepStats, evals: usize, cpu_s: f64) {
+    for large in [false, true] {
+        let norms = s.calls(Step::Norm, large);
+        if norms == 0 {
+            continue;
+        }
+        let per_norm = |st: Step| s.calls(st, large) as f64 / norms as f64;
+        println!(
+            "    order {} {}: {norms} norms ({:.2} per evaluation), {} using the pencil; level-set tests per norm: {:.3} explicit, {:.3} pencil",
+            if large { ">=" } else { "<" },
+            step_stats::LARGE_ORDER,
+            norms as f64 / evals.max(1) as f64,
+            s.calls(Step::NormUsingPencil, large),
+            per_norm(Step::ExplicitLevelSet),
+            per_norm(Step::PencilLevelSet),
+        );
+        println!("      {:<24} {:>9} {:>10} {:>9} {:>7}", "step", "calls", "CPU s", "ms/call", "% run");
+        for step in Step::ALL.into_iter().filter(|&st| st != Step::NormUsingPencil && s.calls(st, large) > 0) {
+            let (c, t) = (s.calls(step, large), s.cpu_s(step, large));
+            println!(
+                "      {:<24} {c:>9} {t:>10.3} {:>9.4} {:>6.1}%",
+                step.name(),
+                t * 1e3 / c as f64,
+                100.0 * t / cpu_s
+            );
+        }
+    }
 }
 
 fn main() {
@@ -277,7 +318,7 @@ fn design_table(args: &[String], names: &[String]) {
     println!("Design run (order nK, ε = 1e-3, seed 1, cpumax {cpumax} s): ms per evaluation / one dense eig of size 2(n + nK)");
     for (name, nk) in [("HE1", 1), ("BDT2", 1), ("CM4", 1)] {
         if names.is_empty() || names.iter().any(|n| n == name) {
-            design_ratio(name, nk, cpumax);
+            design_ratio(name, nk, cpumax, args.iter().any(|a| a == "--steps"));
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Small numeric helpers shared by [`crate::lti`] and [`crate::optim`].
+//! Small numeric helpers shared by [`crate::lti`] and [`crate::optim`], and the crate's one CPU clock.
 //!
 //! They live here, below both layers, so that `lti` and `optim` stay independent of each other
 //! (docs/ARCHITECTURE.md §1) while keeping one copy of each helper.
@@ -37,6 +37,28 @@ pub(crate) fn dot_four_lanes(x: &[f64], y: &[f64]) -> f64 {
 /// Whether every entry of a matrix is finite (no NaN, no ±∞).
 pub(crate) fn all_finite(m: MatRef<'_, f64>) -> bool {
     (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()))
+}
+
+/// CPU seconds used so far by the calling thread: `clock_gettime(CLOCK_THREAD_CPUTIME_ID)`.
+///
+/// The one CPU clock of the crate (the optimiser's budget, the campaign's per-job `cpu_s` and the
+/// benches all read it). Callers only ever take differences of two readings.
+///
+/// # Failure
+/// If the clock cannot be read (the call cannot fail on Linux or macOS with a valid pointer;
+/// a platform without a per-thread CPU clock would fail every time), this returns `0.0`: the
+/// clock then stands still, elapsed CPU reads 0 and a CPU budget is never exhausted (runs end by
+/// `maxit`, convergence or cancellation instead). Every derived number stays finite, so
+/// journal lines and traces remain valid; a NaN here would turn every budget test false as
+/// well, but would also reach the journal and make `RunControl::cpu_remaining` report 0.
+pub fn thread_cpu_time() -> f64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec; clock_gettime only writes into it.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return 0.0;
+    }
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
 #[cfg(test)]

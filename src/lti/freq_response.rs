@@ -12,6 +12,7 @@ use faer::linalg::householder;
 use faer::{c64, Conj, Mat, MatRef, Par};
 
 use super::hessenberg_qr::hessenberg_eigenvalues;
+use super::step_stats::{timed, Step};
 use super::StateSpace;
 
 /// G(iω) evaluator for one system (reusable buffers).
@@ -35,6 +36,11 @@ pub(crate) struct FreqResponse {
 impl FreqResponse {
     /// Reduces A to Hessenberg form and transforms B, C (entries assumed finite).
     pub(crate) fn new(sys: &StateSpace) -> Self {
+        timed(Step::Hessenberg, || Self::reduce(sys))
+    }
+
+    /// [`Self::new`] without the step count.
+    fn reduce(sys: &StateSpace) -> Self {
         let (n, m, p) = (sys.order(), sys.inputs(), sys.outputs());
         let mut hm = sys.a.clone();
         let mut bt = sys.b.clone();
@@ -104,6 +110,11 @@ impl FreqResponse {
     /// Hessenberg reduction instead of two when the response is needed anyway (issue 13). `None`
     /// if the QR does not converge.
     pub(crate) fn poles(&self) -> Option<Vec<c64>> {
+        timed(Step::Poles, || self.poles_uncounted())
+    }
+
+    /// [`Self::poles`] without the step count.
+    fn poles_uncounted(&self) -> Option<Vec<c64>> {
         let n = self.n;
         let mut h = vec![0.0; n * n];
         for i in 0..n {
@@ -190,13 +201,14 @@ impl FreqResponse {
 
     /// σmax(G(iω)) (+∞ if not finite).
     pub(crate) fn sigma_max(&mut self, w: f64) -> f64 {
-        let g = self.eval(w);
-        let s = sigma_max_c(g);
-        if s.is_finite() {
-            s
-        } else {
-            f64::INFINITY
-        }
+        timed(Step::FreqEval, || {
+            let s = sigma_max_c(self.eval(w));
+            if s.is_finite() {
+                s
+            } else {
+                f64::INFINITY
+            }
+        })
     }
 }
 

@@ -28,6 +28,7 @@ use super::closed_loop::ClosedLoop;
 use super::hinf::{hinf_norm_of_finite, HinfNorm};
 use super::interrupt::Interrupt;
 use super::spectral::rightmost_eigen;
+use super::step_stats::{for_order, timed, Step};
 use super::{Controller, LtiError, Plant, StateSpace};
 
 /// Gradient with respect to (Ak, Bk, Ck, Dk), same shapes as the controller.
@@ -148,7 +149,7 @@ pub(crate) fn hinf_with_vectors(
         return Ok(None);
     }
     stop.poll()?;
-    Ok(peak_vectors(sys, norm.peak_freq).map(|pv| (norm, pv)))
+    Ok(for_order(sys.order(), || timed(Step::Gradient, || peak_vectors(sys, norm.peak_freq))).map(|pv| (norm, pv)))
 }
 
 /// u, v, a, b at frequency w (module docs); `None` if an SVD fails.

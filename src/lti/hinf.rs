@@ -66,6 +66,7 @@ use super::interrupt::{Interrupt, Interrupted};
 use super::level_set_pencil::pencil_crossings;
 use super::spectral::eigenvalues;
 use super::square_reduced::{hamiltonian_squared_eigenvalues, SquaredSpectrum};
+use super::step_stats::{count, for_order, timed, Step};
 use super::StateSpace;
 
 /// Default relative tolerance of [`hinf_norm`].
@@ -155,18 +156,22 @@ pub(crate) fn hinf_norm_of_finite(
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
     stop.poll()?;
-    if sys.order() >= HESSENBERG_QR_FROM {
-        let fr = FreqResponse::new(sys);
-        match fr.poles() {
-            Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, stop),
-            None => Ok(HinfNorm::UNSTABLE),
-        }
-    } else {
-        match eigenvalues(sys.a.as_ref()) {
-            Some(poles) => hinf_norm_from(sys, &poles, None, tol, hints, stop),
-            None => Ok(HinfNorm::UNSTABLE),
-        }
-    }
+    for_order(sys.order(), || {
+        timed(Step::Norm, || {
+            if sys.order() >= HESSENBERG_QR_FROM {
+                let fr = FreqResponse::new(sys);
+                match fr.poles() {
+                    Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, stop),
+                    None => Ok(HinfNorm::UNSTABLE),
+                }
+            } else {
+                match timed(Step::Poles, || eigenvalues(sys.a.as_ref())) {
+                    Some(poles) => hinf_norm_from(sys, &poles, None, tol, hints, stop),
+                    None => Ok(HinfNorm::UNSTABLE),
+                }
+            }
+        })
+    })
 }
 
 /// A lower bound of ‖sys‖∞ from a few frequencies: max σmax(G(iω)) over `freqs` and ω = ∞, with
@@ -177,13 +182,17 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
     if !sys.is_finite() {
         return f64::INFINITY;
     }
-    let mut fr = FreqResponse::new(sys);
-    let mut best = fr.sigma_max(f64::INFINITY);
-    for &w in freqs.iter().filter(|w| !w.is_nan()) {
-        let s = fr.sigma_max(w.abs());
-        best = if s.is_nan() { f64::INFINITY } else { best.max(s) };
-    }
-    best
+    for_order(sys.order(), || {
+        timed(Step::LowerBound, || {
+            let mut fr = FreqResponse::new(sys);
+            let mut best = fr.sigma_max(f64::INFINITY);
+            for &w in freqs.iter().filter(|w| !w.is_nan()) {
+                let s = fr.sigma_max(w.abs());
+                best = if s.is_nan() { f64::INFINITY } else { best.max(s) };
+            }
+            best
+        })
+    })
 }
 
 /// [`hinf_norm_interruptible`] when the poles (eigenvalues of A) are already known (shared with
@@ -194,7 +203,7 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
     tol: f64,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
-    hinf_norm_from(sys, poles, None, tol, &[], stop)
+    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, None, tol, &[], stop)))
 }
 
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
@@ -434,6 +443,8 @@ struct Hamiltonian<'s> {
     d_u: Mat<f64>,
     d_s: Vec<f64>,
     d_v: Mat<f64>,
+    /// Whether a pencil test was made (`step_stats`).
+    used_pencil: std::cell::Cell<bool>,
 }
 
 impl<'s> Hamiltonian<'s> {
@@ -452,7 +463,7 @@ impl<'s> Hamiltonian<'s> {
             }
             _ => (Mat::identity(p, p), vec![0.0; p.min(m)], Mat::identity(m, m)),
         };
-        Hamiltonian { sys, sigma_d, freq_scale, d_u, d_s, d_v }
+        Hamiltonian { sys, sigma_d, freq_scale, d_u, d_s, d_v, used_pencil: std::cell::Cell::new(false) }
     }
 
     /// Sorted nonnegative frequencies ω with iω an (numerically) imaginary eigenvalue of H(γ);
@@ -464,11 +475,16 @@ impl<'s> Hamiltonian<'s> {
         // lost real crossings on AC4 closed loops of order 6 (`tests/hinf_regression.rs`).
         let explicit = self.sys.order() >= HESSENBERG_QR_FROM;
         let mut ws = if explicit && kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND {
-            let [f, g, k] = self.explicit_hamiltonian(gamma);
-            let sq = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref())?;
-            squared_crossings(&sq)
+            timed(Step::ExplicitLevelSet, || {
+                let [f, g, k] = self.explicit_hamiltonian(gamma);
+                let sq = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref())?;
+                Some(squared_crossings(&sq))
+            })?
         } else {
-            pencil_crossings(self.sys, gamma, self.freq_scale)?
+            if !self.used_pencil.replace(true) {
+                count(Step::NormUsingPencil);
+            }
+            timed(Step::PencilLevelSet, || pencil_crossings(self.sys, gamma, self.freq_scale))?
         };
         ws.sort_by(f64::total_cmp);
         ws.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * b.abs().max(1e-300));

@@ -49,6 +49,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef};
 
 use super::square_reduced::skew_hamiltonian_eigenvalues;
+use super::step_stats::{timed, Step};
 use super::StateSpace;
 
 /// Distance to the image [−2/s, 0] of the imaginary axis accepted as a crossing, in units of
@@ -69,11 +70,14 @@ pub(crate) fn pencil_crossings(sys: &StateSpace, gamma: f64, scale: f64) -> Opti
     let mut fallback = None;
     for f in SHIFT_FACTORS {
         let s = base * f;
-        let mat = shifted_pencil(sys, gamma, s);
-        let lu = mat.partial_piv_lu();
-        let rhs = Mat::<f64>::from_fn(k, 2 * n, |i, j| if i == j { 1.0 } else { 0.0 });
-        let x = lu.solve(rhs);
-        let t = x.as_ref().submatrix(0, 0, 2 * n, 2 * n).to_owned();
+        let (mat, t) = timed(Step::PencilSolve, || {
+            let mat = shifted_pencil(sys, gamma, s);
+            let lu = mat.partial_piv_lu();
+            let rhs = Mat::<f64>::from_fn(k, 2 * n, |i, j| if i == j { 1.0 } else { 0.0 });
+            let x = lu.solve(rhs);
+            let t = x.as_ref().submatrix(0, 0, 2 * n, 2 * n).to_owned();
+            (mat, t)
+        });
         let t_norm = t.norm_l2();
         if !t_norm.is_finite() {
             continue;

@@ -25,6 +25,7 @@ mod riccati;
 mod spectral;
 mod square_reduced;
 mod state_space;
+pub mod step_stats;
 
 pub use balanced_truncation::{
     balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values,

@@ -31,6 +31,7 @@ use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
 
 use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
 use super::spectral::eigenvalues;
+use super::step_stats::{timed, Step};
 use crate::numeric::dot_four_lanes;
 
 /// The eigenvalues μ = λ² of H² (one per pair ±λ of H) and a bound on their absolute error.
@@ -57,11 +58,12 @@ pub(crate) fn hamiltonian_squared_eigenvalues(
     k: MatRef<'_, f64>,
 ) -> Option<SquaredSpectrum> {
     // M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], and GFᵀ = (FG)ᵀ, FᵀK = (KF)ᵀ.
-    let m11 = f * f + g * k;
-    let fg = f * g;
-    let kf = k * f;
-    let m12 = &fg - fg.transpose();
-    let m21 = &kf - kf.transpose();
+    let (m11, m12, m21) = timed(Step::HamiltonianSquare, || {
+        let m11 = f * f + g * k;
+        let fg = f * g;
+        let kf = k * f;
+        (m11, &fg - fg.transpose(), &kf - kf.transpose())
+    });
     let norm = (2.0 * m11.squared_norm_l2() + m12.squared_norm_l2() + m21.squared_norm_l2()).sqrt();
     if !norm.is_finite() {
         return None;
@@ -80,13 +82,15 @@ pub(crate) fn skew_hamiltonian_eigenvalues(
 ) -> Option<Vec<c64>> {
     let n = a.nrows();
     let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
-    blocks.pvl_reduce();
-    if n >= HESSENBERG_QR_FROM {
-        // W's leading block is already Hessenberg: no second reduction (issue 13).
-        return hessenberg_eigenvalues(&mut blocks.a.data, n).ok();
-    }
-    let w = Mat::from_fn(n, n, |i, j| if i <= j + 1 { blocks.a.at(i, j) } else { 0.0 });
-    eigenvalues(w.as_ref())
+    timed(Step::Pvl, || blocks.pvl_reduce());
+    timed(Step::QrW, || {
+        if n >= HESSENBERG_QR_FROM {
+            // W's leading block is already Hessenberg: no second reduction (issue 13).
+            return hessenberg_eigenvalues(&mut blocks.a.data, n).ok();
+        }
+        let w = Mat::from_fn(n, n, |i, j| if i <= j + 1 { blocks.a.at(i, j) } else { 0.0 });
+        eigenvalues(w.as_ref())
+    })
 }
 
 /// A dense column-major square matrix with direct slice access to its columns (the reduction

@@ -15,27 +15,7 @@
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 
-/// CPU seconds used so far by the calling thread: `clock_gettime(CLOCK_THREAD_CPUTIME_ID)`.
-///
-/// The one CPU clock of the crate (the optimiser's budget, the campaign's per-job `cpu_s` and the
-/// benches all read it). Callers only ever take differences of two readings.
-///
-/// # Failure
-/// If the clock cannot be read (the call cannot fail on Linux or macOS with a valid pointer;
-/// a platform without a per-thread CPU clock would fail every time), this returns `0.0`: the
-/// clock then stands still, elapsed CPU reads 0 and a CPU budget is never exhausted (runs end by
-/// `maxit`, convergence or cancellation instead). Every derived number stays finite, so
-/// journal lines and traces remain valid; a NaN here would turn every budget test false as
-/// well, but would also reach the journal and make `RunControl::cpu_remaining` report 0.
-pub fn thread_cpu_time() -> f64 {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: `ts` is a valid, writable timespec; clock_gettime only writes into it.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    if rc != 0 {
-        return 0.0;
-    }
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
+pub use crate::numeric::thread_cpu_time;
 
 /// Shared budget (CPU seconds of this thread since [`RunControl::new`], and optionally a number
 /// of objective evaluations) and an optional cancel flag. Clones share the clock, the evaluation
