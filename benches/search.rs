@@ -21,10 +21,11 @@
 //!   (target 1.1682), AC10 n_K = 1 (stabilised, ≤ 10.874), BDT2 n_K = 1 (≤ 0.6436).
 //! * `random`: `--random` random open-loop-unstable plants (n = 4…20, seeded), n_K = 1 and 2,
 //!   ε = 1e-3, seed 1, each with `--random-cpumax` CPU s: HIFOO's search (`stall_starts = 0`,
-//!   "old"), the continued search ended by the stall rule and without resuming cut local searches
-//!   (`spend_budget = false`, `continue_at_maxit = false`, "prev": the default before those two),
-//!   and the default search ("new"). Counts the stabilised problems of each, and the entries where
-//!   new is at or below old / prev, better by more than 1 %, worse by more than 1 %.
+//!   "old"), the search with the whole gradient-sampling reserve kept to the end and HIFOO's
+//!   `maxit` for every local search (`return_gs_reserve = false`, `continued_maxit = 0`, "prev":
+//!   the default before those two), and the default search ("new"). Counts the stabilised
+//!   problems of each, and the entries where new is at or below old / prev, better by more than
+//!   1 %, worse by more than 1 %.
 //!
 //! Jobs run on `--threads` worker threads; budgets are thread CPU time, so a busy machine slows
 //! the wall clock, not the result.
@@ -304,14 +305,14 @@ fn random(a: &Args) {
             jobs.push(Job {
                 tag: format!("{tag} prev"),
                 plant: p.clone(),
-                opts: DesignOptions { spend_budget: false, continue_at_maxit: false, ..base.clone() },
+                opts: DesignOptions { return_gs_reserve: false, continued_maxit: 0, ..base.clone() },
             });
             jobs.push(Job { tag: format!("{tag} new"), plant: p.clone(), opts: base });
         }
     }
     println!(
-        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old), the continued search \
-         ended by the stall rule (prev, spend_budget = continue_at_maxit = false), the default (new)",
+        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old), the search before \
+         return_gs_reserve and continued_maxit (prev: both off), the default (new)",
         a.random, a.random_cpumax
     );
     let done = run_all(jobs, a.threads);

@@ -196,6 +196,7 @@ fn bad_options_and_init_are_errors() {
         (DesignOptions { random_scales: vec![], ..ok.clone() }, "random_scales"),
         (DesignOptions { random_scales: vec![1.0, 0.0], ..ok.clone() }, "random_scales"),
         (DesignOptions { cpumax: f64::INFINITY, stall_rtol: 0.0, ..ok.clone() }, "stall_rtol"),
+        (DesignOptions { continued_maxit: hinfix::design::MAX_ITERATIONS + 1, ..ok.clone() }, "continued_maxit"),
     ];
     for (opts, field) in cases {
         match run(&p, &opts, None, &mut NoDesignObserver) {
@@ -270,6 +271,67 @@ fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
             (alone.evaluations, alone.iterations, &alone.search.stop, alone.search.starts, alone.search.best_start)
         );
         assert_eq!(o.search.evals_to_best, alone.search.evals_to_best);
+    }
+}
+
+/// `return_gs_reserve`: gradient sampling needs much less than the 10 % kept for it, and what it
+/// does not need goes back to the search, which makes more local searches (deterministic budget).
+/// The incumbent still gets its gradient sampling.
+#[test]
+fn unused_gradient_sampling_reserve_goes_back_to_the_search() {
+    let p = plant("HE1");
+    let opts = DesignOptions { order: 1, eps: 1e-3, seed: 5, cpumax: 1e6, maxevals: Some(4000), ..Default::default() };
+    assert!(opts.return_gs_reserve, "the default");
+    let kept =
+        run(&p, &DesignOptions { return_gs_reserve: false, ..opts.clone() }, None, &mut NoDesignObserver).unwrap();
+    let returned = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let gs_evals = |o: &hinfix::design::DesignOutcome| {
+        o.phases.iter().filter(|s| s.phase == Phase::GradientSampling).map(|s| s.evals).sum::<usize>()
+    };
+    eprintln!(
+        "kept: {} evals, {} starts, GS {} evals, f {}; returned: {} evals, {} starts, GS {} evals, f {}",
+        kept.evaluations,
+        kept.search.starts,
+        gs_evals(&kept),
+        kept.objective,
+        returned.evaluations,
+        returned.search.starts,
+        gs_evals(&returned),
+        returned.objective
+    );
+    for o in [&kept, &returned] {
+        assert_eq!(o.search.stop, SearchStop::Maxevals, "{:?}", o.search);
+        assert!(gs_evals(o) > 0, "gradient sampling ran: {:?}", o.phases);
+        assert!(o.evaluations <= 4000 + 2, "{} evaluations", o.evaluations);
+        check_recomputed(&p, o);
+    }
+    assert!(kept.evaluations < 3900, "kept reserve unused: {} evaluations", kept.evaluations);
+    assert!(returned.evaluations > kept.evaluations, "{} <= {}", returned.evaluations, kept.evaluations);
+    assert!(returned.search.starts > kept.search.starts, "{:?} vs {:?}", returned.search, kept.search);
+}
+
+/// With `return_gs_reserve` the default search runs gradient sampling where HIFOO's search does
+/// (after its `nrand` first starts, the generator in the same state), so its incumbent from then
+/// on is HIFOO's result and the default can only end at or below it (evaluation budget, far from
+/// the CPU budget).
+#[test]
+fn default_search_is_never_worse_than_hifoos_search() {
+    for (name, order) in [("HE1", 1), ("HE1", 2), ("REA2", 2)] {
+        let p = plant(name);
+        let base =
+            DesignOptions { order, eps: 1e-3, seed: 1, cpumax: 1e6, maxevals: Some(12_000), ..Default::default() };
+        let hifoo_opts =
+            DesignOptions { stall_starts: 0, central_gammas: Vec::new(), open_loop_start: false, ..base.clone() };
+        let hifoo = run(&p, &hifoo_opts, None, &mut NoDesignObserver).unwrap();
+        let default = run(&p, &base, None, &mut NoDesignObserver).unwrap();
+        assert_eq!(hifoo.search.stop, SearchStop::Starts, "{name} {order}: {:?}", hifoo.search);
+        assert!(
+            default.objective <= hifoo.objective,
+            "{name} n_K = {order}: default {} > HIFOO's search {}",
+            default.objective,
+            hifoo.objective
+        );
+        check_recomputed(&p, &default);
     }
 }
 

@@ -561,8 +561,10 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
             cpumax: 20.0,
             maxit,
             spend_budget: false,
-            // maxit bounds each local search only if cut searches are not resumed.
+            // maxit bounds each local search only if cut searches are not resumed, and if the
+            // continued search's local searches have the same limit.
             continue_at_maxit: false,
+            continued_maxit: 0,
             gradient_sampling: false,
             ..Default::default()
         };

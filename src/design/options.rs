@@ -45,6 +45,13 @@ fn is_false(b: &bool) -> bool {
     !*b
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// Default of [`DesignOptions::continued_maxit`].
+pub const DEFAULT_CONTINUED_MAXIT: usize = 3000;
+
 /// Default of [`DesignOptions::central_gammas`].
 pub const DEFAULT_CENTRAL_GAMMAS: [f64; 2] = [1.1, 2.0];
 
@@ -98,6 +105,23 @@ pub struct DesignOptions {
     /// behaviour before this option existed; not written when false.)
     #[serde(default, skip_serializing_if = "is_false")]
     pub continue_at_maxit: bool,
+    /// BFGS iteration limit of the continued search's f_h local searches (HIFOO's first starts
+    /// and every stabilisation keep `maxit`); 0: `maxit`. Local searches on many variables are
+    /// cut by HIFOO's 1000 iterations (Enns n_K = 8, 81 variables); on small plants they end at
+    /// a minimiser long before either limit, so the option changes nothing there. (Missing in a
+    /// serialised record: 0, the behaviour before this option existed; not written when 0.)
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub continued_maxit: usize,
+    /// Give the unused part of the gradient-sampling reserve back to the search: gradient
+    /// sampling runs on the incumbent where HIFOO's search runs it (after the `nrand` first
+    /// starts; the incumbent is then HIFOO's result) and whenever the search's share of a budget
+    /// is spent; the reserve becomes twice what it took (at most the first 10 %), and gradient
+    /// sampling runs again at the end only if the incumbent changed. false: 10 % of each budget
+    /// is kept, and gradient sampling runs once, at the end.
+    /// (Missing in a serialised record: false, the behaviour before this option existed; not
+    /// written when false.)
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub return_gs_reserve: bool,
     /// Largest number of local searches (first starts included); `None`: no limit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_starts: Option<usize>,
@@ -172,6 +196,8 @@ impl Default for DesignOptions {
             stall_rtol: 1e-6,
             spend_budget: true,
             continue_at_maxit: true,
+            continued_maxit: DEFAULT_CONTINUED_MAXIT,
+            return_gs_reserve: true,
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
             random_scales: DEFAULT_RANDOM_SCALES.to_vec(),
@@ -208,6 +234,8 @@ mod tests {
             format!("stall_rtol {:e},", d.stall_rtol),
             format!("spend_budget {},", d.spend_budget),
             format!("continue_at_maxit {},", d.continue_at_maxit),
+            format!("continued_maxit {},", d.continued_maxit),
+            format!("return_gs_reserve {},", d.return_gs_reserve),
             format!("maxit {},", d.maxit),
             format!("normtol {:e},", d.normtol),
             format!("evaldist {:e},", d.evaldist),

@@ -132,6 +132,12 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     if !(1..=MAX_ITERATIONS).contains(&opts.maxit) {
         return Err(opt_err("maxit", format!("must be in 1..={MAX_ITERATIONS}, got {}", opts.maxit)));
     }
+    if opts.continued_maxit > MAX_ITERATIONS {
+        return Err(opt_err(
+            "continued_maxit",
+            format!("must be at most {MAX_ITERATIONS} (0: maxit), got {}", opts.continued_maxit),
+        ));
+    }
     if opts.gradsamp_maxit > MAX_ITERATIONS {
         return Err(opt_err(
             "gradsamp_maxit",

@@ -28,7 +28,10 @@
 //!    being left unfinished. This uses no random numbers and leaves the cycle's draws unchanged.
 //!    It matters for many variables: Enns n_K = 8 (81 variables; ε = 1e-3, seed 1, 60 CPU s) ended
 //!    at 1.13167 without it and at 1.13112 and 1.13144 (two runs) with it; with `maxit = 3000`
-//!    instead, 1.12986.
+//!    instead, 1.12986. The f_h local searches of the continued search (resumptions, hops and
+//!    random starts) have their own iteration limit `continued_maxit` (default
+//!    [`crate::design::DEFAULT_CONTINUED_MAXIT`]; 0: `maxit`), so that HIFOO's first starts and
+//!    every stabilisation keep HIFOO's `maxit`.
 //!
 //! # When it stops
 //! Before each new local search (and within one, between evaluations) the run stops on the CPU
@@ -44,9 +47,22 @@
 //!
 //! # Gradient sampling on the incumbent
 //! If gradient sampling is on, [`GS_RESERVE`] of each budget (CPU and evaluations) is kept for
-//! it once a stable point is known: from then on the local searches run under the remaining part, then gradient sampling on f_h runs from
-//! the best point (HANSO 2.0's rule: only if its certificate dnorm > normtol) under the whole
-//! budget, and replaces the best point if it lowers f_h.
+//! it once a stable point is known: from then on the local searches run under the remaining
+//! part, then gradient sampling on f_h runs from the best point (HANSO 2.0's rule: only if its
+//! certificate dnorm > normtol) under the whole budget, and replaces the best point if it lowers
+//! f_h. It often needs much less than the reserve (HE1 left about 5 of 60 CPU s unused). With
+//! `return_gs_reserve` (the default) gradient sampling runs on the incumbent where HIFOO's search
+//! runs it — right after HIFOO's `nrand` first starts, with the generator in the same state, so
+//! the incumbent is from then on HIFOO's own result, bit for bit, and the search can only end
+//! below it — and the search goes on under the whole budget less [`GS_RESERVE_FACTOR`] times
+//! what that gradient sampling took (CPU seconds and evaluations; the most measured so far, at
+//! most the first reserve). Whenever the search's share is spent, gradient sampling runs again
+//! from the incumbent if it changed, and the search goes on with what that leaves, first resuming
+//! the incumbent's local search if the budget or `maxit` cut it (`continue_at_maxit`), until a
+//! round gives nothing back; at the end gradient sampling runs from the incumbent only if it
+//! changed since the last one. While nothing was measured (no stable point after the first
+//! starts, or a certified incumbent) the first reserve stays. The final incumbent thus always had
+//! its gradient sampling (or a certificate), as without the option.
 //!
 //! # Reproducibility
 //! All randomness comes from the run's ChaCha8 generator, drawn in a fixed order. With
@@ -62,11 +78,15 @@ use crate::optim::{bfgs, gradient_sampling, OptimError, OptimResult, RunControl,
 use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::DesignOptions;
 use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
-use super::phases::{bfgs_options, gradsamp_options, optim_error};
+use super::phases::{bfgs_options, gradsamp_options, optim_error, perf_bfgs_options};
 use super::starts::{perturb, scaled_random_start};
 
 /// Share of the CPU and evaluation budgets kept for the final gradient sampling (when enabled).
 pub const GS_RESERVE: f64 = 0.1;
+
+/// With `return_gs_reserve`: the reserve kept after a gradient sampling on the incumbent is this
+/// many times what it took (CPU seconds and evaluations), at most [`GS_RESERVE`] of the budget.
+pub const GS_RESERVE_FACTOR: f64 = 2.0;
 
 /// Relative tolerance of "first reached" for [`SearchSummary::cpu_to_best_s`].
 pub const TIME_TO_BEST_RTOL: f64 = 1e-6;
@@ -141,9 +161,11 @@ struct State<'s> {
     stab: Option<Best>,
     stabilised: bool,
     stall: usize,
-    /// The f_h local search that produced `perf` ended on `maxit` (not at a minimiser): the next
-    /// continued start resumes it (`continue_at_maxit`).
+    /// The f_h local search that produced `perf` ended on `maxit` or a budget (not at a
+    /// minimiser): the next continued start resumes it (`continue_at_maxit`).
     perf_cut: bool,
+    /// The continued search has begun: its f_h local searches use `continued_maxit`.
+    continued: bool,
 }
 
 impl State<'_> {
@@ -176,7 +198,10 @@ impl State<'_> {
         if r.f.is_finite() && r.f < old {
             self.perf =
                 Some(Best { x: r.x.clone(), f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from: from.to_vec() });
-            self.perf_cut = r.termination == Termination::MaxIters;
+            // Cut by `maxit`, or by the search's share of a budget (`return_gs_reserve` may give
+            // the search more).
+            self.perf_cut =
+                matches!(r.termination, Termination::MaxIters | Termination::CpuBudget | Termination::EvalBudget);
         }
         better
     }
@@ -190,6 +215,23 @@ impl State<'_> {
         self.perf_cut = false;
         self.perf.as_ref().map(|b| b.x.clone())
     }
+}
+
+/// What `return_gs_reserve` has done so far (module docs).
+#[derive(Debug, Default)]
+struct GsRounds {
+    /// The first reserve (CPU seconds, evaluations): the most that is ever kept.
+    first: (f64, usize),
+    /// The reserve kept now.
+    kept: (f64, usize),
+    /// The incumbent as the last gradient sampling left it.
+    at: Option<Vec<f64>>,
+    /// Gradient sampling ran at least once.
+    ran: bool,
+    /// The step after HIFOO's first starts was taken.
+    after_first: bool,
+    /// No round is left to give.
+    done: bool,
 }
 
 /// Everything one search needs besides its state.
@@ -252,7 +294,7 @@ impl Search<'_, '_, '_> {
         self.adapter.switch(self.perf_obj, Phase::Optimisation);
         self.adapter.set_evals_base(st.evals());
         let c0 = ctl.cpu_elapsed();
-        match bfgs(self.perf_obj, xs, k, &bfgs_options(opts, f64::NEG_INFINITY), ctl, self.adapter) {
+        match bfgs(self.perf_obj, xs, k, &perf_bfgs_options(opts, st.continued), ctl, self.adapter) {
             Ok(r) => {
                 st.add(1, &r, c0, ctl.cpu_elapsed());
                 let better = st.offer_perf(&r, xs, k);
@@ -320,6 +362,66 @@ impl Search<'_, '_, '_> {
         }
     }
 
+    /// Gradient sampling on f_h from the incumbent under the whole budget, if the incumbent is
+    /// not certified (HANSO 2.0's rule: dnorm > normtol) and the budget is not spent; its end point
+    /// replaces the incumbent if it lowers f_h. Returns whether it ran.
+    fn gs_incumbent(&mut self, st: &mut State<'_>) -> Result<bool, DesignError> {
+        let opts = st.opts;
+        let Some(best) = st.perf.clone() else { return Ok(false) };
+        if !(best.dnorm > opts.normtol && ctl_stop(self.ctl).is_none()) {
+            return Ok(false);
+        }
+        self.adapter.switch(self.perf_obj, Phase::Optimisation);
+        self.adapter.set_evals_base(st.evals());
+        let c0 = self.ctl.cpu_elapsed();
+        let gopts = gradsamp_options(opts, f64::NEG_INFINITY);
+        match gradient_sampling(self.perf_obj, &best.x, &gopts, self.rng, self.ctl, self.adapter) {
+            Ok(r) => {
+                st.add(2, &r, c0, self.ctl.cpu_elapsed());
+                let b = st.perf.as_mut().expect("checked above");
+                if r.f < b.f {
+                    b.x = r.x;
+                    b.f = r.f;
+                    b.dnorm = r.dnorm;
+                    b.evaldist = r.evaldist;
+                } else if r.x == b.x && r.dnorm < b.dnorm {
+                    b.dnorm = r.dnorm;
+                    b.evaldist = r.evaldist;
+                }
+                Ok(true)
+            }
+            Err(OptimError::NonFiniteStart { .. }) => {
+                st.stats[2].evals += 1;
+                Ok(false)
+            }
+            Err(e) => Err(optim_error(e)),
+        }
+    }
+
+    /// `return_gs_reserve`, after HIFOO's first starts and whenever the search has spent its share
+    /// of the budget: gradient sampling on the incumbent (if it changed since the last one), then
+    /// the control of the search from here — the whole budget less [`GS_RESERVE_FACTOR`] times the
+    /// most a gradient sampling took, at most the first reserve — or None if nothing was measured
+    /// or that share is already spent (module docs).
+    fn return_reserve(&mut self, st: &mut State<'_>, rounds: &mut GsRounds) -> Result<Option<RunControl>, DesignError> {
+        let full = self.ctl;
+        let (c0, e0) = (full.cpu_elapsed(), full.evals());
+        if st.perf.as_ref().map(|b| &b.x) != rounds.at.as_ref() {
+            rounds.ran |= self.gs_incumbent(st)?;
+        }
+        rounds.at = st.perf.as_ref().map(|b| b.x.clone());
+        let (c, e) = (full.cpu_elapsed() - c0, full.evals() - e0);
+        if !rounds.ran {
+            return Ok(None); // nothing measured (a certified incumbent): the first reserve stays
+        }
+        rounds.kept = (
+            rounds.kept.0.max(GS_RESERVE_FACTOR * c).min(rounds.first.0),
+            rounds.kept.1.max((GS_RESERVE_FACTOR * e as f64).ceil() as usize).min(rounds.first.1),
+        );
+        let next = full.less(rounds.kept.0, rounds.kept.1);
+        Ok(ctl_stop(&next).is_none().then_some(next))
+    }
+
     /// Runs the whole search from the first starts `first` (module docs).
     pub(crate) fn run(
         &mut self,
@@ -329,7 +431,7 @@ impl Search<'_, '_, '_> {
         nvar: usize,
     ) -> Result<SearchResult, DesignError> {
         let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
-        let search_ctl = self.ctl.sub_budget(reserve, reserve);
+        let mut search_ctl = self.ctl.sub_budget(reserve, reserve);
         let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
         let mut st = State {
             opts,
@@ -339,6 +441,7 @@ impl Search<'_, '_, '_> {
             stabilised: false,
             stall: 0,
             perf_cut: false,
+            continued: false,
         };
         let mut k = 0usize; // local searches made
         let mut cycle = 0usize; // continued starts drawn from the hop / random cycle
@@ -346,7 +449,31 @@ impl Search<'_, '_, '_> {
         let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
         let mut stop = None;
         let full_ctl = self.ctl;
+        let returning = opts.return_gs_reserve && opts.gradient_sampling;
+        let first_reserve = (
+            GS_RESERVE * full_ctl.cpumax(),
+            full_ctl.maxevals().map_or(usize::MAX, |m| m - search_ctl.maxevals().unwrap_or(m)),
+        );
+        let mut rounds = GsRounds { first: first_reserve, ..Default::default() };
+        // HIFOO's own first starts (random or init): the extra open-loop and central starts are
+        // like the continued search, a budget may end the run before them without truncating it.
+        let hifoo_starts = first_kinds
+            .iter()
+            .take(first.len())
+            .filter(|k| !matches!(k, StartKind::Central | StartKind::OpenLoop))
+            .count();
         while stop.is_none() {
+            let share_spent = ctl_stop(&search_ctl).is_some() && ctl_stop(full_ctl).is_none();
+            // Gradient sampling where HIFOO's search makes it (after its first starts, with the
+            // generator in the same state), and whenever the search's share is spent.
+            let hifoo_done = k == hifoo_starts && !rounds.after_first;
+            if returning && st.stabilised && !rounds.done && (share_spent || hifoo_done) {
+                rounds.after_first |= hifoo_done;
+                match self.return_reserve(&mut st, &mut rounds)? {
+                    Some(c) => search_ctl = c,
+                    None => rounds.done = share_spent,
+                }
+            }
             // The gradient-sampling reserve is kept only once there is a stable point to refine.
             let search_ctl = if st.stabilised { &search_ctl } else { full_ctl };
             if let Some(s) = ctl_stop(search_ctl) {
@@ -386,58 +513,34 @@ impl Search<'_, '_, '_> {
                     }
                 };
                 kinds.push(kind);
+                st.continued = true;
                 self.local(&mut st, &x0, k, search_ctl)?
             };
             k += 1;
             st.stall = if better { 0 } else { st.stall + 1 };
-            stop = s;
+            // The search's share of a budget is spent but the budget is not: the next turn may
+            // give the search back what gradient sampling does not need (`return_gs_reserve`).
+            let share_only =
+                matches!(s, Some(SearchStop::Budget | SearchStop::Maxevals)) && ctl_stop(full_ctl).is_none();
+            stop = s.filter(|_| !(returning && st.stabilised && share_only && !rounds.done));
         }
         let stop = stop.unwrap_or(SearchStop::Starts);
-        // HIFOO's own first starts (random or init): the extra open-loop and central starts are
-        // like the continued search, a budget may end the run before them without truncating it.
-        let hifoo_starts = first_kinds
-            .iter()
-            .take(first.len())
-            .filter(|k| !matches!(k, StartKind::Central | StartKind::OpenLoop))
-            .count();
         let truncated = k < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
 
-        // Gradient sampling from the best stable point, under the whole budget.
-        let mut gs_ran = false;
-        if opts.gradient_sampling && stop != SearchStop::Interrupted {
-            if let Some(best) = st.perf.clone() {
-                if best.dnorm > opts.normtol && ctl_stop(self.ctl).is_none() {
-                    self.adapter.switch(self.perf_obj, Phase::Optimisation);
-                    self.adapter.set_evals_base(st.evals());
-                    let c0 = self.ctl.cpu_elapsed();
-                    let gopts = gradsamp_options(opts, f64::NEG_INFINITY);
-                    match gradient_sampling(self.perf_obj, &best.x, &gopts, self.rng, self.ctl, self.adapter) {
-                        Ok(r) => {
-                            st.add(2, &r, c0, self.ctl.cpu_elapsed());
-                            gs_ran = true;
-                            let b = st.perf.as_mut().expect("checked above");
-                            if r.f < b.f {
-                                b.x = r.x;
-                                b.f = r.f;
-                                b.dnorm = r.dnorm;
-                                b.evaldist = r.evaldist;
-                            } else if r.x == b.x && r.dnorm < b.dnorm {
-                                b.dnorm = r.dnorm;
-                                b.evaldist = r.evaldist;
-                            }
-                        }
-                        Err(OptimError::NonFiniteStart { .. }) => st.stats[2].evals += 1,
-                        Err(e) => return Err(optim_error(e)),
-                    }
-                }
-            }
+        // Gradient sampling from the best stable point, under the whole budget (unless it already
+        // ran from it).
+        if opts.gradient_sampling
+            && stop != SearchStop::Interrupted
+            && st.perf.as_ref().map(|b| &b.x) != rounds.at.as_ref()
+        {
+            rounds.ran |= self.gs_incumbent(&mut st)?;
         }
         let [s0, s1, s2] = st.stats;
         let mut phases = vec![s0];
         if st.stabilised {
             phases.push(s1);
         }
-        if gs_ran {
+        if rounds.ran {
             phases.push(s2);
         }
         let stab = st.stab.unwrap_or_else(|| Best {
