@@ -56,7 +56,8 @@
 //! the incumbent is from then on HIFOO's own result, bit for bit, and the search can only end
 //! below it — and the search goes on under the whole budget less [`GS_RESERVE_FACTOR`] times
 //! what that gradient sampling took (CPU seconds and evaluations; the most measured so far, at
-//! most the first reserve). Whenever the search's share is spent, gradient sampling runs again
+//! most the first reserve; this gradient sampling itself gets at most the first reserve, so that
+//! a small evaluation budget is not spent on it). Whenever the search's share is spent, gradient sampling runs again
 //! from the incumbent if it changed, and the search goes on with what that leaves, first resuming
 //! the incumbent's local search if the budget or `maxit` cut it (`continue_at_maxit`), until a
 //! round gives nothing back; at the end gradient sampling runs from the incumbent only if it
@@ -362,22 +363,22 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// Gradient sampling on f_h from the incumbent under the whole budget, if the incumbent is
-    /// not certified (HANSO 2.0's rule: dnorm > normtol) and the budget is not spent; its end point
+    /// Gradient sampling on f_h from the incumbent under `ctl`, if the incumbent is not
+    /// certified (HANSO 2.0's rule: dnorm > normtol) and the budget is not spent; its end point
     /// replaces the incumbent if it lowers f_h. Returns whether it ran.
-    fn gs_incumbent(&mut self, st: &mut State<'_>) -> Result<bool, DesignError> {
+    fn gs_incumbent(&mut self, st: &mut State<'_>, ctl: &RunControl) -> Result<bool, DesignError> {
         let opts = st.opts;
         let Some(best) = st.perf.clone() else { return Ok(false) };
-        if !(best.dnorm > opts.normtol && ctl_stop(self.ctl).is_none()) {
+        if !(best.dnorm > opts.normtol && ctl_stop(ctl).is_none()) {
             return Ok(false);
         }
         self.adapter.switch(self.perf_obj, Phase::Optimisation);
         self.adapter.set_evals_base(st.evals());
-        let c0 = self.ctl.cpu_elapsed();
+        let c0 = ctl.cpu_elapsed();
         let gopts = gradsamp_options(opts, f64::NEG_INFINITY);
-        match gradient_sampling(self.perf_obj, &best.x, &gopts, self.rng, self.ctl, self.adapter) {
+        match gradient_sampling(self.perf_obj, &best.x, &gopts, self.rng, ctl, self.adapter) {
             Ok(r) => {
-                st.add(2, &r, c0, self.ctl.cpu_elapsed());
+                st.add(2, &r, c0, ctl.cpu_elapsed());
                 let b = st.perf.as_mut().expect("checked above");
                 if r.f < b.f {
                     b.x = r.x;
@@ -407,7 +408,13 @@ impl Search<'_, '_, '_> {
         let full = self.ctl;
         let (c0, e0) = (full.cpu_elapsed(), full.evals());
         if st.perf.as_ref().map(|b| &b.x) != rounds.at.as_ref() {
-            rounds.ran |= self.gs_incumbent(st)?;
+            // At most the first reserve from now (small evaluation budgets: HE1 n_K = 2 under
+            // maxevals = 10 000 spent most of its budget on this gradient sampling otherwise).
+            let cap = full.less(
+                full.cpumax() - c0 - rounds.first.0,
+                full.maxevals().map_or(0, |m| m.saturating_sub(e0.saturating_add(rounds.first.1))),
+            );
+            rounds.ran |= self.gs_incumbent(st, &cap)?;
         }
         rounds.at = st.perf.as_ref().map(|b| b.x.clone());
         let (c, e) = (full.cpu_elapsed() - c0, full.evals() - e0);
@@ -533,7 +540,7 @@ impl Search<'_, '_, '_> {
             && stop != SearchStop::Interrupted
             && st.perf.as_ref().map(|b| &b.x) != rounds.at.as_ref()
         {
-            rounds.ran |= self.gs_incumbent(&mut st)?;
+            rounds.ran |= self.gs_incumbent(&mut st, full_ctl)?;
         }
         let [s0, s1, s2] = st.stats;
         let mut phases = vec![s0];
