@@ -32,7 +32,7 @@ pub use objective::{
     MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
 };
 pub use options::{
-    DesignOptions, ObjectiveKind, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES,
+    DesignOptions, ObjectiveKind, VariableScaling, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES,
     DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
