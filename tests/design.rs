@@ -315,9 +315,10 @@ fn ac10_order1_is_stabilised_from_a_cold_start() {
 
 /// Plant-scaled variables (`variable_scaling`, docs/ALGORITHMS.md §8.6: AC10's two measurements
 /// are 10⁵ apart) within one deterministic budget of 1500 evaluations (one random start and the
-/// open-loop start first, then the continued search): the unscaled search (`Off`) stays near
-/// γ ≈ 18.8; the default, which alternates unscaled and scaled hop cycles after the first starts,
-/// and the all-scaled search both get below 12 (10.71 and 10.7x when written).
+/// open-loop start first, then the continued search): the unscaled search (`Off`) stays at
+/// γ 18.76; the default, whose first hop cycle runs in the coordinates the incumbent was not
+/// found in (here the scaled ones), and the all-scaled search both get below 12 (10.71 and 11.81
+/// when written).
 #[test]
 fn ac10_order1_default_search_with_scaled_cycles_gets_far_below_the_unscaled_one() {
     let p = plant("AC10");

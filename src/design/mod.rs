@@ -42,4 +42,4 @@ pub use outcome::{
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
-pub use search::{GS_RESERVE, TIME_TO_BEST_RTOL};
+pub use search::{ALTERNATE_PERIOD, GS_RESERVE, TIME_TO_BEST_RTOL};

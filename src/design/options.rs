@@ -57,9 +57,10 @@ pub enum VariableScaling {
     /// Every local search in x (HIFOO's search). The value of a record without the field.
     #[default]
     Off,
-    /// Both: HIFOO's first starts in x, then the continued search alternates between whole hop
-    /// cycles in x and in x̃ (the hops and random starts of a cycle drawn in its coordinates).
-    /// The default of [`DesignOptions`].
+    /// Both: HIFOO's first starts in x, then the continued search's hop cycles (the hops and
+    /// random start of a cycle drawn in its coordinates) in the coordinates that found the
+    /// incumbent, except one in [`crate::design::ALTERNATE_PERIOD`] = 4 (the first included) in the
+    /// others. The default of [`DesignOptions`].
     Alternate,
     /// Every local search in x̃ (the boolean `true` of older builds).
     Always,
@@ -198,9 +199,10 @@ pub struct DesignOptions {
     #[serde(default, skip_serializing_if = "is_false")]
     pub open_loop_start: bool,
     /// Coordinates of the local searches ([`VariableScaling`]): `Off`, x only; `Alternate` (the
-    /// default), HIFOO's first starts in x, then the continued search alternates whole hop cycles
-    /// in x and in the plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`: the control and
-    /// measurement channels scaled to comparable sizes, powers of two); `Always`, x̃ only. A
+    /// default), HIFOO's first starts in x, then the continued search's hop cycles in the
+    /// coordinates that found the incumbent, except one in four (the first included) in the
+    /// others — x or the plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`: the control
+    /// and measurement channels scaled to comparable sizes, powers of two); `Always`, x̃ only. A
     /// plant whose channels are alike (within 2¹⁰: HE1, REA2, AC8, Enns, every SISO plant) gets
     /// d = 1, and every mode is the unscaled search bit for bit. AC10 n_K = 1 needs x̃ (γ ≈ 17.6
     /// unscaled, 10.05 always scaled at 300 CPU s), BDT2 n_K = 1 does better in x (0.581 against

@@ -34,8 +34,11 @@
 //! Each local search runs either on the controller's parameters x or, if the plant's channels
 //! are scaled (`design::scaling`), on plant-scaled variables x̃ (x = d ∘ x̃), by
 //! `variable_scaling`: `Off`, x only; `Always`, x̃ only; `Alternate` (the default), HIFOO's first
-//! starts (and the open-loop and central starts) in x, then whole hop cycles alternately in x̃
-//! (the first continued cycle) and in x. A cycle's basin hops perturb the best point in its own
+//! starts (and the open-loop and central starts) in x, then whole hop cycles (one hop per
+//! `hop_scales` entry and one random start): the 1st, 5th, 9th, … ([`ALTERNATE_PERIOD`] = 4) in
+//! the coordinates the current incumbent was *not* found in, the others in those it was found
+//! in. Both keep being tried, and the one that works on the plant gets three cycles in four
+//! (AC10: x̃; BDT2: x). A cycle's basin hops perturb the best point in its own
 //! coordinates (x̃* + ξ ∘ (‖x̃*‖·r) for a scaled cycle) and its random start σ·ξ is drawn in them.
 //! The incumbents are kept in x whatever coordinates found them (x ↔ x̃ is exact: d holds
 //! powers of two), so each coordinate system hops around the best point either found; resuming a
@@ -83,6 +86,10 @@ use super::starts::{perturb, scaled_random_start};
 
 /// Share of the CPU and evaluation budgets kept for the final gradient sampling (when enabled).
 pub const GS_RESERVE: f64 = 0.1;
+
+/// `variable_scaling = "alternate"`: one hop cycle in this many runs in the coordinates (x or
+/// x̃) the incumbent was not found in, the others in those it was (module docs).
+pub const ALTERNATE_PERIOD: usize = 4;
 
 /// Relative tolerance of "first reached" for [`SearchSummary::cpu_to_best_s`].
 pub const TIME_TO_BEST_RTOL: f64 = 1e-6;
@@ -277,19 +284,23 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// The coordinates of HIFOO's first starts (`first`) or of continued start number `j`, whose
-    /// hop cycle has length `cycle` (module docs): `Alternate` runs the even-numbered cycles in
-    /// x̃ and the odd-numbered in x.
-    fn coords_of(&self, mode: VariableScaling, continued: Option<(usize, usize)>) -> Coords {
+    /// The coordinates of HIFOO's first starts (`continued` None) or of the hop cycle that begins
+    /// with continued start number `j` (`continued` = (j, hop cycle length, coordinates of the
+    /// incumbent's local search)), module docs: `Alternate` runs one hop cycle in [`ALTERNATE_PERIOD`] (the first one
+    /// included) in the coordinates the incumbent was not found in, the others in those it was.
+    fn coords_of(&self, mode: VariableScaling, continued: Option<(usize, usize, Coords)>) -> Coords {
         if self.scaled.is_none() {
             return Coords::Raw;
         }
+        let other = |c| if c == Coords::Raw { Coords::Scaled } else { Coords::Raw };
         match (mode, continued) {
             (VariableScaling::Off, _) => Coords::Raw,
             (VariableScaling::Always, _) => Coords::Scaled,
             (VariableScaling::Alternate, None) => Coords::Raw,
-            (VariableScaling::Alternate, Some((j, cycle))) if (j / cycle) % 2 == 0 => Coords::Scaled,
-            (VariableScaling::Alternate, Some(_)) => Coords::Raw,
+            (VariableScaling::Alternate, Some((j, cycle, inc))) if (j / cycle).is_multiple_of(ALTERNATE_PERIOD) => {
+                other(inc)
+            }
+            (VariableScaling::Alternate, Some((_, _, inc))) => inc,
         }
     }
 
@@ -447,6 +458,7 @@ impl Search<'_, '_, '_> {
         let mut gs_fallback_done = false;
         let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
         let mut coords: Vec<Coords> = Vec::new(); // its coordinates
+        let mut cycle_coords = Coords::Raw; // coordinates of the current hop cycle
         let mut stop = None;
         let full_ctl = self.ctl;
         while stop.is_none() {
@@ -489,7 +501,13 @@ impl Search<'_, '_, '_> {
                     Some((x, c)) => (self.to_coords(&x, c), StartKind::Hop, c),
                     None => {
                         cycle += 1;
-                        let c = self.coords_of(opts.variable_scaling, Some((cycle - 1, opts.hop_scales.len() + 1)));
+                        // A hop cycle's coordinates are chosen at its first start.
+                        let len = opts.hop_scales.len() + 1;
+                        if (cycle - 1).is_multiple_of(len) {
+                            let inc = st.perf.as_ref().or(st.stab.as_ref()).map_or(Coords::Raw, |b| b.coords);
+                            cycle_coords = self.coords_of(opts.variable_scaling, Some((cycle - 1, len, inc)));
+                        }
+                        let c = cycle_coords;
                         let (x0, kind) = self.next_start(&st, cycle - 1, nvar, c);
                         (x0, kind, c)
                     }
