@@ -88,9 +88,10 @@ pub struct DesignArgs {
     #[arg(long)]
     pub no_open_loop_start: bool,
     /// Coordinates of the local searches: "off" (the controller's parameters), "alternate"
-    /// (HIFOO's first starts unscaled, then the continued search alternates whole hop cycles
-    /// between the parameters and variables scaled by the plant's control and measurement channel
-    /// sizes) or "always" (scaled only; a bare --variable-scaling). No change for a plant whose
+    /// (HIFOO's first starts unscaled; then three hop cycles in four in the coordinates that
+    /// found the best controller so far and one in the others: the parameters, or variables
+    /// scaled by the plant's control and measurement channel sizes) or "always" (scaled only; a
+    /// bare --variable-scaling). No change for a plant whose
     /// channels are within 2^10 of each other. Plants whose channels differ by orders of
     /// magnitude (AC10) need the scaled searches, others (BDT2) do better unscaled.
     #[arg(long, value_name = "MODE", default_value = "alternate", num_args = 0..=1,
