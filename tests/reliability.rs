@@ -83,6 +83,7 @@ fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
             starts: 1,
             best_start: 0,
             best_start_kind: None,
+            best_start_scaled: false,
             cpu_to_best_s: x,
             evals_to_best: 1,
             stop: hinfix::design::SearchStop::Stall,

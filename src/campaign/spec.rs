@@ -20,7 +20,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
-use crate::design::{DesignOptions, ObjectiveKind};
+use crate::design::{DesignOptions, ObjectiveKind, VariableScaling};
 use crate::lti::Plant;
 
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
@@ -85,7 +85,7 @@ macro_rules! with_design_settings {
             central_gammas: Option<Spanned<Vec<f64>>>,
             random_scales: Option<Spanned<Vec<f64>>>,
             open_loop_start: Option<bool>,
-            variable_scaling: Option<bool>,
+            variable_scaling: Option<VariableScaling>,
             spend_budget: Option<bool>,
             continue_at_maxit: Option<bool>,
             continued_maxit: Option<Spanned<usize>>,
@@ -401,7 +401,7 @@ struct Layered {
     central_gammas: Setting<Vec<f64>>,
     random_scales: Setting<Vec<f64>>,
     open_loop_start: Option<bool>,
-    variable_scaling: Option<bool>,
+    variable_scaling: Option<VariableScaling>,
     spend_budget: Option<bool>,
     continue_at_maxit: Option<bool>,
     continued_maxit: Setting<usize>,
@@ -735,14 +735,26 @@ objective = "plain"
             (vec![1.0, 1e-3], false)
         );
         assert_eq!((c.problems[1].base.random_scales.clone(), c.problems[1].base.open_loop_start), (vec![0.5], true));
+        // The booleans of older builds (false: off, true: always) and the mode names.
         let c = parse(
             "name = \"t\"\n[defaults]\nvariable_scaling = true\n[[problem]]\nplant = \"HE1\"\norders = [1]\n\
-             [[problem]]\nplant = \"REA2\"\norders = [1]\nvariable_scaling = false\n",
+             [[problem]]\nplant = \"REA2\"\norders = [1]\nvariable_scaling = false\n\
+             [[problem]]\nplant = \"REA2\"\norders = [2]\nvariable_scaling = \"off\"\n",
         )
         .unwrap();
-        assert_eq!((c.problems[0].base.variable_scaling, c.problems[1].base.variable_scaling), (true, false));
+        let modes: Vec<_> = c.problems.iter().map(|p| p.base.variable_scaling).collect();
+        assert_eq!(modes, [VariableScaling::Always, VariableScaling::Off, VariableScaling::Off]);
+        let c = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nvariable_scaling = \"always\"\n");
+        assert_eq!(c.unwrap().problems[0].base.variable_scaling, VariableScaling::Always);
+        let c = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+        assert_eq!(c.problems[0].base.variable_scaling, VariableScaling::Alternate, "the default");
         let e = err("name = \"t\"\n[defaults]\nvariable_scaling = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
         assert!(e.message.contains("variable_scaling") || e.location.line == 3, "{e}");
+        let e = err(
+            "name = \"t\"\n[defaults]\nvariable_scaling = \"sometimes\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n",
+        );
+        assert_eq!(e.location.line, 3, "{e}");
+        assert!(e.message.contains("alternate") && e.message.contains("sometimes"), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
         assert!(e.message.contains("random_scales"), "{e}");

@@ -2,7 +2,7 @@
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--stop-on-stall] [--max-starts N] [--hop-scales 0.01,0.1,1]
 //! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start] [--no-continue-at-maxit]
 //! [--continued-maxit 3000] [--keep-gs-reserve]
-//! [--variable-scaling] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
+//! [--variable-scaling off|alternate|always] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
 //!
@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::design::{
-    run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind,
+    run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, VariableScaling,
     DEFAULT_CONTINUED_MAXIT, DEFAULT_STALL_STARTS,
 };
 use crate::fs_atomic::write_atomic;
@@ -99,11 +99,16 @@ pub struct DesignArgs {
     /// ones: Bk, Ck, Dk = 0 and Ak a stable diagonal).
     #[arg(long)]
     pub no_open_loop_start: bool,
-    /// Search in controller variables scaled by the plant's control and measurement channel
-    /// sizes (powers of two; no change for a plant whose channels are within 2^10 of each other).
-    /// Plants whose channels differ by orders of magnitude (AC10) need it; off by default.
-    #[arg(long)]
-    pub variable_scaling: bool,
+    /// Coordinates of the local searches: "off" (the controller's parameters), "alternate"
+    /// (HIFOO's first starts unscaled; then three hop cycles in four in the coordinates that
+    /// found the best controller so far and one in the others: the parameters, or variables
+    /// scaled by the plant's control and measurement channel sizes) or "always" (scaled only; a
+    /// bare --variable-scaling). No change for a plant whose
+    /// channels are within 2^10 of each other. Plants whose channels differ by orders of
+    /// magnitude (AC10) need the scaled searches, others (BDT2) do better unscaled.
+    #[arg(long, value_name = "MODE", default_value = "alternate", num_args = 0..=1,
+          default_missing_value = "always", value_parser = VariableScaling::parse)]
+    pub variable_scaling: VariableScaling,
     /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
     /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
     /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.

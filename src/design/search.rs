@@ -33,6 +33,22 @@
 //!    [`crate::design::DEFAULT_CONTINUED_MAXIT`]; 0: `maxit`), so that HIFOO's first starts and
 //!    every stabilisation keep HIFOO's `maxit`.
 //!
+//! # Coordinates (docs/ALGORITHMS.md §8.6)
+//! Each local search runs either on the controller's parameters x or, if the plant's channels
+//! are scaled (`design::scaling`), on plant-scaled variables x̃ (x = d ∘ x̃), by
+//! `variable_scaling`: `Off`, x only; `Always`, x̃ only; `Alternate` (the default), HIFOO's first
+//! starts (and the open-loop and central starts) in x, then whole hop cycles (one hop per
+//! `hop_scales` entry and one random start): the 1st, 5th, 9th, … ([`ALTERNATE_PERIOD`] = 4) in
+//! the coordinates the current incumbent was *not* found in, the others in those it was found
+//! in. Both keep being tried, and the one that works on the plant gets three cycles in four
+//! (AC10: x̃; BDT2: x). A cycle's basin hops perturb the best point in its own
+//! coordinates (x̃* + ξ ∘ (‖x̃*‖·r) for a scaled cycle) and its random start σ·ξ is drawn in them.
+//! The incumbents are kept in x whatever coordinates found them (x ↔ x̃ is exact: d holds
+//! powers of two), so each coordinate system hops around the best point either found; resuming a
+//! cut search, gradient-sampling stabilisation and the final gradient sampling use the
+//! coordinates of the local search that produced their point. On a plant that is not scaled
+//! every mode is the unscaled search, bit for bit (no random number is drawn differently).
+//!
 //! # When it stops
 //! Before each new local search (and within one, between evaluations) the run stops on the CPU
 //! budget `cpumax`, the evaluation budget `maxevals`, a cancel request, or when `max_starts`
@@ -71,15 +87,18 @@
 //! run's path — and the returned controller, bit for bit — does not depend on timing, threads or
 //! load. A run ended by `cpumax` depends on the machine's speed.
 
+use std::rc::Rc;
+
 use rand::RngCore;
 
 use crate::lti::is_stable;
 use crate::optim::{bfgs, gradient_sampling, OptimError, OptimResult, RunControl, Termination};
 
 use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
-use super::options::DesignOptions;
+use super::options::{DesignOptions, VariableScaling};
 use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
 use super::phases::{bfgs_options, gradsamp_options, optim_error, perf_bfgs_options};
+use super::scaling::{from_scaled, to_scaled};
 use super::starts::{perturb, scaled_random_start};
 
 /// Share of the CPU and evaluation budgets kept for the final gradient sampling (when enabled).
@@ -88,6 +107,10 @@ pub const GS_RESERVE: f64 = 0.1;
 /// With `return_gs_reserve`: the reserve kept after a gradient sampling on the incumbent is this
 /// many times what it took (CPU seconds and evaluations), at most [`GS_RESERVE`] of the budget.
 pub const GS_RESERVE_FACTOR: f64 = 2.0;
+
+/// `variable_scaling = "alternate"`: one hop cycle in this many runs in the coordinates (x or
+/// x̃) the incumbent was not found in, the others in those it was (module docs).
+pub const ALTERNATE_PERIOD: usize = 4;
 
 /// Relative tolerance of "first reached" for [`SearchSummary::cpu_to_best_s`].
 pub const TIME_TO_BEST_RTOL: f64 = 1e-6;
@@ -107,6 +130,26 @@ pub(crate) struct Best {
     pub start: usize,
     /// The stable point its f_h local search started from (to tell whether it moved).
     pub from: Vec<f64>,
+    /// The coordinates of the local search that produced it.
+    pub coords: Coords,
+}
+
+/// The coordinates of one local search (docs/ALGORITHMS.md §8.6): the controller's parameters x,
+/// or the plant-scaled variables x̃ (x = d ∘ x̃). Points outside a local search (the incumbents)
+/// are always kept in x; x ↔ x̃ is exact (d holds powers of two).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Coords {
+    /// x.
+    Raw,
+    /// x̃.
+    Scaled,
+}
+
+/// The objectives in plant-scaled variables (`DesignObjective::with_scaling(Some(d))`) and d.
+pub(crate) struct ScaledObjectives<'r, 'o> {
+    pub stab_obj: &'r mut DesignObjective<'o>,
+    pub perf_obj: &'r mut DesignObjective<'o>,
+    pub d: Rc<[f64]>,
 }
 
 /// What the search produced.
@@ -182,23 +225,23 @@ impl State<'_> {
     }
 
     /// Records an f_s end point; returns whether it improved the best f_s (stall sense).
-    fn offer_stab(&mut self, x: Vec<f64>, f: f64, start: usize) -> bool {
+    fn offer_stab(&mut self, x: Vec<f64>, f: f64, start: usize, coords: Coords) -> bool {
         let f = if f.is_nan() { f64::INFINITY } else { f };
         let old = self.stab.as_ref().map_or(f64::INFINITY, |b| b.f);
         let better = improves(f, old, self.opts.stall_rtol, 1.0);
         if self.stab.is_none() || f < old {
-            self.stab = Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start });
+            self.stab = Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, coords });
         }
         better
     }
 
     /// Records an f_h end point; returns whether it improved the best f_h (stall sense).
-    fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize) -> bool {
+    fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize, coords: Coords) -> bool {
         let old = self.perf.as_ref().map_or(f64::INFINITY, |b| b.f);
         let better = improves(r.f, old, self.opts.stall_rtol, 0.0);
         if r.f.is_finite() && r.f < old {
-            self.perf =
-                Some(Best { x: r.x.clone(), f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from: from.to_vec() });
+            let (x, from) = (r.x.clone(), from.to_vec());
+            self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from, coords });
             // Cut by `maxit`, or by the search's share of a budget (`return_gs_reserve` may give
             // the search more).
             self.perf_cut =
@@ -208,13 +251,13 @@ impl State<'_> {
     }
 
     /// The start that resumes the incumbent's local search if `maxit` cut it (and
-    /// `continue_at_maxit`): the incumbent itself, once.
-    fn take_continuation(&mut self) -> Option<Vec<f64>> {
+    /// `continue_at_maxit`): the incumbent itself, once, in its local search's coordinates.
+    fn take_continuation(&mut self) -> Option<(Vec<f64>, Coords)> {
         if !(self.opts.continue_at_maxit && self.perf_cut) {
             return None;
         }
         self.perf_cut = false;
-        self.perf.as_ref().map(|b| b.x.clone())
+        self.perf.as_ref().map(|b| (b.x.clone(), b.coords))
     }
 }
 
@@ -243,27 +286,88 @@ pub(crate) struct Search<'r, 'o, 'a> {
     pub rng: &'r mut dyn RngCore,
     /// The whole run's control.
     pub ctl: &'r RunControl,
+    /// The objectives in plant-scaled variables, if the plant is scaled (`design::scaling`) and
+    /// the run's [`VariableScaling`] mode is not off.
+    pub scaled: Option<ScaledObjectives<'r, 'o>>,
+}
+
+/// The objective of `phase` (stabilisation, or performance if `perf`) in coordinates `c`.
+fn pick<'s, 'o>(
+    raw: &'s mut DesignObjective<'o>,
+    scaled: &'s mut Option<ScaledObjectives<'_, 'o>>,
+    perf: bool,
+    c: Coords,
+) -> &'s mut DesignObjective<'o> {
+    match (c, scaled) {
+        (Coords::Scaled, Some(s)) => {
+            if perf {
+                s.perf_obj
+            } else {
+                s.stab_obj
+            }
+        }
+        _ => raw,
+    }
 }
 
 impl Search<'_, '_, '_> {
-    /// One local search from `x0` (module docs). Returns the stop reason if a budget or an
-    /// interrupt ended it, and whether it improved the incumbent (stall sense).
+    /// `x` (controller parameters) in coordinates `c`.
+    fn to_coords(&self, x: &[f64], c: Coords) -> Vec<f64> {
+        match (c, &self.scaled) {
+            (Coords::Scaled, Some(s)) => to_scaled(x, Some(&s.d)),
+            _ => x.to_vec(),
+        }
+    }
+
+    /// The controller parameters of `x` given in coordinates `c`.
+    fn to_raw(&self, x: &[f64], c: Coords) -> Vec<f64> {
+        match (c, &self.scaled) {
+            (Coords::Scaled, Some(s)) => from_scaled(x, Some(&s.d)),
+            _ => x.to_vec(),
+        }
+    }
+
+    /// The coordinates of HIFOO's first starts (`continued` None) or of the hop cycle that begins
+    /// with continued start number `j` (`continued` = (j, hop cycle length, coordinates of the
+    /// incumbent's local search)), module docs: `Alternate` runs one hop cycle in [`ALTERNATE_PERIOD`] (the first one
+    /// included) in the coordinates the incumbent was not found in, the others in those it was.
+    fn coords_of(&self, mode: VariableScaling, continued: Option<(usize, usize, Coords)>) -> Coords {
+        if self.scaled.is_none() {
+            return Coords::Raw;
+        }
+        let other = |c| if c == Coords::Raw { Coords::Scaled } else { Coords::Raw };
+        match (mode, continued) {
+            (VariableScaling::Off, _) => Coords::Raw,
+            (VariableScaling::Always, _) => Coords::Scaled,
+            (VariableScaling::Alternate, None) => Coords::Raw,
+            (VariableScaling::Alternate, Some((j, cycle, inc))) if (j / cycle).is_multiple_of(ALTERNATE_PERIOD) => {
+                other(inc)
+            }
+            (VariableScaling::Alternate, Some((_, _, inc))) => inc,
+        }
+    }
+
+    /// One local search from `x0`, given in coordinates `c` (module docs). Returns the stop
+    /// reason if a budget or an interrupt ended it, and whether it improved the incumbent (stall
+    /// sense).
     fn local(
         &mut self,
         st: &mut State<'_>,
         x0: &[f64],
         k: usize,
+        c: Coords,
         ctl: &RunControl,
     ) -> Result<(Option<SearchStop>, bool), DesignError> {
         let opts = st.opts;
-        self.adapter.switch(self.stab_obj, Phase::Stabilisation);
+        let obj = pick(self.stab_obj, &mut self.scaled, false, c);
+        self.adapter.switch(obj, Phase::Stabilisation);
         self.adapter.set_evals_base(st.evals());
         let c0 = ctl.cpu_elapsed();
-        let (xs, fs) = match bfgs(self.stab_obj, x0, k, &bfgs_options(opts, 0.0), ctl, self.adapter) {
+        let (xs, fs) = match bfgs(obj, x0, k, &bfgs_options(opts, 0.0), ctl, self.adapter) {
             Ok(r) => {
                 st.add(0, &r, c0, ctl.cpu_elapsed());
                 if let Some(stop) = stop_of(r.termination) {
-                    let better = st.offer_stab(r.x, r.f, k);
+                    let better = st.offer_stab(self.to_raw(&r.x, c), r.f, k, c);
                     return Ok((Some(stop), better));
                 }
                 (r.x, r.f)
@@ -274,31 +378,34 @@ impl Search<'_, '_, '_> {
             }
             Err(e) => return Err(optim_error(e)),
         };
-        let stab_better = st.offer_stab(xs.clone(), fs, k);
+        let stab_better = st.offer_stab(self.to_raw(&xs, c), fs, k, c);
         if !is_stable(fs) {
             // Not stabilised: progress only counts while no stable point is known.
             return Ok((None, !st.stabilised && stab_better));
         }
         st.stabilised = true;
-        self.optimise_from(st, &xs, k, ctl)
+        self.optimise_from(st, &xs, k, c, ctl)
     }
 
-    /// BFGS on f_h from the stable point `xs`.
+    /// BFGS on f_h from the stable point `xs`, given in coordinates `c`.
     fn optimise_from(
         &mut self,
         st: &mut State<'_>,
         xs: &[f64],
         k: usize,
+        c: Coords,
         ctl: &RunControl,
     ) -> Result<(Option<SearchStop>, bool), DesignError> {
         let opts = st.opts;
-        self.adapter.switch(self.perf_obj, Phase::Optimisation);
+        let obj = pick(self.perf_obj, &mut self.scaled, true, c);
+        self.adapter.switch(obj, Phase::Optimisation);
         self.adapter.set_evals_base(st.evals());
         let c0 = ctl.cpu_elapsed();
-        match bfgs(self.perf_obj, xs, k, &perf_bfgs_options(opts, st.continued), ctl, self.adapter) {
-            Ok(r) => {
+        match bfgs(obj, xs, k, &perf_bfgs_options(opts, st.continued), ctl, self.adapter) {
+            Ok(mut r) => {
                 st.add(1, &r, c0, ctl.cpu_elapsed());
-                let better = st.offer_perf(&r, xs, k);
+                r.x = self.to_raw(&r.x, c);
+                let better = st.offer_perf(&r, &self.to_raw(xs, c), k, c);
                 Ok((stop_of(r.termination), better))
             }
             // f_h = +∞ at a point with α just below 0 (the norm's stability test has a margin):
@@ -312,7 +419,7 @@ impl Search<'_, '_, '_> {
     }
 
     /// HIFOO's fallback when no first start was stabilised: gradient sampling on f_s from the
-    /// best f_s point, then f_h from its end point if stable.
+    /// best f_s point (in its local search's coordinates), then f_h from its end point if stable.
     fn gs_stabilise(
         &mut self,
         st: &mut State<'_>,
@@ -320,22 +427,24 @@ impl Search<'_, '_, '_> {
         ctl: &RunControl,
     ) -> Result<(Option<SearchStop>, bool), DesignError> {
         let opts = st.opts;
-        let Some(x0) = st.stab.as_ref().filter(|b| b.f.is_finite()).map(|b| b.x.clone()) else {
+        let Some((x0, c)) = st.stab.as_ref().filter(|b| b.f.is_finite()).map(|b| (b.x.clone(), b.coords)) else {
             return Ok((None, false));
         };
-        self.adapter.switch(self.stab_obj, Phase::Stabilisation);
+        let x0 = self.to_coords(&x0, c);
+        let obj = pick(self.stab_obj, &mut self.scaled, false, c);
+        self.adapter.switch(obj, Phase::Stabilisation);
         self.adapter.set_evals_base(st.evals());
         let c0 = ctl.cpu_elapsed();
-        match gradient_sampling(self.stab_obj, &x0, &gradsamp_options(opts, 0.0), self.rng, ctl, self.adapter) {
+        match gradient_sampling(obj, &x0, &gradsamp_options(opts, 0.0), self.rng, ctl, self.adapter) {
             Ok(r) => {
                 st.add(0, &r, c0, ctl.cpu_elapsed());
-                let better = st.offer_stab(r.x.clone(), r.f, k);
+                let better = st.offer_stab(self.to_raw(&r.x, c), r.f, k, c);
                 if let Some(stop) = stop_of(r.termination) {
                     return Ok((Some(stop), better));
                 }
                 if is_stable(r.f) {
                     st.stabilised = true;
-                    return self.optimise_from(st, &r.x, k, ctl);
+                    return self.optimise_from(st, &r.x, k, c, ctl);
                 }
                 Ok((None, better))
             }
@@ -347,14 +456,18 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// The start of continued local search number `j` (0-based after the first starts).
+    /// The start of continued local search number `j` (0-based after the first starts), in
+    /// coordinates `c` (hops of the best point and random starts are drawn in them).
     /// The c-th fresh random start (c counts them) is at scale `random_scales[c mod len]`.
-    fn next_start(&mut self, st: &State<'_>, j: usize, nvar: usize) -> (Vec<f64>, StartKind) {
+    fn next_start(&mut self, st: &State<'_>, j: usize, nvar: usize, c: Coords) -> (Vec<f64>, StartKind) {
         let scales = &st.opts.hop_scales;
         let centre = st.perf.as_ref().or(st.stab.as_ref()).filter(|b| b.x.iter().all(|v| v.is_finite()));
         let cycle = scales.len() + 1;
         match (j % cycle, centre) {
-            (i, Some(c)) if i < scales.len() => (perturb(&c.x, scales[i], self.rng), StartKind::Hop),
+            (i, Some(b)) if i < scales.len() => {
+                let centre = self.to_coords(&b.x, c);
+                (perturb(&centre, scales[i], self.rng), StartKind::Hop)
+            }
             _ => {
                 let sigmas = &st.opts.random_scales;
                 let sigma = sigmas[(j / cycle) % sigmas.len()];
@@ -372,13 +485,18 @@ impl Search<'_, '_, '_> {
         if !(best.dnorm > opts.normtol && ctl_stop(ctl).is_none()) {
             return Ok(false);
         }
-        self.adapter.switch(self.perf_obj, Phase::Optimisation);
+        // In the coordinates of the local search that found the best point.
+        let c = best.coords;
+        let x0 = self.to_coords(&best.x, c);
+        let obj = pick(self.perf_obj, &mut self.scaled, true, c);
+        self.adapter.switch(obj, Phase::Optimisation);
         self.adapter.set_evals_base(st.evals());
         let c0 = ctl.cpu_elapsed();
         let gopts = gradsamp_options(opts, f64::NEG_INFINITY);
-        match gradient_sampling(self.perf_obj, &best.x, &gopts, self.rng, ctl, self.adapter) {
-            Ok(r) => {
+        match gradient_sampling(obj, &x0, &gopts, self.rng, ctl, self.adapter) {
+            Ok(mut r) => {
                 st.add(2, &r, c0, ctl.cpu_elapsed());
+                r.x = self.to_raw(&r.x, c);
                 let b = st.perf.as_mut().expect("checked above");
                 if r.f < b.f {
                     b.x = r.x;
@@ -454,6 +572,8 @@ impl Search<'_, '_, '_> {
         let mut cycle = 0usize; // continued starts drawn from the hop / random cycle
         let mut gs_fallback_done = false;
         let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
+        let mut coords: Vec<Coords> = Vec::new(); // its coordinates
+        let mut cycle_coords = Coords::Raw; // coordinates of the current hop cycle
         let mut stop = None;
         let full_ctl = self.ctl;
         let returning = opts.return_gs_reserve && opts.gradient_sampling;
@@ -493,10 +613,14 @@ impl Search<'_, '_, '_> {
             }
             let (s, better) = if k < first.len() {
                 kinds.push(first_kinds.get(k).copied().unwrap_or(StartKind::Random));
-                self.local(&mut st, &first[k], k, search_ctl)?
+                let c = self.coords_of(opts.variable_scaling, None);
+                coords.push(c);
+                let x0 = self.to_coords(&first[k], c);
+                self.local(&mut st, &x0, k, c, search_ctl)?
             } else if !st.stabilised && opts.gradient_sampling && !gs_fallback_done {
                 gs_fallback_done = true;
                 kinds.push(StartKind::GradientSampling);
+                coords.push(st.stab.as_ref().map_or(Coords::Raw, |b| b.coords));
                 self.gs_stabilise(&mut st, k, search_ctl)?
             } else {
                 if opts.stall_starts == 0 {
@@ -512,16 +636,25 @@ impl Search<'_, '_, '_> {
                     stop = Some(SearchStop::Stall);
                     break;
                 }
-                let (x0, kind) = match st.take_continuation() {
-                    Some(x) => (x, StartKind::Hop),
+                let (x0, kind, c) = match st.take_continuation() {
+                    Some((x, c)) => (self.to_coords(&x, c), StartKind::Hop, c),
                     None => {
                         cycle += 1;
-                        self.next_start(&st, cycle - 1, nvar)
+                        // A hop cycle's coordinates are chosen at its first start.
+                        let len = opts.hop_scales.len() + 1;
+                        if (cycle - 1).is_multiple_of(len) {
+                            let inc = st.perf.as_ref().or(st.stab.as_ref()).map_or(Coords::Raw, |b| b.coords);
+                            cycle_coords = self.coords_of(opts.variable_scaling, Some((cycle - 1, len, inc)));
+                        }
+                        let c = cycle_coords;
+                        let (x0, kind) = self.next_start(&st, cycle - 1, nvar, c);
+                        (x0, kind, c)
                     }
                 };
                 kinds.push(kind);
                 st.continued = true;
-                self.local(&mut st, &x0, k, search_ctl)?
+                coords.push(c);
+                self.local(&mut st, &x0, k, c, search_ctl)?
             };
             k += 1;
             st.stall = if better { 0 } else { st.stall + 1 };
@@ -557,6 +690,7 @@ impl Search<'_, '_, '_> {
             evaldist: f64::NAN,
             start: 0,
             from: first[0].clone(),
+            coords: Coords::Raw,
         });
         let best_start = st.perf.as_ref().map_or(stab.start, |b| b.start);
         let (phase, f) = match &st.perf {
@@ -568,6 +702,7 @@ impl Search<'_, '_, '_> {
             starts: k,
             best_start,
             best_start_kind: kinds.get(best_start).copied(),
+            best_start_scaled: coords.get(best_start) == Some(&Coords::Scaled),
             cpu_to_best_s: reached.map_or(0.0, |r| r.cpu_s),
             evals_to_best: reached.map_or(0, |r| r.evals),
             stop,
