@@ -2,10 +2,10 @@
 //! search on random plants (NOT CI; long: up to ~80 CPU minutes with every part).
 //!
 //! ```text
-//! cargo bench --bench search -- [--parts paper,singles,random] [--threads 2] [--cpumax 60]
+//! cargo bench --bench search -- [--parts paper,singles,random,spread] [--threads 2] [--cpumax 60]
 //!                               [--eps 1e-2,1e-3] [--seed 1] [--plants HE1,REA2,AC8,Enns]
 //!                               [--orders 1,2,...] [--single-cpumax 300] [--random 12]
-//!                               [--random-cpumax 20]
+//!                               [--random-cpumax 20] [--spread 1e4]
 //! ```
 //!
 //! * `paper`: one job per (plant, order of the paper's tables, ε), seed 1, `--cpumax` CPU s each,
@@ -21,10 +21,18 @@
 //!   (target 1.1682), AC10 n_K = 1 (stabilised, ≤ 10.874), BDT2 n_K = 1 (≤ 0.6436).
 //! * `random`: `--random` random open-loop-unstable plants (n = 4…20, seeded), n_K = 1 and 2,
 //!   ε = 1e-3, seed 1, each with `--random-cpumax` CPU s: HIFOO's search (`stall_starts = 0`,
-//!   "old"), the continued search ended by the stall rule and without resuming cut local searches
-//!   (`spend_budget = false`, `continue_at_maxit = false`, "prev": the default before those two),
-//!   and the default search ("new"). Counts the stabilised problems of each, and the entries where
-//!   new is at or below old / prev, better by more than 1 %, worse by more than 1 %.
+//!   "old"), the search with the whole gradient-sampling reserve kept to the end and HIFOO's
+//!   `maxit` for every local search (`return_gs_reserve = false`, `continued_maxit = 0`, "prev":
+//!   the default before those two), and the default search ("new"). Counts the stabilised
+//!   problems of each, and the entries where new is at or below old / prev, better by more than
+//!   1 %, worse by more than 1 %.
+//! * `spread` (not in the default parts): `--random` random plants as in `random` but with two
+//!   controls and two measurements whose channels are `--spread` apart (the second control's
+//!   B2 column and D12 column divided by it, the second measurement's C2 row and D21 row
+//!   multiplied by it: the same design problem, same achievable γ, in badly scaled units, as
+//!   AC10 and BDT2 are), n_K = 1 and 2, ε = 1e-3, seed 1, `--random-cpumax` CPU s each: the
+//!   unscaled search (`variable_scaling = off`) against the default (alternate unscaled and
+//!   plant-scaled hop cycles, docs/ALGORITHMS.md §8.6).
 //!
 //! Jobs run on `--threads` worker threads; budgets are thread CPU time, so a busy machine slows
 //! the wall clock, not the result.
@@ -34,7 +42,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
-use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver};
+use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, VariableScaling};
 use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -51,6 +59,7 @@ struct Args {
     single_cpumax: f64,
     random: usize,
     random_cpumax: f64,
+    spread: f64,
 }
 
 fn parse_args() -> Args {
@@ -65,6 +74,7 @@ fn parse_args() -> Args {
         single_cpumax: 300.0,
         random: 12,
         random_cpumax: 20.0,
+        spread: 1e4,
     };
     let args: Vec<String> = std::env::args().skip(1).collect();
     let list = |s: &str| s.split(',').filter(|x| !x.is_empty()).map(String::from).collect::<Vec<_>>();
@@ -86,6 +96,7 @@ fn parse_args() -> Args {
             "--single-cpumax" => a.single_cpumax = val.parse().expect("--single-cpumax S"),
             "--random" => a.random = val.parse().expect("--random N"),
             "--random-cpumax" => a.random_cpumax = val.parse().expect("--random-cpumax S"),
+            "--spread" => a.spread = val.parse().expect("--spread S"),
             other => panic!("unknown argument {other}"),
         }
         i += 2;
@@ -251,12 +262,16 @@ fn singles(a: &Args) {
     }
 }
 
-/// A seeded random plant with n states and at least one unstable open-loop eigenvalue.
-fn random_plant(seed: u64) -> Plant {
+/// A seeded random plant with n states and at least one unstable open-loop eigenvalue. With
+/// `spread`, two controls and two measurements, the second of each scaled by it (`spread` part).
+fn random_plant(seed: u64, spread: Option<f64>) -> Plant {
     let mut rng = ChaCha8Rng::seed_from_u64(1000 + seed);
     let n = 4 + (seed as usize * 7) % 17; // 4..=20
-    let (m1, p1, m2, p2) =
+    let (m1, p1, mut m2, mut p2) =
         (1 + seed as usize % 2, 1 + (seed as usize / 2) % 2, 1 + (seed as usize / 3) % 2, 1 + (seed as usize / 5) % 2);
+    if spread.is_some() {
+        (m2, p2) = (2, 2);
+    }
     let mut randn = |r: usize, c: usize, s: f64| -> Vec<Vec<f64>> {
         (0..r)
             .map(|_| {
@@ -275,12 +290,20 @@ fn random_plant(seed: u64) -> Plant {
         for (i, row) in a.iter_mut().enumerate() {
             row[i] -= 0.6;
         }
+        // Drawn in the order of the plant's fields (the `random` part's plants predate `spread`).
+        let (b1, mut b2, c1, mut c2) = (randn(n, m1, 1.0), randn(n, m2, 1.0), randn(p1, n, 1.0), randn(p2, n, 1.0));
+        let (d11, mut d12, mut d21) = (randn(p1, m1, 0.0), randn(p1, m2, 0.3), randn(p2, m1, 0.3));
+        if let Some(s) = spread {
+            // u₂ in units 1/s as large, y₂ in units s times as large.
+            b2.iter_mut().chain(d12.iter_mut()).for_each(|row| row[1] /= s);
+            c2[1].iter_mut().chain(d21[1].iter_mut()).for_each(|v| *v *= s);
+        }
         let doc = serde_json::json!({
             "name": format!("rand{seed}"),
             "dims": {"n": n, "m1": m1, "m2": m2, "p1": p1, "p2": p2},
-            "A": a, "B1": randn(n, m1, 1.0), "B2": randn(n, m2, 1.0),
-            "C1": randn(p1, n, 1.0), "C2": randn(p2, n, 1.0),
-            "D11": randn(p1, m1, 0.0), "D12": randn(p1, m2, 0.3), "D21": randn(p2, m1, 0.3), "D22": randn(p2, m2, 0.0),
+            "A": a, "B1": b1, "B2": b2,
+            "C1": c1, "C2": c2,
+            "D11": d11, "D12": d12, "D21": d21, "D22": randn(p2, m2, 0.0),
         });
         let p = Plant::from_json_str(&doc.to_string(), format!("<random plant {seed}>")).expect("valid random plant");
         if spectral_abscissa(p.a.as_ref()) > 0.0 {
@@ -292,7 +315,7 @@ fn random_plant(seed: u64) -> Plant {
 fn random(a: &Args) {
     let mut jobs = Vec::new();
     for s in 0..a.random as u64 {
-        let p = std::sync::Arc::new(random_plant(s));
+        let p = std::sync::Arc::new(random_plant(s, None));
         for order in [1usize, 2] {
             let base = DesignOptions { order, eps: 1e-3, seed: 1, cpumax: a.random_cpumax, ..Default::default() };
             let tag = format!("rand{s} n={} nk={order}", p.dims.n);
@@ -304,14 +327,14 @@ fn random(a: &Args) {
             jobs.push(Job {
                 tag: format!("{tag} prev"),
                 plant: p.clone(),
-                opts: DesignOptions { spend_budget: false, continue_at_maxit: false, ..base.clone() },
+                opts: DesignOptions { return_gs_reserve: false, continued_maxit: 0, ..base.clone() },
             });
             jobs.push(Job { tag: format!("{tag} new"), plant: p.clone(), opts: base });
         }
     }
     println!(
-        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old), the continued search \
-         ended by the stall rule (prev, spend_budget = continue_at_maxit = false), the default (new)",
+        "# random: {} plants, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: HIFOO's search (old), the search before \
+         return_gs_reserve and continued_maxit (prev: both off), the default (new)",
         a.random, a.random_cpumax
     );
     let done = run_all(jobs, a.threads);
@@ -368,6 +391,60 @@ fn random(a: &Args) {
     );
 }
 
+/// Random plants with badly scaled channels (`--spread`): the unscaled search against the default.
+fn spread(a: &Args) {
+    let mut jobs = Vec::new();
+    for s in 0..a.random as u64 {
+        let p = std::sync::Arc::new(random_plant(s, Some(a.spread)));
+        for order in [1usize, 2] {
+            let base = DesignOptions { order, eps: 1e-3, seed: 1, cpumax: a.random_cpumax, ..Default::default() };
+            let tag = format!("rand{s} n={} nk={order}", p.dims.n);
+            let off = DesignOptions { variable_scaling: VariableScaling::Off, ..base.clone() };
+            jobs.push(Job { tag: format!("{tag} off"), plant: p.clone(), opts: off });
+            jobs.push(Job { tag: format!("{tag} new"), plant: p.clone(), opts: base });
+        }
+    }
+    println!(
+        "# spread: {} random plants, channels {:e} apart, n_K = 1, 2, ε = 1e-3, seed 1, {} CPU s: the unscaled \
+         search (off) against the default (new: {})",
+        a.random,
+        a.spread,
+        a.random_cpumax,
+        DesignOptions::default().variable_scaling.name()
+    );
+    let done = run_all(jobs, a.threads);
+    println!("{:<22} {:>12} {:>12} {:>9} {:>8} {:>8}", "problem", "off γ", "new γ", "new/off", "off cpu", "new cpu");
+    let (mut entries, mut t, mut stabilised) = (0, [0usize; 3], [0usize; 2]);
+    for pair in done.chunks(2) {
+        let [(jo, oo), (jn, on)] = pair else { continue };
+        let g = [verified_gamma(&jo.plant, oo), verified_gamma(&jn.plant, on)];
+        for (s, gi) in stabilised.iter_mut().zip(&g) {
+            *s += gi.is_some() as usize;
+        }
+        let tag = jo.tag.trim_end_matches(" off");
+        if g.iter().all(Option::is_none) {
+            println!("{tag:<22} {:>12} {:>12}", "unstable", "unstable");
+            continue;
+        }
+        entries += 1;
+        let [go, gn] = g.map(|x| x.unwrap_or(f64::INFINITY));
+        t[0] += (gn <= go) as usize;
+        t[1] += (gn < go / 1.01) as usize;
+        t[2] += (gn > go * 1.01) as usize;
+        println!("{tag:<22} {go:>12.5} {gn:>12.5} {:>9.4} {:>8.1} {:>8.1}", gn / go, oo.design_cpu_s, on.design_cpu_s);
+    }
+    println!(
+        "# spread: {} problems; stabilised by off {}, new {}; of the {entries} stabilised by either: new ≤ off on {}, \
+         better by > 1 % on {}, worse by > 1 % on {}",
+        done.len() / 2,
+        stabilised[0],
+        stabilised[1],
+        t[0],
+        t[1],
+        t[2]
+    );
+}
+
 fn main() {
     let a = parse_args();
     for part in &a.parts {
@@ -375,7 +452,8 @@ fn main() {
             "paper" => paper(&a),
             "singles" => singles(&a),
             "random" => random(&a),
-            other => panic!("unknown part {other} (paper, singles, random)"),
+            "spread" => spread(&a),
+            other => panic!("unknown part {other} (paper, singles, random, spread)"),
         }
     }
 }

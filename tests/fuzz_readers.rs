@@ -74,6 +74,7 @@ fn record_line() -> &'static str {
                 starts: 3,
                 best_start: 1,
                 best_start_kind: Some(hinfix::design::StartKind::Central),
+                best_start_scaled: false,
                 cpu_to_best_s: 0.25,
                 evals_to_best: 12,
                 stop: hinfix::design::SearchStop::Stall,

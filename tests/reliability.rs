@@ -83,6 +83,7 @@ fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
             starts: 1,
             best_start: 0,
             best_start_kind: None,
+            best_start_scaled: false,
             cpu_to_best_s: x,
             evals_to_best: 1,
             stop: hinfix::design::SearchStop::Stall,
@@ -561,8 +562,10 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
             cpumax: 20.0,
             maxit,
             spend_budget: false,
-            // maxit bounds each local search only if cut searches are not resumed.
+            // maxit bounds each local search only if cut searches are not resumed, and if the
+            // continued search's local searches have the same limit.
             continue_at_maxit: false,
+            continued_maxit: 0,
             gradient_sampling: false,
             ..Default::default()
         };

@@ -127,6 +127,7 @@ impl JobRunner for FakeRunner {
                 starts: 1,
                 best_start: 0,
                 best_start_kind: None,
+                best_start_scaled: false,
                 cpu_to_best_s: 0.0,
                 evals_to_best: iters,
                 stop: SearchStop::Starts,

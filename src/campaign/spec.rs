@@ -20,7 +20,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
-use crate::design::{DesignOptions, ObjectiveKind};
+use crate::design::{DesignOptions, ObjectiveKind, VariableScaling};
 use crate::lti::Plant;
 
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
@@ -85,9 +85,11 @@ macro_rules! with_design_settings {
             central_gammas: Option<Spanned<Vec<f64>>>,
             random_scales: Option<Spanned<Vec<f64>>>,
             open_loop_start: Option<bool>,
-            variable_scaling: Option<bool>,
+            variable_scaling: Option<VariableScaling>,
             spend_budget: Option<bool>,
             continue_at_maxit: Option<bool>,
+            continued_maxit: Option<Spanned<usize>>,
+            return_gs_reserve: Option<bool>,
             $($tail)*
         }
     };
@@ -399,9 +401,11 @@ struct Layered {
     central_gammas: Setting<Vec<f64>>,
     random_scales: Setting<Vec<f64>>,
     open_loop_start: Option<bool>,
-    variable_scaling: Option<bool>,
+    variable_scaling: Option<VariableScaling>,
     spend_budget: Option<bool>,
     continue_at_maxit: Option<bool>,
+    continued_maxit: Setting<usize>,
+    return_gs_reserve: Option<bool>,
 }
 
 impl Layered {
@@ -428,6 +432,8 @@ impl Layered {
             variable_scaling: p.variable_scaling.or(d.variable_scaling),
             spend_budget: p.spend_budget.or(d.spend_budget),
             continue_at_maxit: p.continue_at_maxit.or(d.continue_at_maxit),
+            continued_maxit: layer(&p.continued_maxit, &d.continued_maxit),
+            return_gs_reserve: p.return_gs_reserve.or(d.return_gs_reserve),
         }
     }
 
@@ -444,6 +450,7 @@ impl Layered {
         o.stall_rtol = value(&self.stall_rtol, o.stall_rtol);
         o.nrand = count(&self.nrand, o.nrand);
         o.maxit = count(&self.maxit, o.maxit);
+        o.continued_maxit = count(&self.continued_maxit, o.continued_maxit);
         o.stall_starts = count(&self.stall_starts, o.stall_starts);
         if let Some((x, _)) = &self.maxevals {
             o.maxevals = Some(*x);
@@ -472,6 +479,9 @@ impl Layered {
         if let Some(b) = self.continue_at_maxit {
             o.continue_at_maxit = b;
         }
+        if let Some(b) = self.return_gs_reserve {
+            o.return_gs_reserve = b;
+        }
         if let Some(k) = self.objective {
             o.objective = k;
         }
@@ -495,6 +505,7 @@ impl Layered {
             "stall_rtol" => span(&self.stall_rtol),
             "nrand" => span(&self.nrand),
             "maxit" => span(&self.maxit),
+            "continued_maxit" => span(&self.continued_maxit),
             "maxevals" => span(&self.maxevals),
             "max_starts" => span(&self.max_starts),
             "stall_starts" => span(&self.stall_starts),
@@ -724,14 +735,26 @@ objective = "plain"
             (vec![1.0, 1e-3], false)
         );
         assert_eq!((c.problems[1].base.random_scales.clone(), c.problems[1].base.open_loop_start), (vec![0.5], true));
+        // The booleans of older builds (false: off, true: always) and the mode names.
         let c = parse(
             "name = \"t\"\n[defaults]\nvariable_scaling = true\n[[problem]]\nplant = \"HE1\"\norders = [1]\n\
-             [[problem]]\nplant = \"REA2\"\norders = [1]\nvariable_scaling = false\n",
+             [[problem]]\nplant = \"REA2\"\norders = [1]\nvariable_scaling = false\n\
+             [[problem]]\nplant = \"REA2\"\norders = [2]\nvariable_scaling = \"off\"\n",
         )
         .unwrap();
-        assert_eq!((c.problems[0].base.variable_scaling, c.problems[1].base.variable_scaling), (true, false));
+        let modes: Vec<_> = c.problems.iter().map(|p| p.base.variable_scaling).collect();
+        assert_eq!(modes, [VariableScaling::Always, VariableScaling::Off, VariableScaling::Off]);
+        let c = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nvariable_scaling = \"always\"\n");
+        assert_eq!(c.unwrap().problems[0].base.variable_scaling, VariableScaling::Always);
+        let c = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+        assert_eq!(c.problems[0].base.variable_scaling, VariableScaling::Alternate, "the default");
         let e = err("name = \"t\"\n[defaults]\nvariable_scaling = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
         assert!(e.message.contains("variable_scaling") || e.location.line == 3, "{e}");
+        let e = err(
+            "name = \"t\"\n[defaults]\nvariable_scaling = \"sometimes\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n",
+        );
+        assert_eq!(e.location.line, 3, "{e}");
+        assert!(e.message.contains("alternate") && e.message.contains("sometimes"), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
         assert!(e.message.contains("random_scales"), "{e}");
@@ -753,6 +776,30 @@ objective = "plain"
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nspend_budget = 1\n");
         assert_eq!(e.location.line, 5, "{e}");
         assert!(e.message.contains("bool"), "{e}");
+    }
+
+    #[test]
+    fn reserve_and_continued_maxit_keys_layer_and_bad_values_are_located() {
+        let c = parse(
+            "name = \"t\"\n[defaults]\ncontinued_maxit = 500\nreturn_gs_reserve = false\n[[problem]]\nplant = \"HE1\"\n\
+             orders = [1]\n[[problem]]\nplant = \"REA2\"\norders = [1]\ncontinued_maxit = 0\nreturn_gs_reserve = true\n",
+        )
+        .unwrap();
+        let got: Vec<(usize, bool)> =
+            c.problems.iter().map(|p| (p.base.continued_maxit, p.base.return_gs_reserve)).collect();
+        assert_eq!(got, [(500, false), (0, true)]);
+        let d = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+        assert_eq!(
+            (d.problems[0].base.continued_maxit, d.problems[0].base.return_gs_reserve),
+            (DesignOptions::default().continued_maxit, true)
+        );
+        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nreturn_gs_reserve = \"yes\"\n");
+        assert_eq!(e.location.line, 5, "{e}");
+        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_maxit = -3\n");
+        assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
+        let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_maxit = 1000000000\n");
+        assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
+        assert!(e.message.contains("continued_maxit"), "{e}");
     }
 
     #[test]

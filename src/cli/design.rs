@@ -1,7 +1,8 @@
 //! `campaign design --plant NAME|PATH --order K [--eps 1e-3] [--seed 7] [--cpumax 60] [--nrand 3]
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--stop-on-stall] [--max-starts N] [--hop-scales 0.01,0.1,1]
 //! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start] [--no-continue-at-maxit]
-//! [--variable-scaling] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
+//! [--continued-maxit 3000] [--keep-gs-reserve]
+//! [--variable-scaling off|alternate|always] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
 //!
@@ -15,7 +16,8 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::design::{
-    run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, DEFAULT_STALL_STARTS,
+    run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, VariableScaling,
+    DEFAULT_CONTINUED_MAXIT, DEFAULT_STALL_STARTS,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
@@ -70,6 +72,17 @@ pub struct DesignArgs {
     /// (by default the next continued start is that point itself, with a fresh BFGS).
     #[arg(long)]
     pub no_continue_at_maxit: bool,
+    /// BFGS iteration limit of the continued search's local searches on the H∞ objective
+    /// (HIFOO's first starts keep its 1000); 0: the same 1000. Only local searches on many
+    /// variables reach it.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_CONTINUED_MAXIT, allow_negative_numbers = true)]
+    pub continued_maxit: usize,
+    /// Keep the whole gradient-sampling reserve (10 % of the budget) to the end. By default
+    /// gradient sampling runs on the best controller right after the --nrand first starts (as
+    /// HIFOO's search does) and the search keeps only twice what that took; gradient sampling
+    /// runs again at the end if the best controller changed.
+    #[arg(long)]
+    pub keep_gs_reserve: bool,
     /// Largest number of local searches (first starts included; deterministic).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub max_starts: Option<u64>,
@@ -86,11 +99,16 @@ pub struct DesignArgs {
     /// ones: Bk, Ck, Dk = 0 and Ak a stable diagonal).
     #[arg(long)]
     pub no_open_loop_start: bool,
-    /// Search in controller variables scaled by the plant's control and measurement channel
-    /// sizes (powers of two; no change for a plant whose channels are within 2^10 of each other).
-    /// Plants whose channels differ by orders of magnitude (AC10) need it; off by default.
-    #[arg(long)]
-    pub variable_scaling: bool,
+    /// Coordinates of the local searches: "off" (the controller's parameters), "alternate"
+    /// (HIFOO's first starts unscaled; then three hop cycles in four in the coordinates that
+    /// found the best controller so far and one in the others: the parameters, or variables
+    /// scaled by the plant's control and measurement channel sizes) or "always" (scaled only; a
+    /// bare --variable-scaling). No change for a plant whose
+    /// channels are within 2^10 of each other. Plants whose channels differ by orders of
+    /// magnitude (AC10) need the scaled searches, others (BDT2) do better unscaled.
+    #[arg(long, value_name = "MODE", default_value = "alternate", num_args = 0..=1,
+          default_missing_value = "always", value_parser = VariableScaling::parse)]
+    pub variable_scaling: VariableScaling,
     /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
     /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
     /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.
@@ -129,6 +147,8 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         stall_rtol: a.stall_rtol,
         spend_budget: !a.stop_on_stall,
         continue_at_maxit: !a.no_continue_at_maxit,
+        continued_maxit: a.continued_maxit,
+        return_gs_reserve: !a.keep_gs_reserve,
         max_starts: a.max_starts.map(|n| n as usize),
         hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
         central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,

@@ -32,8 +32,8 @@ pub use objective::{
     MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
 };
 pub use options::{
-    DesignOptions, ObjectiveKind, DEFAULT_CENTRAL_GAMMAS, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES,
-    DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
+    DesignOptions, ObjectiveKind, VariableScaling, DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES,
+    DEFAULT_RANDOM_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
     Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError,
@@ -42,4 +42,4 @@ pub use outcome::{
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use run::{run, run_with_control, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
-pub use search::{GS_RESERVE, TIME_TO_BEST_RTOL};
+pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};

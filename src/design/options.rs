@@ -45,6 +45,88 @@ fn is_false(b: &bool) -> bool {
     !*b
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// Default of [`DesignOptions::continued_maxit`].
+pub const DEFAULT_CONTINUED_MAXIT: usize = 3000;
+
+/// Which coordinates the local searches of a run use (docs/ALGORITHMS.md §8.6): the controller's
+/// parameters x, or the plant-scaled variables x̃ with x = d ∘ x̃ (`design::scaling`). A plant
+/// whose channels are alike has d = 1: every mode is then the unscaled search, bit for bit.
+///
+/// Serialised as `"alternate"`, `true` (always) and, when off, not at all: builds before the mode
+/// had the boolean `variable_scaling` (false: off, true: always), so their records and campaign
+/// files read unchanged and keep their job ids. A campaign file or record may give either form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum VariableScaling {
+    /// Every local search in x (HIFOO's search). The value of a record without the field.
+    #[default]
+    Off,
+    /// Both: HIFOO's first starts in x, then the continued search's hop cycles (the hops and
+    /// random start of a cycle drawn in its coordinates) in the coordinates that found the
+    /// incumbent, except one in [`crate::design::ALTERNATE_PERIOD`] = 4 (the first included) in the
+    /// others. The default of [`DesignOptions`].
+    Alternate,
+    /// Every local search in x̃ (the boolean `true` of older builds).
+    Always,
+}
+
+impl VariableScaling {
+    /// The name used in campaign files, `--variable-scaling` and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            VariableScaling::Off => "off",
+            VariableScaling::Alternate => "alternate",
+            VariableScaling::Always => "always",
+        }
+    }
+
+    /// Reads a name ("off", "alternate", "always"; also "false" / "true").
+    pub fn parse(s: &str) -> Result<Self, String> {
+        match s {
+            "off" | "false" => Ok(VariableScaling::Off),
+            "alternate" => Ok(VariableScaling::Alternate),
+            "always" | "true" => Ok(VariableScaling::Always),
+            other => Err(format!("expected \"off\", \"alternate\" or \"always\" (or a boolean), found {other:?}")),
+        }
+    }
+
+    fn is_off(&self) -> bool {
+        *self == VariableScaling::Off
+    }
+}
+
+impl Serialize for VariableScaling {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            VariableScaling::Off => s.serialize_bool(false),
+            VariableScaling::Always => s.serialize_bool(true),
+            VariableScaling::Alternate => s.serialize_str(self.name()),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for VariableScaling {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = VariableScaling;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"off\", \"alternate\", \"always\" or a boolean (false: off, true: always)")
+            }
+            fn visit_bool<E: serde::de::Error>(self, b: bool) -> Result<VariableScaling, E> {
+                Ok(if b { VariableScaling::Always } else { VariableScaling::Off })
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<VariableScaling, E> {
+                VariableScaling::parse(s).map_err(E::custom)
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
 /// Default of [`DesignOptions::central_gammas`].
 pub const DEFAULT_CENTRAL_GAMMAS: [f64; 2] = [1.1, 2.0];
 
@@ -98,6 +180,23 @@ pub struct DesignOptions {
     /// behaviour before this option existed; not written when false.)
     #[serde(default, skip_serializing_if = "is_false")]
     pub continue_at_maxit: bool,
+    /// BFGS iteration limit of the continued search's f_h local searches (HIFOO's first starts
+    /// and every stabilisation keep `maxit`); 0: `maxit`. Local searches on many variables are
+    /// cut by HIFOO's 1000 iterations (Enns n_K = 8, 81 variables); on small plants they end at
+    /// a minimiser long before either limit, so the option changes nothing there. (Missing in a
+    /// serialised record: 0, the behaviour before this option existed; not written when 0.)
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub continued_maxit: usize,
+    /// Give the unused part of the gradient-sampling reserve back to the search: gradient
+    /// sampling runs on the incumbent where HIFOO's search runs it (after the `nrand` first
+    /// starts; the incumbent is then HIFOO's result) and whenever the search's share of a budget
+    /// is spent; the reserve becomes twice what it took (at most the first 10 %), and gradient
+    /// sampling runs again at the end only if the incumbent changed. false: 10 % of each budget
+    /// is kept, and gradient sampling runs once, at the end.
+    /// (Missing in a serialised record: false, the behaviour before this option existed; not
+    /// written when false.)
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub return_gs_reserve: bool,
     /// Largest number of local searches (first starts included); `None`: no limit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_starts: Option<usize>,
@@ -123,14 +222,19 @@ pub struct DesignOptions {
     /// serialised record: false; not written when false.)
     #[serde(default, skip_serializing_if = "is_false")]
     pub open_loop_start: bool,
-    /// Search in plant-scaled controller variables x = d ∘ x̃ (`design::scaling`: the control
-    /// and measurement channels scaled to comparable sizes, powers of two; a plant whose channels
-    /// are alike gets d = 1 and an unchanged search). The first `nrand` starts (and an initial
-    /// controller) are the same controllers either way. Default false: it brings AC10 n_K = 1 from
-    /// γ ≈ 17 to 10.9 but made BDT2 n_K = 1 worse (0.90 against 0.60 at 300 CPU s).
-    /// (Missing in a serialised record: false; not written when false.)
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub variable_scaling: bool,
+    /// Coordinates of the local searches ([`VariableScaling`]): `Off`, x only; `Alternate` (the
+    /// default), HIFOO's first starts in x, then the continued search's hop cycles in the
+    /// coordinates that found the incumbent, except one in four (the first included) in the
+    /// others — x or the plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`: the control
+    /// and measurement channels scaled to comparable sizes, powers of two); `Always`, x̃ only. A
+    /// plant whose channels are alike (within 2¹⁰: HE1, REA2, AC8, Enns, every SISO plant) gets
+    /// d = 1, and every mode is the unscaled search bit for bit. AC10 n_K = 1 needs x̃ (γ ≈ 17.6
+    /// unscaled, 10.05 always scaled at 300 CPU s), BDT2 n_K = 1 does better in x (0.581 against
+    /// 0.897); the incumbent is kept in x, so alternating keeps what each finds (AC10 10.46,
+    /// BDT2 0.5815 with `Alternate`). (Missing in a
+    /// serialised record: off. The booleans of older builds read as off / always.)
+    #[serde(default, skip_serializing_if = "VariableScaling::is_off")]
+    pub variable_scaling: VariableScaling,
     /// Levels γ = f·γ_opt (factors f > 1 of the full-order optimum) of the reduced-order
     /// central-controller starts: for each f, the full-order H∞ central controller at that level,
     /// reduced to `order` by balanced truncation, is one more first start, made after the `nrand`
@@ -172,11 +276,13 @@ impl Default for DesignOptions {
             stall_rtol: 1e-6,
             spend_budget: true,
             continue_at_maxit: true,
+            continued_maxit: DEFAULT_CONTINUED_MAXIT,
+            return_gs_reserve: true,
             max_starts: None,
             hop_scales: DEFAULT_HOP_SCALES.to_vec(),
             random_scales: DEFAULT_RANDOM_SCALES.to_vec(),
             open_loop_start: true,
-            variable_scaling: false,
+            variable_scaling: VariableScaling::Alternate,
             central_gammas: DEFAULT_CENTRAL_GAMMAS.to_vec(),
             objective: ObjectiveKind::Strong,
             hinf_tol: crate::lti::DEFAULT_HINF_TOL,
@@ -208,6 +314,8 @@ mod tests {
             format!("stall_rtol {:e},", d.stall_rtol),
             format!("spend_budget {},", d.spend_budget),
             format!("continue_at_maxit {},", d.continue_at_maxit),
+            format!("continued_maxit {},", d.continued_maxit),
+            format!("return_gs_reserve {},", d.return_gs_reserve),
             format!("maxit {},", d.maxit),
             format!("normtol {:e},", d.normtol),
             format!("evaldist {:e},", d.evaldist),

@@ -153,6 +153,10 @@ pub struct SearchSummary {
     /// The kind of that start (absent in records of older builds).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub best_start_kind: Option<StartKind>,
+    /// Whether that local search ran in plant-scaled variables (`variable_scaling`,
+    /// docs/ALGORITHMS.md §8.6). Absent in records of older builds and when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub best_start_scaled: bool,
     /// CPU seconds from the start of the run until the returned objective value was first
     /// reached within a relative 1e-6 (the final objective of a not-stabilised run: its best
     /// abscissa).
@@ -172,16 +176,20 @@ impl SearchSummary {
             starts: 0,
             best_start: 0,
             best_start_kind: None,
+            best_start_scaled: false,
             cpu_to_best_s: f64::NAN,
             evals_to_best: 0,
             stop: SearchStop::NotRecorded,
         }
     }
 
-    /// "7 (central)": the best start's index and, if recorded, its kind.
+    /// "7 (central)": the best start's index and, if recorded, its kind ("7 (hop, scaled)" if
+    /// its local search ran in plant-scaled variables).
     pub fn best_start_label(&self) -> String {
+        let scaled = if self.best_start_scaled { ", scaled" } else { "" };
         match self.best_start_kind {
-            Some(k) => format!("{} ({})", self.best_start, k.name()),
+            Some(k) => format!("{} ({}{scaled})", self.best_start, k.name()),
+            None if self.best_start_scaled => format!("{} (scaled)", self.best_start),
             None => self.best_start.to_string(),
         }
     }

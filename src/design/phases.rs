@@ -13,6 +13,13 @@ pub(crate) fn bfgs_options(opts: &DesignOptions, fvalquit: f64) -> BfgsOptions {
     BfgsOptions { normtol: opts.normtol, evaldist: opts.evaldist, maxit: opts.maxit, fvalquit, ..Default::default() }
 }
 
+/// BFGS options of an f_h local search (fvalquit = −∞): `maxit`, or `continued_maxit` (0: `maxit`)
+/// for a local search of the continued search.
+pub(crate) fn perf_bfgs_options(opts: &DesignOptions, continued: bool) -> BfgsOptions {
+    let maxit = if continued && opts.continued_maxit > 0 { opts.continued_maxit } else { opts.maxit };
+    BfgsOptions { maxit, ..bfgs_options(opts, f64::NEG_INFINITY) }
+}
+
 /// Gradient-sampling options of both phases.
 pub(crate) fn gradsamp_options(opts: &DesignOptions, fvalquit: f64) -> GradSampOptions {
     GradSampOptions { maxit: opts.gradsamp_maxit, fvalquit, only_if_uncertified: true, ..Default::default() }

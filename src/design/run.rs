@@ -17,13 +17,13 @@ use super::central_start::central_starts;
 use super::objective::{
     ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
 };
-use super::options::{DesignOptions, ObjectiveKind, MAX_ITERATIONS, MAX_NRAND};
+use super::options::{DesignOptions, ObjectiveKind, VariableScaling, MAX_ITERATIONS, MAX_NRAND};
 use super::outcome::{
     Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
-use super::scaling::{from_scaled, to_scaled, variable_scaling};
-use super::search::Search;
+use super::scaling::variable_scaling;
+use super::search::{ScaledObjectives, Search};
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
 
 /// Designs a controller of order `opts.order` for `plant` (HIFOO, strong stabilisation unless
@@ -131,6 +131,12 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     }
     if !(1..=MAX_ITERATIONS).contains(&opts.maxit) {
         return Err(opt_err("maxit", format!("must be in 1..={MAX_ITERATIONS}, got {}", opts.maxit)));
+    }
+    if opts.continued_maxit > MAX_ITERATIONS {
+        return Err(opt_err(
+            "continued_maxit",
+            format!("must be at most {MAX_ITERATIONS} (0: maxit), got {}", opts.continued_maxit),
+        ));
     }
     if opts.gradsamp_maxit > MAX_ITERATIONS {
         return Err(opt_err(
@@ -243,42 +249,52 @@ fn run_validated(
         first.push(controller_to_x(&k));
         kinds.push(StartKind::Central);
     }
-    // The search runs on x̃ = x / d (`design::scaling`); its starts are the same controllers.
-    let scaling: Option<std::rc::Rc<[f64]>> =
-        if opts.variable_scaling { variable_scaling(plant, shape).map(Into::into) } else { None };
-    if let Some(d) = scaling.as_deref() {
-        first.iter_mut().for_each(|x| *x = to_scaled(x, Some(d)));
-    }
-    let cache = Rc::new(RefCell::new(ComponentCache::default()));
-    let stab_obj = DesignObjective::new(
-        plant,
-        shape,
-        ObjectivePhase::Stabilisation,
-        strong,
-        opts.eps,
-        opts.hinf_tol,
-        Rc::clone(&cache),
-    );
+    // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
+    // asks for them and the plant is scaled at all.
+    let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
+        VariableScaling::Off => None,
+        VariableScaling::Alternate | VariableScaling::Always => variable_scaling(plant, shape).map(Into::into),
+    };
     // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
     // sub-budget of the search is checked between evaluations.
     let stop_ctl = ctl.clone();
     let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
-    let mut stab_obj = stab_obj.with_interrupt(Some(Rc::clone(&stop))).with_scaling(scaling.clone());
     // On large plants, hold back the largest evaluation seen from the CPU budget: the returned
     // controller's figures (about one evaluation) are computed after the search, and should end
     // near cpumax, not one evaluation after it. (Small plants never report: their runs are
     // unchanged.)
     let reserve_ctl = ctl.clone();
     let report: Rc<dyn Fn(f64)> = Rc::new(move |s| reserve_ctl.reserve_cpu(s));
-    let mut perf_obj =
-        DesignObjective::new(plant, shape, ObjectivePhase::Performance, strong, opts.eps, opts.hinf_tol, cache)
-            .with_interrupt(Some(stop))
-            .with_eval_cpu_report(Some(report))
-            .with_scaling(scaling.clone());
+    // The two objectives in coordinates with scaling `d` (each coordinate system has its own
+    // component cache: the cache is keyed by the objective's variables).
+    let objectives = |d: Option<Rc<[f64]>>| {
+        let cache = Rc::new(RefCell::new(ComponentCache::default()));
+        let new = |phase, cache| DesignObjective::new(plant, shape, phase, strong, opts.eps, opts.hinf_tol, cache);
+        let stab = new(ObjectivePhase::Stabilisation, Rc::clone(&cache))
+            .with_interrupt(Some(Rc::clone(&stop)))
+            .with_scaling(d.clone());
+        let perf = new(ObjectivePhase::Performance, cache)
+            .with_interrupt(Some(Rc::clone(&stop)))
+            .with_eval_cpu_report(Some(Rc::clone(&report)))
+            .with_scaling(d);
+        (stab, perf)
+    };
+    let (mut stab_obj, mut perf_obj) = objectives(None);
+    let mut scaled_objs = scaling.clone().map(|d| objectives(Some(d)));
     let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
-    let res =
-        Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl: &ctl }
-            .run(opts, &first, &kinds, shape.nvar())?;
+    let scaled = match (&mut scaled_objs, &scaling) {
+        (Some((s, p)), Some(d)) => Some(ScaledObjectives { stab_obj: s, perf_obj: p, d: Rc::clone(d) }),
+        _ => None,
+    };
+    let res = Search {
+        stab_obj: &mut stab_obj,
+        perf_obj: &mut perf_obj,
+        adapter: &mut adapter,
+        rng: &mut rng,
+        ctl: &ctl,
+        scaled,
+    }
+    .run(opts, &first, &kinds, shape.nvar())?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
 
     let (final_x, certificate) = match &res.perf {
@@ -299,7 +315,7 @@ fn run_validated(
         DesignStatus::Stopped
     };
 
-    let k = shape.controller(&from_scaled(&final_x, scaling.as_deref()));
+    let k = shape.controller(&final_x);
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
     let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });

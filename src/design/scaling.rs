@@ -1,6 +1,7 @@
-//! Plant-scaled controller variables (docs/ALGORITHMS.md §8.6), used when
-//! `DesignOptions::variable_scaling` is set (default off: it helps AC10 and hurts BDT2, see the
-//! last paragraph).
+//! Plant-scaled controller variables (docs/ALGORITHMS.md §8.6), used by the local searches that
+//! `DesignOptions::variable_scaling` puts in them (by default every other hop cycle of the
+//! continued search, `design::search`: scaled searches help AC10 and hurt BDT2, see the last
+//! paragraph).
 //!
 //! The search works on x̃ with x = d ∘ x̃ (elementwise), where d comes from the scaling of the
 //! plant's control and measurement channels — the usual input/output scaling of a multivariable
@@ -34,8 +35,9 @@
 //! first-order controller differ by ~10⁴; from the same start, BFGS in x stalls after ~20
 //! iterations (γ 14.6, or not stabilised) where BFGS in x̃ goes on to γ ≈ 10.2–13.3, and one
 //! 300-CPU-s job reaches 10.047 against 17.57 unscaled. On BDT2 n_K = 1 (controls 10⁴ apart) the
-//! same job reached 0.897 scaled against 0.596 unscaled — not understood yet — so the option is
-//! off by default.
+//! same job reached 0.897 with every local search scaled against 0.581 unscaled — not understood
+//! yet — so the default alternates: the incumbent is kept in x, and unscaled and scaled hop
+//! cycles both start from the best point either found.
 
 use faer::Mat;
 

@@ -67,6 +67,18 @@ impl RunControl {
         c
     }
 
+    /// A control with limits `cpu_s` CPU seconds and `evals` evaluations below this one's (not
+    /// below 0), on the same clock, counter and cancel flag: keeps an absolute amount of a budget
+    /// for a final stage. A missing limit stays missing.
+    pub fn less(&self, cpu_s: f64, evals: usize) -> RunControl {
+        let mut c = self.clone();
+        if c.cpumax.is_finite() && cpu_s.is_finite() {
+            c.cpumax = (c.cpumax - cpu_s.max(0.0)).max(0.0);
+        }
+        c.maxevals = c.maxevals.map(|m| m.saturating_sub(evals));
+        c
+    }
+
     /// Counts one objective evaluation (called by the solvers' evaluator).
     pub fn count_eval(&self) {
         self.evals.fetch_add(1, Ordering::Relaxed);
@@ -160,5 +172,19 @@ mod tests {
         let unlimited = RunControl::new(f64::INFINITY);
         unlimited.reserve_cpu(1e9);
         assert!(!unlimited.cpu_exhausted(), "no limit, nothing to exhaust");
+    }
+
+    #[test]
+    fn less_lowers_both_limits_by_absolute_amounts() {
+        let ctl = RunControl::new(10.0).with_maxevals(Some(100));
+        let l = ctl.less(4.0, 30);
+        assert_eq!((l.cpumax(), l.maxevals()), (6.0, Some(70)));
+        let all = ctl.less(20.0, 200);
+        assert_eq!((all.cpumax(), all.maxevals()), (0.0, Some(0)), "not below 0");
+        assert!(all.cpu_exhausted() && all.evals_exhausted());
+        let unlimited = RunControl::new(f64::INFINITY).less(5.0, 5);
+        assert_eq!((unlimited.cpumax(), unlimited.maxevals()), (f64::INFINITY, None), "a missing limit stays missing");
+        l.count_eval();
+        assert_eq!(ctl.evals(), 1, "same counter");
     }
 }
