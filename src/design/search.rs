@@ -520,11 +520,18 @@ impl Search<'_, '_, '_> {
     /// `return_gs_reserve`, after HIFOO's first starts and whenever the search has spent its share
     /// of the budget: gradient sampling on the incumbent (if it changed since the last one), then
     /// the control of the search from here — the whole budget less [`GS_RESERVE_FACTOR`] times the
-    /// most a gradient sampling took, at most the first reserve — or None if nothing was measured
-    /// or that share is already spent (module docs).
-    fn return_reserve(&mut self, st: &mut State<'_>, rounds: &mut GsRounds) -> Result<Option<RunControl>, DesignError> {
+    /// most a gradient sampling took, at most the first reserve; the whole budget when the share
+    /// is spent and gradient sampling had nothing to do — or None if nothing was measured or that
+    /// share is already spent (module docs).
+    fn return_reserve(
+        &mut self,
+        st: &mut State<'_>,
+        rounds: &mut GsRounds,
+        share_spent: bool,
+    ) -> Result<Option<RunControl>, DesignError> {
         let full = self.ctl;
         let (c0, e0) = (full.cpu_elapsed(), full.evals());
+        let mut ran_now = false;
         if st.perf.as_ref().map(|b| &b.x) != rounds.at.as_ref() {
             // At most the first reserve from now (small evaluation budgets: HE1 n_K = 2 under
             // maxevals = 10 000 spent most of its budget on this gradient sampling otherwise).
@@ -532,9 +539,17 @@ impl Search<'_, '_, '_> {
                 full.cpumax() - c0 - rounds.first.0,
                 full.maxevals().map_or(0, |m| m.saturating_sub(e0.saturating_add(rounds.first.1))),
             );
-            rounds.ran |= self.gs_incumbent(st, &cap)?;
+            ran_now = self.gs_incumbent(st, &cap)?;
+            rounds.ran |= ran_now;
         }
         rounds.at = st.perf.as_ref().map(|b| b.x.clone());
+        if share_spent && !ran_now {
+            // The search's share is spent and gradient sampling had nothing to do (a certified
+            // incumbent, or the one it already ran from): a reserve kept for it would go unused,
+            // so the search gets the whole rest. A later incumbent is better than this one, so
+            // the result cannot get worse; gradient sampling then runs on what is left.
+            return Ok(Some(full.less(0.0, 0)));
+        }
         let (c, e) = (full.cpu_elapsed() - c0, full.evals() - e0);
         if !rounds.ran {
             return Ok(None); // nothing measured (a certified incumbent): the first reserve stays
@@ -596,7 +611,7 @@ impl Search<'_, '_, '_> {
             let hifoo_done = k == hifoo_starts && !rounds.after_first;
             if returning && st.stabilised && !rounds.done && (share_spent || hifoo_done) {
                 rounds.after_first |= hifoo_done;
-                match self.return_reserve(&mut st, &mut rounds)? {
+                match self.return_reserve(&mut st, &mut rounds, share_spent)? {
                     Some(c) => search_ctl = c,
                     None => rounds.done = share_spent,
                 }
