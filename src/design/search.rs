@@ -272,6 +272,8 @@ struct GsRounds {
     at: Option<Vec<f64>>,
     /// Gradient sampling ran at least once.
     ran: bool,
+    /// The incumbent as the last gradient sampling that actually ran left it.
+    treated: Option<Vec<f64>>,
     /// The step after HIFOO's first starts was taken.
     after_first: bool,
     /// No round is left to give.
@@ -543,8 +545,13 @@ impl Search<'_, '_, '_> {
             rounds.ran |= ran_now;
         }
         rounds.at = st.perf.as_ref().map(|b| b.x.clone());
-        if share_spent && !ran_now {
-            // The search's share is spent and gradient sampling had nothing to do (a certified
+        if ran_now {
+            rounds.treated.clone_from(&rounds.at);
+        }
+        let idle =
+            st.perf.as_ref().is_some_and(|b| b.dnorm <= st.opts.normtol || rounds.treated.as_ref() == Some(&b.x));
+        if share_spent && idle {
+            // The search's share is spent and gradient sampling has nothing to do (a certified
             // incumbent, or the one it already ran from): a reserve kept for it would go unused,
             // so the search gets the whole rest. A later incumbent is better than this one, so
             // the result cannot get worse; gradient sampling then runs on what is left.
