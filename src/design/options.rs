@@ -155,7 +155,7 @@ pub struct DesignOptions {
     /// Number of random starting points (HIFOO `nrand`, default 3), or of perturbations of an
     /// initial controller. These starts are always made (unless a budget ends the run first).
     pub nrand: usize,
-    /// Stall rule of the continued search (see [`crate::design`], "Search"): after the first
+    /// Stall rule of the continued search (the `design::search` module docs, "When it stops"): after the first
     /// starts, new local searches are started until `stall_starts` consecutive ones have not
     /// improved the best objective by a relative `stall_rtol` (or a budget ends the run; with
     /// `spend_budget`, the rule ends only runs that no budget bounds).
