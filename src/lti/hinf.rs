@@ -31,6 +31,9 @@
 //!    crossings were spurious and we stop (AB13DD's safeguard); at most [`MAX_LEVEL_SET_ITERS`].
 //!
 //! # Structure-preserving eigenvalues
+//! Below order [`HESSENBERG_QR_FROM`] the level-set test always uses the pencil (next section but
+//! one, `level_set_pencil.rs`): the squared spectrum lost real crossings of order-6 closed loops
+//! (`tests/hinf_regression.rs`). From that order on:
 //! H(γ) is Hamiltonian. Its eigenvalues are taken from H² by Van Loan's square-reduced method
 //! (`square_reduced.rs`: an orthogonal symplectic reduction, then an n×n Hessenberg QR instead
 //! of a 2n×2n one), as AB13DD also uses a structure-preserving method. Its eigenvalues μ = λ²
