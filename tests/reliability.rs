@@ -702,3 +702,23 @@ fn item9_error_texts() {
     let longest = out.split_whitespace().map(str::len).max().unwrap_or(0);
     assert!(longest < 40, "a {longest}-character word in: {out}");
 }
+
+/// A printing command whose reader goes away (`campaign plant CM4 --json | head -c 100`) ends
+/// quietly, by SIGPIPE as Unix tools do, not with a "failed printing to stdout" panic.
+#[test]
+fn closed_stdout_ends_printing_commands_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    for args in [&["plant", "CM4", "--json"][..], &["plants"][..]] {
+        let mut child =
+            cli(args).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+        drop(child.stdout.take()); // the reader closes before the command has printed
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_no_panic(&err);
+        assert!(
+            o.status.code() == Some(0) || o.status.signal() == Some(libc::SIGPIPE),
+            "{:?} {args:?}: {err}",
+            o.status
+        );
+    }
+}

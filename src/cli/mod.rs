@@ -86,6 +86,9 @@ pub fn main() -> ExitCode {
 /// no environment variable or option switches it to fake results.
 pub fn main_with(fake: Option<FakeRunner>) -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Run(_) | Command::Design(_) | Command::Plot(_)) {
+        signals::end_quietly_on_closed_stdout();
+    }
     let result = match cli.command {
         Command::Run(a) => campaign::run(a, fake),
         Command::Status(a) => campaign::status(a, fake),

@@ -55,3 +55,15 @@ pub fn exit_code() -> u8 {
         s => (128 + s).min(255) as u8,
     }
 }
+
+/// Restores the default action of SIGPIPE (the Rust runtime ignores it, so a closed pipe turns
+/// `println!` into a panic): a printing command piped into `head` then ends quietly, as Unix
+/// tools do, instead of panicking with "failed printing to stdout". Only for the commands that
+/// print and write no files; `run`, `design` and `plot` keep their own clean-up on signals.
+pub fn end_quietly_on_closed_stdout() {
+    // SAFETY: setting a signal's disposition to SIG_DFL has no preconditions; it is done
+    // before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
