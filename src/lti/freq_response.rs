@@ -5,15 +5,20 @@
 //! complex Hessenberg solve, O(n²·m), by Gaussian elimination with adjacent-row partial
 //! pivoting (backward stable, as for any GEPP on a Hessenberg matrix). This is the classical
 //! Laub (1981) approach and what makes the many test frequencies of the level-set method cheap.
+//! From order [`HESSENBERG_QR_FROM`] on the solve runs on split real and imaginary parts
+//! (`hessenberg_solve.rs`, vectorised; issue 13), below it on interleaved complex numbers (the
+//! rounding the small plants' results were obtained with).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg;
 use faer::linalg::householder;
 use faer::{c64, Conj, Mat, MatRef, Par};
 
-use super::hessenberg_qr::hessenberg_eigenvalues;
+use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
+use super::hessenberg_solve::ShiftedHessenbergSolve;
 use super::step_stats::{timed, Step};
 use super::StateSpace;
+use crate::numeric::dot_four_lanes;
 
 /// G(iω) evaluator for one system (reusable buffers).
 pub(crate) struct FreqResponse {
@@ -31,6 +36,9 @@ pub(crate) struct FreqResponse {
     rhs: Vec<c64>,
     /// The last G(iω), p×m.
     g: Mat<c64>,
+    /// From order [`HESSENBERG_QR_FROM`] on: the split-complex solve (`hessenberg_solve.rs`) and
+    /// C̃ row-major (p×n).
+    large: Option<(ShiftedHessenbergSolve, Vec<f64>)>,
 }
 
 impl FreqResponse {
@@ -96,11 +104,13 @@ impl FreqResponse {
             p,
             h,
             bt: btv,
-            ct,
+            ct: ct.clone(),
             d: sys.d.clone(),
             work: vec![c64::new(0.0, 0.0); n * n],
             rhs: vec![c64::new(0.0, 0.0); n * m],
             g: Mat::zeros(p, m),
+            large: (n >= HESSENBERG_QR_FROM)
+                .then(|| (ShiftedHessenbergSolve::new(n, m), (0..p * n).map(|k| ct[(k / n, k % n)]).collect())),
         }
     }
 
@@ -134,6 +144,17 @@ impl FreqResponse {
             }
         }
         if w.is_infinite() || n == 0 {
+            return self.g.as_ref();
+        }
+        if let Some((solver, ct)) = &mut self.large {
+            let (xr, xi) = solver.solve(&self.h, &self.bt, w);
+            for i in 0..p {
+                let row = &ct[i * n..(i + 1) * n];
+                for c in 0..m {
+                    let col = c * n..(c + 1) * n;
+                    self.g[(i, c)] += c64::new(dot_four_lanes(row, &xr[col.clone()]), dot_four_lanes(row, &xi[col]));
+                }
+            }
             return self.g.as_ref();
         }
         // T = iωI − H (upper Hessenberg, row-major), rhs = B̃.

@@ -13,6 +13,7 @@ pub(crate) mod freq_response;
 mod full_order;
 mod gradient;
 mod hessenberg_qr;
+mod hessenberg_solve;
 mod hinf;
 mod interrupt;
 mod level_set_pencil;
