@@ -233,6 +233,39 @@ impl FreqResponse {
     }
 }
 
+/// One frequency-response evaluator kept for the next H∞ computation on the same system: the
+/// line-search screen ([`hinf_lower_bound_sharing`](super::hinf::hinf_lower_bound_sharing)) leaves
+/// the closed loop's Hessenberg form here, and the norm of a trial that passes the screen
+/// ([`closed_loop_hinf_grad_sharing`](super::closed_loop_hinf_grad_sharing)) takes it instead of
+/// reducing A again (issue 13). Taken only for a bitwise identical system, and the evaluator's
+/// buffers are overwritten before they are read, so the results are exactly those of a fresh one.
+#[derive(Default)]
+pub struct ResponseSlot {
+    kept: Option<(StateSpace, FreqResponse)>,
+}
+
+impl ResponseSlot {
+    /// The evaluator of `sys` if one is kept (and empties the slot either way).
+    pub(crate) fn take_for(&mut self, sys: &StateSpace) -> Option<FreqResponse> {
+        self.kept.take().filter(|(kept, _)| same_bits(kept, sys)).map(|(_, fr)| fr)
+    }
+
+    /// Keeps the evaluator `fr` of `sys`.
+    pub(crate) fn keep(&mut self, sys: &StateSpace, fr: FreqResponse) {
+        self.kept = Some((sys.clone(), fr));
+    }
+}
+
+/// Whether two systems have the same dimensions and bitwise the same entries.
+fn same_bits(x: &StateSpace, y: &StateSpace) -> bool {
+    let eq = |a: &Mat<f64>, b: &Mat<f64>| {
+        a.nrows() == b.nrows()
+            && a.ncols() == b.ncols()
+            && (0..a.ncols()).all(|j| (0..a.nrows()).all(|i| a[(i, j)].to_bits() == b[(i, j)].to_bits()))
+    };
+    eq(&x.a, &y.a) && eq(&x.b, &y.b) && eq(&x.c, &y.c) && eq(&x.d, &y.d)
+}
+
 /// The eigenvalues of a finite square matrix by [`FreqResponse::new`]'s Hessenberg reduction and
 /// our Francis QR: bit for bit [`FreqResponse::poles`] of any system with this A, so the
 /// stability decision and the H∞ norm's poles agree exactly. `None` if the QR does not converge.
