@@ -67,14 +67,18 @@ const SHIFT_FACTORS: [f64; 4] = [1.0, 3.7, 0.23, 17.0];
 /// Shifts are tried in the order of [`SHIFT_FACTORS`]; the first well-conditioned one whose
 /// crossings can be computed gives the result. If none is, the first ill-conditioned one (with
 /// finite T₁₁) whose crossings can be computed does. The crossings of an ill-conditioned shift are
-/// only computed when every shift has failed, and a shift that [`shifted_inverse`] can reject from
-/// a lower bound of ‖T₁₁‖ is not even solved for in full (issue 13: on CM4's converged designs
+/// only computed when every shift has failed, and from order [`SCREEN_SHIFTS_FROM`] on a shift that
+/// [`shifted_inverse`] can reject from a lower bound of ‖T₁₁‖ is not even solved for in full (issue 13: on CM4's converged designs
 /// the first shift failed in two tests of three, and each failure cost a full solve plus a PVL
 /// reduction and QR for a fallback that was then not used). The result is the same as computing
 /// every tried shift in full.
 pub(crate) fn pencil_crossings(sys: &StateSpace, gamma: f64, scale: f64) -> Option<Vec<f64>> {
-    crossings_screened(sys, gamma, scale, true)
+    crossings_screened(sys, gamma, scale, sys.order() >= SCREEN_SHIFTS_FROM)
 }
+
+/// From this order on an ill-conditioned shift is rejected before the full solve (below it the
+/// full solve costs little more than the screen's four single-column solves).
+const SCREEN_SHIFTS_FROM: usize = 30;
 
 /// [`pencil_crossings`], with the early rejection of ill-conditioned shifts if `screen`.
 fn crossings_screened(sys: &StateSpace, gamma: f64, scale: f64, screen: bool) -> Option<Vec<f64>> {
