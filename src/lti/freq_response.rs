@@ -6,8 +6,8 @@
 //! pivoting (backward stable, as for any GEPP on a Hessenberg matrix). This is the classical
 //! Laub (1981) approach and what makes the many test frequencies of the level-set method cheap.
 //! From order [`HESSENBERG_QR_FROM`] on the solve runs on split real and imaginary parts
-//! (`hessenberg_solve.rs`, vectorised; issue 13), below it on interleaved complex numbers (the
-//! rounding the small plants' results were obtained with).
+//! (`hessenberg_solve.rs`: the elimination vectorises; issue 13), with the same operations in the
+//! same order as the interleaved solve used below it, so both give the same bits.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg;
@@ -18,7 +18,6 @@ use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
 use super::hessenberg_solve::ShiftedHessenbergSolve;
 use super::step_stats::{timed, Step};
 use super::StateSpace;
-use crate::numeric::dot_four_lanes;
 
 /// G(iω) evaluator for one system (reusable buffers).
 pub(crate) struct FreqResponse {
@@ -148,11 +147,16 @@ impl FreqResponse {
         }
         if let Some((solver, ct)) = &mut self.large {
             let (xr, xi) = solver.solve(&self.h, &self.bt, w);
+            // G = D + C̃X, summed in the interleaved path's order (the same bits).
             for i in 0..p {
                 let row = &ct[i * n..(i + 1) * n];
                 for c in 0..m {
-                    let col = c * n..(c + 1) * n;
-                    self.g[(i, c)] += c64::new(dot_four_lanes(row, &xr[col.clone()]), dot_four_lanes(row, &xi[col]));
+                    let (mut re, mut im) = (self.d[(i, c)], 0.0);
+                    for (k, &ctk) in row.iter().enumerate() {
+                        re += xr[c * n + k] * ctk;
+                        im += xi[c * n + k] * ctk;
+                    }
+                    self.g[(i, c)] = c64::new(re, im);
                 }
             }
             return self.g.as_ref();
@@ -336,6 +340,37 @@ mod tests {
             }
             s
         })
+    }
+
+    /// From order 30 on the split solve gives bit for bit the interleaved solve's G(iω).
+    #[test]
+    fn split_solve_has_the_interleaved_bits() {
+        let mut seed = 11u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for &(n, m, p) in &[(30, 1, 3), (45, 2, 4), (83, 3, 2)] {
+            let sys = StateSpace {
+                a: Mat::from_fn(n, n, |_, _| rnd()),
+                b: Mat::from_fn(n, m, |_, _| rnd()),
+                c: Mat::from_fn(p, n, |_, _| rnd()),
+                d: Mat::from_fn(p, m, |_, _| rnd()),
+            };
+            let mut split = FreqResponse::new(&sys);
+            assert!(split.large.is_some());
+            let mut interleaved = FreqResponse::new(&sys);
+            interleaved.large = None;
+            for &w in &[0.0, 0.3, 2.0, 17.0] {
+                let (g1, g2) = (split.eval(w).to_owned(), interleaved.eval(w).to_owned());
+                for j in 0..m {
+                    for i in 0..p {
+                        assert_eq!(g1[(i, j)].re.to_bits(), g2[(i, j)].re.to_bits(), "n={n} w={w}");
+                        assert_eq!(g1[(i, j)].im.to_bits(), g2[(i, j)].im.to_bits(), "n={n} w={w}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -1,17 +1,16 @@
 //! The solve (iωI − H) X = B̃ of the frequency response (`freq_response.rs`) for large orders,
 //! with real and imaginary parts in separate arrays.
 //!
-//! The method is the one of `FreqResponse::eval` (Gaussian elimination with adjacent-row partial
-//! pivoting on the upper Hessenberg iωI − H, then back substitution; backward stable), only laid
-//! out for SIMD (issue 13): a row update r₁ ← r₁ − l·r₀ on split real and imaginary parts is four
-//! real multiply–adds per entry that the compiler vectorises, where interleaved complex numbers
-//! kept it scalar; the back substitution's and the output's dot products run in four lanes, with
-//! X stored by columns so that they read contiguous memory. On x86-64 CPUs with AVX2 (detected at
-//! run time) the same code is compiled for 256-bit registers. Without fused multiply–adds and
-//! with the same order of operations in each lane, both builds give the same bits.
-//!
-//! Its rounding differs from the interleaved solve's (the dot products' order), so it serves
-//! only orders from `HESSENBERG_QR_FROM` on: smaller systems compute bit for bit what they did.
+//! The method and the arithmetic are those of `FreqResponse::eval` (Gaussian elimination with
+//! adjacent-row partial pivoting on the upper Hessenberg iωI − H, then back substitution; backward
+//! stable), with the same operations in the same order, so the result has the same bits; only the
+//! layout differs (issue 13): a row update r₁ ← r₁ − l·r₀ on split real and imaginary parts is
+//! independent per entry, and the compiler vectorises it where interleaved complex numbers kept it
+//! scalar. On x86-64 CPUs with AVX2 (detected at run time) the same code is compiled for 256-bit
+//! registers; without fused multiply–adds every lane rounds as the scalar code does, so both
+//! builds also give the same bits. The back substitution is a sequential sum per entry (kept, for
+//! the same bits) and stays scalar. Used from order `HESSENBERG_QR_FROM` on, where the elimination
+//! is long enough to pay for the split layout.
 
 use faer::c64;
 
@@ -124,44 +123,25 @@ impl ShiftedHessenbergSolve {
                 xi[c * n + k + 1] -= lr * x_im + li * x_re;
             }
         }
-        for c in 0..m {
-            let (xr, xi) = (&mut xr[c * n..(c + 1) * n], &mut xi[c * n..(c + 1) * n]);
-            for k in (0..n).rev() {
-                let row = k * n;
-                let (dr, di) =
-                    complex_dot(&tr[row + k + 1..row + n], &ti[row + k + 1..row + n], &xr[k + 1..], &xi[k + 1..]);
-                let s = c64::new(xr[k] - dr, xi[k] - di);
-                let piv = c64::new(tr[row + k], ti[row + k]);
-                let x = if piv == c64::new(0.0, 0.0) { c64::new(f64::INFINITY, 0.0) } else { s / piv };
-                xr[k] = x.re;
-                xi[k] = x.im;
+        // Back substitution in the interleaved solve's order (a sequential sum per entry), so the
+        // bits are the same; only the elimination above vectorises.
+        for k in (0..n).rev() {
+            let row = k * n;
+            let piv = c64::new(tr[row + k], ti[row + k]);
+            for c in 0..m {
+                let col = c * n;
+                let (mut sr, mut si) = (xr[col + k], xi[col + k]);
+                for j in k + 1..n {
+                    let (a_re, a_im, b_re, b_im) = (tr[row + j], ti[row + j], xr[col + j], xi[col + j]);
+                    sr -= a_re * b_re - a_im * b_im;
+                    si -= a_re * b_im + a_im * b_re;
+                }
+                let x = if piv == c64::new(0.0, 0.0) { c64::new(f64::INFINITY, 0.0) } else { c64::new(sr, si) / piv };
+                xr[col + k] = x.re;
+                xi[col + k] = x.im;
             }
         }
     }
-}
-
-/// Σ (a_re + i a_im)(b_re + i b_im) over the common length, in four lanes per part.
-#[inline(always)]
-pub(crate) fn complex_dot(a_re: &[f64], a_im: &[f64], b_re: &[f64], b_im: &[f64]) -> (f64, f64) {
-    let len = a_re.len();
-    let (a_re, a_im, b_re, b_im) = (&a_re[..len], &a_im[..len], &b_re[..len], &b_im[..len]);
-    let mut re = [0.0f64; 4];
-    let mut im = [0.0f64; 4];
-    let chunks = len / 4;
-    for q in 0..chunks {
-        let o = 4 * q;
-        let (ar, ai, br, bi) = (&a_re[o..o + 4], &a_im[o..o + 4], &b_re[o..o + 4], &b_im[o..o + 4]);
-        for l in 0..4 {
-            re[l] += ar[l] * br[l] - ai[l] * bi[l];
-            im[l] += ar[l] * bi[l] + ai[l] * br[l];
-        }
-    }
-    let (mut sr, mut si) = ((re[0] + re[1]) + (re[2] + re[3]), (im[0] + im[1]) + (im[2] + im[3]));
-    for k in 4 * chunks..len {
-        sr += a_re[k] * b_re[k] - a_im[k] * b_im[k];
-        si += a_re[k] * b_im[k] + a_im[k] * b_re[k];
-    }
-    (sr, si)
 }
 
 #[cfg(test)]
