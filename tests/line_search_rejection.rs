@@ -60,3 +60,42 @@ fn lower_bound_rejection_is_exact_and_used() {
     assert!(bounded.rejected > 0, "no trial point was rejected by its bound");
     assert_eq!(bounded.rejected + bounded.full, b.evals);
 }
+
+/// The screen's frequency-response evaluator, reused by the norm of the same closed loop
+/// (`lti::ResponseSlot`), gives bit for bit the norm and gradient of a fresh one, and saves the
+/// second Hessenberg reduction; a slot holding another closed loop is not used.
+#[test]
+fn screened_evaluator_reuse_is_exact() {
+    use hinfix::lti::step_stats::{self, Step};
+    use hinfix::lti::{
+        closed_loop, closed_loop_hinf_grad_near, closed_loop_hinf_grad_sharing, hinf_lower_bound_sharing,
+        resolve_plant, Controller, Interrupt, Plant, ResponseSlot, DEFAULT_HINF_TOL,
+    };
+    let plant = resolve_plant("CM4").and_then(Plant::load).unwrap();
+    let d = plant.dims;
+    let mut k = Controller::zeros(1, d.m2, d.p2);
+    k.ak[(0, 0)] = -2.0;
+    k.bk[(0, 0)] = 0.01;
+    let mut other = k.clone();
+    other.ak[(0, 0)] = -3.0;
+    let hint = [0.7];
+    let fresh = closed_loop_hinf_grad_near(&plant, &k, DEFAULT_HINF_TOL, &hint).unwrap();
+    assert!(fresh.0.value.is_finite(), "the test loop must be stable");
+    for screened in [&k, &other] {
+        let mut slot = ResponseSlot::default();
+        let cl = closed_loop(&plant, screened).unwrap();
+        assert!(cl.order() >= 30, "the large-order path");
+        let lb = hinf_lower_bound_sharing(&cl, &hint, &mut slot);
+        step_stats::reset();
+        let shared =
+            closed_loop_hinf_grad_sharing(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot).unwrap();
+        let reductions = step_stats::snapshot().calls(Step::Hessenberg, true);
+        assert_eq!(reductions, u64::from(!std::ptr::eq(screened, &k)), "Hessenberg reductions of the norm");
+        assert_eq!(shared.0.value.to_bits(), fresh.0.value.to_bits());
+        assert_eq!(shared.0.peak_freq.to_bits(), fresh.0.peak_freq.to_bits());
+        assert_eq!(shared.1, fresh.1);
+        if std::ptr::eq(screened, &k) {
+            assert!(lb <= shared.0.value);
+        }
+    }
+}

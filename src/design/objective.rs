@@ -36,9 +36,9 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad,
-    controller_hinf_grad, hinf_lower_bound, spectral_abscissa, Controller, ControllerGradient, Interrupt, LtiError,
-    Plant,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
+    controller_hinf_grad, hinf_lower_bound_sharing, spectral_abscissa, Controller, ControllerGradient, Interrupt,
+    LtiError, Plant, ResponseSlot,
 };
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
@@ -132,6 +132,9 @@ pub struct DesignObjective<'p> {
     /// Peak frequency of ‖Tzw‖∞ at the last finite performance evaluation (NaN: none yet), where
     /// σmax(Tzw(iω)) gives a line search's trial point a cheap lower bound of f.
     peak_hint: Cell<f64>,
+    /// The closed loop's frequency-response evaluator left by the last screened trial
+    /// ([`Objective::eval_below`]), for its norm if it passes the screen (`lti::ResponseSlot`).
+    screened: RefCell<ResponseSlot>,
     /// Polled inside long evaluations (module docs).
     stop: Option<StopHook>,
     /// Whether the last evaluation was abandoned because `stop` fired.
@@ -165,6 +168,7 @@ impl<'p> DesignObjective<'p> {
             hinf_tol,
             cache,
             peak_hint: Cell::new(f64::NAN),
+            screened: RefCell::new(ResponseSlot::default()),
             stop: None,
             abandoned: Cell::new(false),
             on_eval_cpu: None,
@@ -278,7 +282,8 @@ impl<'p> DesignObjective<'p> {
         // frequencies (`lti::hinf_norm_near`); the level-set certification is unchanged.
         let hint = [self.peak_hint.get()];
         let cpu0 = hook.map(|_| thread_cpu_time());
-        let (gamma, g_cl) = match closed_loop_hinf_grad_near_interruptible(self.plant, k, self.hinf_tol, &hint, stop) {
+        let slot = &mut self.screened.borrow_mut();
+        let (gamma, g_cl) = match closed_loop_hinf_grad_sharing(self.plant, k, self.hinf_tol, &hint, stop, slot) {
             Ok((norm, g)) => {
                 if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
                     report(thread_cpu_time() - t0);
@@ -324,7 +329,7 @@ impl DesignObjective<'_> {
             lb = self.eps * norm.value;
         }
         match closed_loop(self.plant, k) {
-            Ok(cl) => lb.max(hinf_lower_bound(&cl, &[self.peak_hint.get()])),
+            Ok(cl) => lb.max(hinf_lower_bound_sharing(&cl, &[self.peak_hint.get()], &mut self.screened.borrow_mut())),
             Err(_) => f64::INFINITY,
         }
     }

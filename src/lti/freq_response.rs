@@ -5,13 +5,17 @@
 //! complex Hessenberg solve, O(n²·m), by Gaussian elimination with adjacent-row partial
 //! pivoting (backward stable, as for any GEPP on a Hessenberg matrix). This is the classical
 //! Laub (1981) approach and what makes the many test frequencies of the level-set method cheap.
+//! From order [`HESSENBERG_QR_FROM`] on the solve runs on split real and imaginary parts
+//! (`hessenberg_solve.rs`: the elimination vectorises; issue 13), with the same operations in the
+//! same order as the interleaved solve used below it, so both give the same bits.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg;
 use faer::linalg::householder;
 use faer::{c64, Conj, Mat, MatRef, Par};
 
-use super::hessenberg_qr::hessenberg_eigenvalues;
+use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
+use super::hessenberg_solve::ShiftedHessenbergSolve;
 use super::step_stats::{timed, Step};
 use super::StateSpace;
 
@@ -31,6 +35,9 @@ pub(crate) struct FreqResponse {
     rhs: Vec<c64>,
     /// The last G(iω), p×m.
     g: Mat<c64>,
+    /// From order [`HESSENBERG_QR_FROM`] on: the split-complex solve (`hessenberg_solve.rs`) and
+    /// C̃ row-major (p×n).
+    large: Option<(ShiftedHessenbergSolve, Vec<f64>)>,
 }
 
 impl FreqResponse {
@@ -96,11 +103,13 @@ impl FreqResponse {
             p,
             h,
             bt: btv,
-            ct,
+            ct: ct.clone(),
             d: sys.d.clone(),
             work: vec![c64::new(0.0, 0.0); n * n],
             rhs: vec![c64::new(0.0, 0.0); n * m],
             g: Mat::zeros(p, m),
+            large: (n >= HESSENBERG_QR_FROM)
+                .then(|| (ShiftedHessenbergSolve::new(n, m), (0..p * n).map(|k| ct[(k / n, k % n)]).collect())),
         }
     }
 
@@ -134,6 +143,22 @@ impl FreqResponse {
             }
         }
         if w.is_infinite() || n == 0 {
+            return self.g.as_ref();
+        }
+        if let Some((solver, ct)) = &mut self.large {
+            let (xr, xi) = solver.solve(&self.h, &self.bt, w);
+            // G = D + C̃X, summed in the interleaved path's order (the same bits).
+            for i in 0..p {
+                let row = &ct[i * n..(i + 1) * n];
+                for c in 0..m {
+                    let (mut re, mut im) = (self.d[(i, c)], 0.0);
+                    for (k, &ctk) in row.iter().enumerate() {
+                        re += xr[c * n + k] * ctk;
+                        im += xi[c * n + k] * ctk;
+                    }
+                    self.g[(i, c)] = c64::new(re, im);
+                }
+            }
             return self.g.as_ref();
         }
         // T = iωI − H (upper Hessenberg, row-major), rhs = B̃.
@@ -212,6 +237,39 @@ impl FreqResponse {
     }
 }
 
+/// One frequency-response evaluator kept for the next H∞ computation on the same system: the
+/// line-search screen ([`hinf_lower_bound_sharing`](super::hinf::hinf_lower_bound_sharing)) leaves
+/// the closed loop's Hessenberg form here, and the norm of a trial that passes the screen
+/// ([`closed_loop_hinf_grad_sharing`](super::closed_loop_hinf_grad_sharing)) takes it instead of
+/// reducing A again (issue 13). Taken only for a bitwise identical system, and the evaluator's
+/// buffers are overwritten before they are read, so the results are exactly those of a fresh one.
+#[derive(Default)]
+pub struct ResponseSlot {
+    kept: Option<(StateSpace, FreqResponse)>,
+}
+
+impl ResponseSlot {
+    /// The evaluator of `sys` if one is kept (and empties the slot either way).
+    pub(crate) fn take_for(&mut self, sys: &StateSpace) -> Option<FreqResponse> {
+        self.kept.take().filter(|(kept, _)| same_bits(kept, sys)).map(|(_, fr)| fr)
+    }
+
+    /// Keeps the evaluator `fr` of `sys`.
+    pub(crate) fn keep(&mut self, sys: &StateSpace, fr: FreqResponse) {
+        self.kept = Some((sys.clone(), fr));
+    }
+}
+
+/// Whether two systems have the same dimensions and bitwise the same entries.
+fn same_bits(x: &StateSpace, y: &StateSpace) -> bool {
+    let eq = |a: &Mat<f64>, b: &Mat<f64>| {
+        a.nrows() == b.nrows()
+            && a.ncols() == b.ncols()
+            && (0..a.ncols()).all(|j| (0..a.nrows()).all(|i| a[(i, j)].to_bits() == b[(i, j)].to_bits()))
+    };
+    eq(&x.a, &y.a) && eq(&x.b, &y.b) && eq(&x.c, &y.c) && eq(&x.d, &y.d)
+}
+
 /// The eigenvalues of a finite square matrix by [`FreqResponse::new`]'s Hessenberg reduction and
 /// our Francis QR: bit for bit [`FreqResponse::poles`] of any system with this A, so the
 /// stability decision and the H∞ norm's poles agree exactly. `None` if the QR does not converge.
@@ -282,6 +340,37 @@ mod tests {
             }
             s
         })
+    }
+
+    /// From order 30 on the split solve gives bit for bit the interleaved solve's G(iω).
+    #[test]
+    fn split_solve_has_the_interleaved_bits() {
+        let mut seed = 11u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for &(n, m, p) in &[(30, 1, 3), (45, 2, 4), (83, 3, 2)] {
+            let sys = StateSpace {
+                a: Mat::from_fn(n, n, |_, _| rnd()),
+                b: Mat::from_fn(n, m, |_, _| rnd()),
+                c: Mat::from_fn(p, n, |_, _| rnd()),
+                d: Mat::from_fn(p, m, |_, _| rnd()),
+            };
+            let mut split = FreqResponse::new(&sys);
+            assert!(split.large.is_some());
+            let mut interleaved = FreqResponse::new(&sys);
+            interleaved.large = None;
+            for &w in &[0.0, 0.3, 2.0, 17.0] {
+                let (g1, g2) = (split.eval(w).to_owned(), interleaved.eval(w).to_owned());
+                for j in 0..m {
+                    for i in 0..p {
+                        assert_eq!(g1[(i, j)].re.to_bits(), g2[(i, j)].re.to_bits(), "n={n} w={w}");
+                        assert_eq!(g1[(i, j)].im.to_bits(), g2[(i, j)].im.to_bits(), "n={n} w={w}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

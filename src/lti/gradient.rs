@@ -25,6 +25,7 @@ use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
 
 use super::closed_loop::ClosedLoop;
+use super::freq_response::{FreqResponse, ResponseSlot};
 use super::hinf::{hinf_norm_of_finite, HinfNorm};
 use super::interrupt::Interrupt;
 use super::spectral::rightmost_eigen;
@@ -99,8 +100,24 @@ pub fn closed_loop_hinf_grad_near_interruptible(
     hints: &[f64],
     stop: Interrupt<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    closed_loop_hinf_grad_sharing(plant, k, tol, hints, stop, &mut ResponseSlot::default())
+}
+
+/// [`closed_loop_hinf_grad_near_interruptible`] taking the closed loop's frequency-response
+/// evaluator from `slot` if it holds that of this very closed loop (left there by
+/// [`hinf_lower_bound_sharing`](super::hinf_lower_bound_sharing); the same result, one Hessenberg
+/// reduction fewer).
+pub fn closed_loop_hinf_grad_sharing(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+    slot: &mut ResponseSlot,
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, hints, stop)? else {
+    let kept = slot.take_for(&cl.sys);
+    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, hints, stop, kept)? else {
         return Ok((HinfNorm::UNSTABLE, nan_like(k)));
     };
     Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
@@ -109,7 +126,7 @@ pub fn closed_loop_hinf_grad_near_interruptible(
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER) else {
+    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER, None) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -135,16 +152,18 @@ pub(crate) struct PeakVectors {
 }
 
 /// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `stop` fires.
+/// `kept`: the evaluator of `sys` if one was made already.
 pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
     tol: f64,
     hints: &[f64],
     stop: Interrupt<'_>,
+    kept: Option<FreqResponse>,
 ) -> Result<Option<(HinfNorm, PeakVectors)>, LtiError> {
     if !sys.is_finite() {
         return Ok(None);
     }
-    let norm = hinf_norm_of_finite(sys, tol, hints, stop)?;
+    let norm = hinf_norm_of_finite(sys, tol, hints, stop, kept)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }

@@ -63,7 +63,7 @@
 
 use faer::{c64, Mat};
 
-use super::freq_response::FreqResponse;
+use super::freq_response::{FreqResponse, ResponseSlot};
 use super::hessenberg_qr::HESSENBERG_QR_FROM;
 use super::interrupt::{Interrupt, Interrupted};
 use super::level_set_pencil::pencil_crossings;
@@ -145,31 +145,33 @@ pub fn hinf_norm_near_interruptible(
     if !sys.is_finite() {
         return Ok(HinfNorm::UNSTABLE);
     }
-    hinf_norm_of_finite(sys, tol, hints, stop)
+    hinf_norm_of_finite(sys, tol, hints, stop, None)
 }
 
 /// [`hinf_norm_near_interruptible`] for finite data, with the poles computed here: from order
 /// [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one Hessenberg
 /// reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver (the rounding
 /// the small plants' results were obtained with). An eigensolver failure counts as unstable.
+/// `kept`: the frequency-response evaluator of `sys` if one was already made (`ResponseSlot`).
 pub(crate) fn hinf_norm_of_finite(
     sys: &StateSpace,
     tol: f64,
     hints: &[f64],
     stop: Interrupt<'_>,
+    kept: Option<FreqResponse>,
 ) -> Result<HinfNorm, Interrupted> {
     stop.poll()?;
     for_order(sys.order(), || {
         timed(Step::Norm, || {
             if sys.order() >= HESSENBERG_QR_FROM {
-                let fr = FreqResponse::new(sys);
+                let fr = kept.unwrap_or_else(|| FreqResponse::new(sys));
                 match fr.poles() {
                     Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, stop),
                     None => Ok(HinfNorm::UNSTABLE),
                 }
             } else {
                 match timed(Step::Poles, || eigenvalues(sys.a.as_ref())) {
-                    Some(poles) => hinf_norm_from(sys, &poles, None, tol, hints, stop),
+                    Some(poles) => hinf_norm_from(sys, &poles, kept, tol, hints, stop),
                     None => Ok(HinfNorm::UNSTABLE),
                 }
             }
@@ -182,6 +184,12 @@ pub(crate) fn hinf_norm_of_finite(
 /// system is +∞); +∞ if the data are not finite. One Hessenberg reduction plus O(n²m) per
 /// frequency: the cheap test behind the exact rejection of line-search trial points.
 pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
+    hinf_lower_bound_sharing(sys, freqs, &mut ResponseSlot::default())
+}
+
+/// [`hinf_lower_bound`] leaving its frequency-response evaluator in `slot`, for the norm of the
+/// same system if it follows (`ResponseSlot`).
+pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], slot: &mut ResponseSlot) -> f64 {
     if !sys.is_finite() {
         return f64::INFINITY;
     }
@@ -193,6 +201,7 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
                 let s = fr.sigma_max(w.abs());
                 best = if s.is_nan() { f64::INFINITY } else { best.max(s) };
             }
+            slot.keep(sys, fr);
             best
         })
     })

@@ -63,35 +63,118 @@ const SHIFT_FACTORS: [f64; 4] = [1.0, 3.7, 0.23, 17.0];
 /// Sorted-or-not frequencies ω ≥ 0 of the crossings at level γ; `None` if every shift failed.
 /// `scale` is a positive frequency typical of the system (e.g. the geometric mean of its pole
 /// magnitudes).
+///
+/// Shifts are tried in the order of [`SHIFT_FACTORS`]; the first well-conditioned one whose
+/// crossings can be computed gives the result. If none is, the first ill-conditioned one (with
+/// finite T₁₁) whose crossings can be computed does. The crossings of an ill-conditioned shift are
+/// only computed when every shift has failed, and from order [`SCREEN_SHIFTS_FROM`] on a shift that
+/// [`shifted_inverse`] can reject from a lower bound of ‖T₁₁‖ is not even solved for in full (issue 13: on CM4's converged designs
+/// the first shift failed in two tests of three, and each failure cost a full solve plus a PVL
+/// reduction and QR for a fallback that was then not used). The result is the same as computing
+/// every tried shift in full.
 pub(crate) fn pencil_crossings(sys: &StateSpace, gamma: f64, scale: f64) -> Option<Vec<f64>> {
-    let (n, m, p) = (sys.order(), sys.inputs(), sys.outputs());
-    let k = 2 * n + m + p;
+    crossings_screened(sys, gamma, scale, sys.order() >= SCREEN_SHIFTS_FROM)
+}
+
+/// From this order on an ill-conditioned shift is rejected before the full solve (below it the
+/// full solve costs little more than the screen's four single-column solves).
+const SCREEN_SHIFTS_FROM: usize = 30;
+
+/// [`pencil_crossings`], with the early rejection of ill-conditioned shifts if `screen`.
+fn crossings_screened(sys: &StateSpace, gamma: f64, scale: f64, screen: bool) -> Option<Vec<f64>> {
     let base = if scale.is_finite() && scale > 0.0 { scale } else { 1.0 };
-    let mut fallback = None;
+    // Ill-conditioned shifts in the order tried, with T₁₁ if it was computed.
+    let mut ill: Vec<(f64, Option<Mat<f64>>)> = Vec::new();
     for f in SHIFT_FACTORS {
         let s = base * f;
-        let (mat, t) = timed(Step::PencilSolve, || {
-            let mat = shifted_pencil(sys, gamma, s);
-            let lu = mat.partial_piv_lu();
-            let rhs = Mat::<f64>::from_fn(k, 2 * n, |i, j| if i == j { 1.0 } else { 0.0 });
-            let x = lu.solve(rhs);
-            let t = x.as_ref().submatrix(0, 0, 2 * n, 2 * n).to_owned();
-            (mat, t)
-        });
-        let t_norm = t.norm_l2();
-        if !t_norm.is_finite() {
-            continue;
-        }
-        let cond = t_norm * mat.norm_l2();
-        if cond <= MAX_SHIFT_CONDITION {
-            if let Some(ws) = cayley_crossings(t.as_ref(), s) {
-                return Some(ws);
+        match shifted_inverse(sys, gamma, s, screen) {
+            ShiftedInverse::Rejected => ill.push((s, None)),
+            ShiftedInverse::NotFinite => {}
+            ShiftedInverse::Solved { t, well_conditioned: true } => {
+                if let Some(ws) = cayley_crossings(t.as_ref(), s) {
+                    return Some(ws);
+                }
             }
-        } else if fallback.is_none() {
-            fallback = cayley_crossings(t.as_ref(), s);
+            ShiftedInverse::Solved { t, well_conditioned: false } => ill.push((s, Some(t))),
         }
     }
-    fallback
+    ill.into_iter().find_map(|(s, t)| {
+        let t = match t {
+            Some(t) => t,
+            None => match shifted_inverse(sys, gamma, s, false) {
+                ShiftedInverse::Solved { t, .. } => t,
+                _ => return None,
+            },
+        };
+        cayley_crossings(t.as_ref(), s)
+    })
+}
+
+/// The outcome of one shift.
+enum ShiftedInverse {
+    /// T₁₁ = (H − sI)⁻¹ and whether ‖T₁₁‖_F·‖M − sE‖_F ≤ [`MAX_SHIFT_CONDITION`].
+    Solved { t: Mat<f64>, well_conditioned: bool },
+    /// ‖T₁₁‖_F is not finite.
+    NotFinite,
+    /// A lower bound of ‖T₁₁‖ already shows the shift ill-conditioned (by a margin of
+    /// [`REJECT_MARGIN`] against rounding): T₁₁ was not computed.
+    Rejected,
+}
+
+/// Factor by which the lower bound of ‖T₁₁‖·‖M − sE‖_F must exceed [`MAX_SHIFT_CONDITION`] to
+/// reject a shift without the full solve. The bound and the full ‖T₁₁‖_F come from the same LU,
+/// so their rounding differs by far less than this factor: a shift rejected early would have
+/// failed the full test too.
+const REJECT_MARGIN: f64 = 2.0;
+
+/// T₁₁ = first 2n rows of (M − sE)⁻¹[I₂ₙ; 0] by one LU with partial pivoting of M − sE
+/// (module docs). With `screen`, before the 2n-column solve, a lower bound of ‖T₁₁‖₂ ≤ ‖T₁₁‖_F
+/// from one and a half power iterations (y = T₁₁x, z = T₁₁ᵀy: ‖y‖/‖x‖ and ‖z‖/‖y‖ are both at
+/// most ‖T₁₁‖₂; four single-column solves against 2n) rejects a shift close to an eigenvalue.
+fn shifted_inverse(sys: &StateSpace, gamma: f64, s: f64, screen: bool) -> ShiftedInverse {
+    let n = sys.order();
+    let k = 2 * n + sys.inputs() + sys.outputs();
+    timed(Step::PencilSolve, || {
+        let mat = shifted_pencil(sys, gamma, s);
+        let m_norm = mat.norm_l2();
+        let lu = mat.partial_piv_lu();
+        if screen && n > 0 {
+            let t_lower = t11_norm_lower_bound(&lu, n, k);
+            if t_lower.is_finite() && t_lower * m_norm > REJECT_MARGIN * MAX_SHIFT_CONDITION {
+                return ShiftedInverse::Rejected;
+            }
+        }
+        let rhs = Mat::<f64>::from_fn(k, 2 * n, |i, j| if i == j { 1.0 } else { 0.0 });
+        let x = lu.solve(rhs);
+        let t = x.as_ref().submatrix(0, 0, 2 * n, 2 * n).to_owned();
+        let t_norm = t.norm_l2();
+        if !t_norm.is_finite() {
+            return ShiftedInverse::NotFinite;
+        }
+        ShiftedInverse::Solved { t, well_conditioned: t_norm * m_norm <= MAX_SHIFT_CONDITION }
+    })
+}
+
+/// max(‖y‖/‖x‖, ‖z‖/‖y‖) ≤ ‖T₁₁‖₂ for y = T₁₁x, z = T₁₁ᵀy (T₁₁ the leading 2n×2n block of
+/// (M − sE)⁻¹, whose transpose is the leading block of (M − sE)⁻ᵀ), from a fixed x with entries
+/// of varying size and sign (so that it is not orthogonal to a dominant singular vector by
+/// accident). NaN if not finite.
+fn t11_norm_lower_bound(lu: &faer::linalg::solvers::PartialPivLu<f64>, n: usize, k: usize) -> f64 {
+    let x = Mat::<f64>::from_fn(k, 1, |i, _| if i < 2 * n { ((i + 1) as f64).sin() + 0.5 } else { 0.0 });
+    let x_norm = x.norm_l2();
+    let mut y = lu.solve(x);
+    for i in 2 * n..k {
+        y[(i, 0)] = 0.0;
+    }
+    let y_norm = y.norm_l2();
+    let z = lu.solve_transpose(y);
+    let z_norm = z.as_ref().submatrix(0, 0, 2 * n, 1).norm_l2();
+    let bound = (y_norm / x_norm).max(z_norm / y_norm);
+    if bound.is_finite() {
+        bound
+    } else {
+        f64::NAN
+    }
 }
 
 /// M − sE of the module docs.
@@ -146,6 +229,7 @@ fn cayley_crossings(t: MatRef<'_, f64>, s: f64) -> Option<Vec<f64>> {
 mod tests {
     use super::*;
     use crate::lti::freq_response::FreqResponse;
+    use faer::linalg::solvers::DenseSolveCore;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, StandardNormal};
@@ -166,6 +250,35 @@ mod tests {
         let (b, c, d) = (r(n, m, 1.0), r(p, n, delta), r(p, m, 1.0));
         let sd = d.singular_values().unwrap()[0];
         StateSpace { a, b, c, d: d * faer::Scale(1.0 / sd) }
+    }
+
+    /// A shift on a real eigenvalue of H(γ) is rejected from the lower bound of ‖T₁₁‖ alone, the
+    /// bound never exceeds ‖T₁₁‖_F, and the crossings are exactly those of the unscreened path.
+    #[test]
+    fn ill_conditioned_shift_is_rejected_early_with_the_same_crossings() {
+        let sys = near_d_system(12, 2, 3, 1e-2, 3);
+        let mut fr = FreqResponse::new(&sys);
+        let peak = (0..2000).map(|k| fr.sigma_max(10f64.powf(-3.0 + 6.0 * k as f64 / 2000.0))).fold(0.0, f64::max);
+        let gamma = 1.0 + 0.5 * (peak - 1.0).abs();
+        // T₁₁ = (H − sI)⁻¹ at a generic shift gives H = s I + T₁₁⁻¹: its real positive eigenvalues.
+        let n = sys.order();
+        let ShiftedInverse::Solved { t, .. } = shifted_inverse(&sys, gamma, 1.3, false) else { panic!("no inverse") };
+        let h = t.partial_piv_lu().inverse() + Mat::<f64>::identity(2 * n, 2 * n) * faer::Scale(1.3);
+        let ev = crate::lti::spectral::eigenvalues(h.as_ref()).unwrap();
+        let real = ev.iter().filter(|l| l.im == 0.0 && l.re > 0.0).map(|l| l.re).next().expect("a real eigenvalue");
+        for (s, expect_rejected) in [(real, true), (1.3, false), (0.7 * real, false)] {
+            let mat = shifted_pencil(&sys, gamma, s);
+            let k = mat.nrows();
+            let lu = mat.partial_piv_lu();
+            let lb = t11_norm_lower_bound(&lu, n, k);
+            let full = lu.solve(Mat::<f64>::from_fn(k, 2 * n, |i, j| if i == j { 1.0 } else { 0.0 }));
+            let t_norm = full.as_ref().submatrix(0, 0, 2 * n, 2 * n).norm_l2();
+            assert!(lb <= t_norm * (1.0 + 1e-10), "s = {s}: bound {lb:e} above ‖T‖_F {t_norm:e}");
+            let rejected = matches!(shifted_inverse(&sys, gamma, s, true), ShiftedInverse::Rejected);
+            assert_eq!(rejected, expect_rejected, "s = {s}: bound {lb:e}, ‖T‖_F {t_norm:e}");
+            // Every shift order starting at s: the same crossings, bit for bit.
+            assert_eq!(crossings_screened(&sys, gamma, s, true), crossings_screened(&sys, gamma, s, false), "s = {s}");
+        }
     }
 
     #[test]

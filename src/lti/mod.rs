@@ -10,9 +10,11 @@ mod controller;
 mod error;
 pub(crate) mod export;
 pub(crate) mod freq_response;
+pub use freq_response::ResponseSlot;
 mod full_order;
 mod gradient;
 mod hessenberg_qr;
+mod hessenberg_solve;
 mod hinf;
 mod interrupt;
 mod level_set_pencil;
@@ -42,12 +44,14 @@ pub use full_order::{
 };
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, closed_loop_hinf_grad_near,
-    closed_loop_hinf_grad_near_interruptible, controller_abscissa_grad, controller_hinf_grad, ControllerGradient,
+    closed_loop_hinf_grad_near_interruptible, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
+    controller_hinf_grad, ControllerGradient,
 };
 pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
-    hinf_lower_bound, hinf_norm, hinf_norm_interruptible, hinf_norm_near, hinf_norm_near_interruptible, HinfNorm,
-    DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
+    hinf_lower_bound, hinf_lower_bound_sharing, hinf_norm, hinf_norm_interruptible, hinf_norm_near,
+    hinf_norm_near_interruptible, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS,
+    MIN_HINF_TOL,
 };
 pub use interrupt::{Interrupt, Interrupted};
 pub use lyapunov::{lyapunov_residual, solve_lyapunov, stable_antistable_basis, LyapunovError, LYAPUNOV_RESIDUAL_TOL};
