@@ -15,6 +15,12 @@
 //! `cargo test --test hinf_property` runs a fast subset; the full family (4000 systems) is
 //! `cargo test --release --test hinf_property -- --ignored --nocapture`, which prints the counts
 //! and the worst relative error.
+//!
+//! A second, large-order family ([`member_large`], issue 13) covers n = 30…60, where the level-set
+//! test takes Van Loan's squared spectrum, with hard shapes (modes spread over seven decades, two
+//! nearly equal peaks, a dominant peak near ω = 0 or at high ω); its warm-started norm is hinted
+//! at the best lower local peak. Fast subset in `cargo test`; full family (1500 systems) ignored.
+//! `HINF_LARGE_SEEDS=a..b` picks seeds, `HINF_NMAX=80` raises the largest order.
 
 use faer::{c64, Mat};
 use hinfix::lti::{hinf_norm, hinf_norm_near, StateSpace, DEFAULT_HINF_TOL};
@@ -54,10 +60,8 @@ fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     (lo.ln() + (hi.ln() - lo.ln()) * rng.random::<f64>()).exp()
 }
 
-/// Member `seed` of the family.
-fn member(seed: u64) -> Member {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let n = rng.random_range(2..=30usize);
+/// Input and output counts: m = p, or m ≠ p.
+fn dims(rng: &mut ChaCha8Rng) -> (bool, usize, usize) {
     let square = rng.random_bool(0.5);
     let m = rng.random_range(1..=3usize);
     let p = if square {
@@ -69,36 +73,70 @@ fn member(seed: u64) -> Member {
         }
         p
     };
-    // D with σmax(D) = 1; one in four has a repeated largest singular value.
-    let d0 = randn(&mut rng, p, m);
+    (square, m, p)
+}
+
+/// A random p×m D with σmax(D) = 1; one in four (with min(p, m) ≥ 2) has a repeated largest
+/// singular value.
+fn unit_d(rng: &mut ChaCha8Rng, p: usize, m: usize) -> Mat<f64> {
+    let d0 = randn(rng, p, m);
     let svd = d0.svd().unwrap();
     let k = p.min(m);
     let repeated = k >= 2 && rng.random_bool(0.25);
     let s: Vec<f64> =
         (0..k).map(|i| if i == 0 || (repeated && i == 1) { 1.0 } else { svd.S()[i] / svd.S()[0] }).collect();
-    let d = Mat::from_fn(p, m, |i, j| (0..k).map(|l| svd.U()[(i, l)] * s[l] * svd.V()[(j, l)]).sum::<f64>());
+    Mat::from_fn(p, m, |i, j| (0..k).map(|l| svd.U()[(i, l)] * s[l] * svd.V()[(j, l)]).sum::<f64>())
+}
 
+/// The mode of natural frequency `w` and damping `zeta` ((σ, ω) of `Member::modes`); a real pole
+/// −w if `zeta` is NaN.
+fn mode(w: f64, zeta: f64) -> (f64, f64) {
+    if zeta.is_nan() {
+        (-w, f64::NAN)
+    } else {
+        (-zeta * w, w * (1.0 - zeta * zeta).sqrt())
+    }
+}
+
+/// blockdiag of the modes: [σ ω; −ω σ] per complex mode, σ per real pole.
+fn modal_blocks(modes: &[(f64, f64)], n: usize) -> Mat<f64> {
+    let mut blocks = Mat::<f64>::zeros(n, n);
+    let mut i = 0;
+    for &(re, im) in modes {
+        blocks[(i, i)] = re;
+        if im.is_nan() {
+            i += 1;
+        } else {
+            blocks[(i + 1, i + 1)] = re;
+            blocks[(i, i + 1)] = im;
+            blocks[(i + 1, i)] = -im;
+            i += 2;
+        }
+    }
+    blocks
+}
+
+/// Member `seed` of the family (n from 2 to 30).
+fn member(seed: u64) -> Member {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let n = rng.random_range(2..=30usize);
+    let (square, m, p) = dims(&mut rng);
+    let d = unit_d(&mut rng, p, m);
     let lightly_damped = rng.random_bool(0.5);
     let mut modes = Vec::new();
-    let mut blocks = Mat::<f64>::zeros(n, n);
     let mut i = 0;
     while i < n {
         let w = log_uniform(&mut rng, 1e-2, 1e2);
         if i + 1 == n {
-            blocks[(i, i)] = -w;
-            modes.push((-w, f64::NAN));
+            modes.push(mode(w, f64::NAN));
             i += 1;
             continue;
         }
         let zeta = if lightly_damped { log_uniform(&mut rng, 1e-4, 1e-2) } else { rng.random_range(0.2..0.95) };
-        let (re, im) = (-zeta * w, w * (1.0 - zeta * zeta).sqrt());
-        blocks[(i, i)] = re;
-        blocks[(i + 1, i + 1)] = re;
-        blocks[(i, i + 1)] = im;
-        blocks[(i + 1, i)] = -im;
-        modes.push((re, im));
+        modes.push(mode(w, zeta));
         i += 2;
     }
+    let blocks = modal_blocks(&modes, n);
     let q = randn(&mut rng, n, n).qr().compute_Q();
     let a = &q * &blocks * q.transpose();
     let b0 = randn(&mut rng, n, m);
@@ -108,6 +146,95 @@ fn member(seed: u64) -> Member {
     let c_modal = &c * &q;
     let b_modal = q.transpose() * &b0;
     Member { sys: StateSpace::new(a, b0, c, d).unwrap(), modes, c_modal, b_modal, delta, lightly_damped, square }
+}
+
+/// The shapes of the large-order family ([`member_large`]).
+const LARGE_SHAPES: [&str; 5] = ["random", "spread", "twin peaks", "peak near 0", "peak at high ω"];
+
+/// Member `seed` of the large-order family: n from 30 to `n_max`, where the level-set test takes
+/// the squared (explicit Hamiltonian) path whenever κ ≤ 1e3. G = D + δ·G₀ with σmax(D) = 1 and δ
+/// from 1e-3 to 3, or D = 0 (κ = 1). Shapes ([`LARGE_SHAPES`]): random modes in [1e-2, 1e2];
+/// modes spread over [1e-3, 1e4] (very different magnitudes: ‖H‖ large against the low
+/// crossings); two lightly damped modes with equal resonance heights (two nearly equal peaks);
+/// a dominant low mode or pole in [1e-4, 1e-2] (peak near ω = 0); a dominant mode in [1e3, 1e4].
+/// Each mode's input map is scaled to give it a resonance height (≈ ‖cₖ‖‖bₖ‖/(2ζω)) drawn
+/// below the dominant ones'.
+fn member_large(seed: u64, n_max: usize) -> (Member, &'static str) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x13_0000_0000);
+    let n = rng.random_range(30..=n_max);
+    let (square, m, p) = dims(&mut rng);
+    let zero_d = rng.random_bool(0.25);
+    let d = if zero_d { Mat::zeros(p, m) } else { unit_d(&mut rng, p, m) };
+    let shape = rng.random_range(0..LARGE_SHAPES.len());
+    let lightly_damped = shape == 2 || rng.random_bool(0.5);
+    let damping = |rng: &mut ChaCha8Rng| {
+        if lightly_damped {
+            log_uniform(rng, 1e-4, 1e-2)
+        } else {
+            rng.random_range(0.05..0.9)
+        }
+    };
+    let (lo, hi) = if shape == 1 { (1e-3, 1e4) } else { (1e-2, 1e2) };
+    let mut modes = Vec::new();
+    let mut heights = Vec::new();
+    let mut i = 0;
+    while i < n {
+        let w = log_uniform(&mut rng, lo, hi);
+        let zeta = if i + 1 == n { f64::NAN } else { damping(&mut rng) };
+        modes.push(mode(w, zeta));
+        heights.push(log_uniform(&mut rng, 1e-2, 0.5));
+        i += if zeta.is_nan() { 1 } else { 2 };
+    }
+    // The dominant modes.
+    let k = modes.len();
+    match shape {
+        2 if k >= 3 => {
+            let (a, b) = (0, k / 2);
+            heights[a] = 1.0;
+            heights[b] = 1.0 + log_uniform(&mut rng, 1e-6, 1e-2);
+        }
+        3 => {
+            let w = log_uniform(&mut rng, 1e-4, 1e-2);
+            modes[0] = mode(w, if rng.random_bool(0.5) { f64::NAN } else { damping(&mut rng) });
+            heights[0] = 1.0;
+        }
+        4 => {
+            modes[0] = mode(log_uniform(&mut rng, 1e3, 1e4), damping(&mut rng));
+            heights[0] = 1.0;
+        }
+        _ => {}
+    }
+    // A dominant real pole replacing a complex mode: one state to fill, to keep the order n.
+    let dim: usize = modes.iter().map(|m| if m.1.is_nan() { 1 } else { 2 }).sum();
+    if dim < n {
+        modes.push(mode(log_uniform(&mut rng, lo, hi), f64::NAN));
+        heights.push(log_uniform(&mut rng, 1e-2, 0.5));
+    }
+    let blocks = modal_blocks(&modes, n);
+    let q = randn(&mut rng, n, n).qr().compute_Q();
+    let a = &q * &blocks * q.transpose();
+    let c_unit = randn(&mut rng, p, n);
+    let mut b_modal = randn(&mut rng, n, m);
+    let mut i = 0;
+    for (&(re, im), &h) in modes.iter().zip(&heights) {
+        let rows = if im.is_nan() { 1 } else { 2 };
+        let norm = |mat: faer::MatRef<'_, f64>| mat.norm_l2();
+        let gain = norm(c_unit.as_ref().submatrix(0, i, p, rows)) * norm(b_modal.as_ref().submatrix(i, 0, rows, m));
+        let scale = h * rows as f64 * re.abs() / gain;
+        for r in i..i + rows {
+            for j in 0..m {
+                b_modal[(r, j)] *= scale;
+            }
+        }
+        i += rows;
+    }
+    let delta = if zero_d { 1.0 } else { log_uniform(&mut rng, 1e-3, 3.0) };
+    let c_modal = &c_unit * faer::Scale(delta);
+    let b = &q * &b_modal;
+    let c = &c_modal * q.transpose();
+    let mb =
+        Member { sys: StateSpace::new(a, b, c, d).unwrap(), modes, c_modal, b_modal, delta, lightly_damped, square };
+    (mb, LARGE_SHAPES[shape])
 }
 
 /// σmax(G(iω)) in modal coordinates (ω = ∞ gives σmax(D)).
@@ -160,8 +287,16 @@ fn eval_error(mb: &Member, w: f64) -> f64 {
     f64::EPSILON * mb.sys.a.norm_l2() / dist
 }
 
-/// The truth: (max σmax, its frequency) over a dense sweep, refined around the best peaks.
-fn truth(mb: &Member) -> (f64, f64) {
+/// The truth: max σmax and its frequency over a dense sweep, refined around the best peaks, and
+/// the frequency of the best other local maximum of the sweep (a lower peak, where a warm start
+/// from a nearby system would put its hint).
+struct Truth {
+    value: f64,
+    freq: f64,
+    runner_up: Option<f64>,
+}
+
+fn truth(mb: &Member) -> Truth {
     let mut ws: Vec<f64> = Vec::new();
     let wn: Vec<(f64, f64)> = mb
         .modes
@@ -175,7 +310,7 @@ fn truth(mb: &Member) -> (f64, f64) {
             }
         })
         .collect();
-    let lo = wn.iter().map(|x| x.0).fold(f64::INFINITY, f64::min) * 1e-3;
+    let lo = wn.iter().map(|x| x.0).fold(f64::INFINITY, f64::min).max(1e-300) * 1e-3;
     let hi = wn.iter().map(|x| x.0).fold(0.0, f64::max) * 1e4;
     let npts = 3000;
     for k in 0..=npts {
@@ -229,7 +364,12 @@ fn truth(mb: &Member) -> (f64, f64) {
             }
         }
     }
-    best
+    // The best sweep maximum whose frequency differs from the peak's by more than 1 %.
+    let runner_up = peaks
+        .iter()
+        .map(|&i| ws[i])
+        .find(|&w| w > 0.0 && w.is_finite() && !(best.1.is_finite() && (w / best.1).ln().abs() < 0.01));
+    Truth { value: best.0, freq: best.1, runner_up }
 }
 
 #[derive(Default)]
@@ -245,20 +385,36 @@ struct Tally {
     failures: Vec<String>,
 }
 
-fn check(seeds: std::ops::Range<u64>) -> Tally {
+/// The family's members with the hints of their warm-started norm.
+type Family = fn(u64) -> (Member, &'static str);
+
+/// The first family: n from 2 to 30, hinted at a frequency unrelated to the peak.
+fn small(seed: u64) -> (Member, &'static str) {
+    (member(seed), "")
+}
+
+/// The large-order family up to n = 60.
+fn large(seed: u64) -> (Member, &'static str) {
+    member_large(seed, std::env::var("HINF_NMAX").ok().and_then(|v| v.parse().ok()).unwrap_or(60))
+}
+
+fn check(family: Family, seeds: impl IntoIterator<Item = u64>) -> Tally {
     let mut t = Tally::default();
     for seed in seeds {
-        let mb = member(seed);
-        let (want, want_w) = truth(&mb);
+        let (mb, shape) = family(seed);
+        let Truth { value: want, freq: want_w, runner_up } = truth(&mb);
         let got = hinf_norm(&mb.sys, DEFAULT_HINF_TOL);
         if let Ok(dir) = std::env::var("HINF_DUMP") {
             let j = |m: &Mat<f64>| hinfix::lti::matrix_to_json(m.as_ref());
-            let doc = serde_json::json!({"A": j(&mb.sys.a), "B": j(&mb.sys.b), "C": j(&mb.sys.c), "D": j(&mb.sys.d)});
+            let doc = serde_json::json!({"A": j(&mb.sys.a), "B": j(&mb.sys.b), "C": j(&mb.sys.c), "D": j(&mb.sys.d),
+                "truth": want, "truth_freq": want_w, "runner_up": runner_up});
             std::fs::write(format!("{dir}/seed{seed}.json"), doc.to_string()).unwrap();
         }
-        // The warm-started norm (design runs) with a misleading hint: a frequency unrelated to
-        // the peak, so its certification has to find the peak.
-        let hint = 10f64.powf(-2.0 + 4.0 * ((seed * 7919) % 1000) as f64 / 1000.0);
+        // The warm-started norm (design runs). The first family: a misleading hint, a frequency
+        // unrelated to the peak, so its certification has to find the peak. The large family: a
+        // hint on the best lower local peak, as a warm start from a nearby system gives it.
+        let unrelated = 10f64.powf(-2.0 + 4.0 * ((seed * 7919) % 1000) as f64 / 1000.0);
+        let hint = if shape.is_empty() { unrelated } else { runner_up.unwrap_or(unrelated) };
         let hinted = hinf_norm_near(&mb.sys, DEFAULT_HINF_TOL, &[hint]);
         t.count += 1;
         t.square += mb.square as usize;
@@ -280,7 +436,7 @@ fn check(seeds: std::ops::Range<u64>) -> Tally {
             let failed = !(under <= allowed) || !(over <= allowed);
             if failed {
                 t.failures.push(format!(
-                    "seed {seed}{label}: n={} m={} p={} δ={:.2e} light={}: hinf {} at ω={} (attains {attained}), truth {want} at ω={want_w}, under {under:.2e}",
+                    "seed {seed}{label} {shape}: n={} m={} p={} δ={:.2e} light={}: hinf {} at ω={} (attains {attained}), truth {want} at ω={want_w}, under {under:.2e}",
                     mb.sys.order(), mb.sys.inputs(), mb.sys.outputs(), mb.delta, mb.lightly_damped, got.value, got.peak_freq
                 ));
             }
@@ -294,7 +450,7 @@ fn report(t: &Tally) {
         "{} systems ({} square D, {} non-square; {} lightly damped; {} with the peak at ω = ∞): worst under-estimate {:.3e} (seed {}), worst over-estimate {:.3e}, {} failures",
         t.count, t.square, t.non_square, t.light, t.peak_at_infinity, t.worst_under, t.worst_under_seed, t.worst_over, t.failures.len()
     );
-    for f in t.failures.iter().take(20) {
+    for f in t.failures.iter().take(200) {
         println!("  {f}");
     }
 }
@@ -302,8 +458,8 @@ fn report(t: &Tally) {
 #[test]
 fn hinf_norm_never_under_estimates_near_sigma_max_d_fast_subset() {
     let t = match std::env::var("HINF_SEED").ok().and_then(|s| s.parse::<u64>().ok()) {
-        Some(s) => check(s..s + 1),
-        None => check(0..120),
+        Some(s) => check(small, s..s + 1),
+        None => check(small, 0..120),
     };
     report(&t);
     assert!(t.failures.is_empty(), "{} of {} systems failed", t.failures.len(), t.count);
@@ -312,7 +468,38 @@ fn hinf_norm_never_under_estimates_near_sigma_max_d_fast_subset() {
 #[test]
 #[ignore = "full property family (4000 systems): run with --release -- --ignored --nocapture"]
 fn hinf_norm_never_under_estimates_near_sigma_max_d_full_family() {
-    let t = check(0..4000);
+    let t = check(small, 0..4000);
+    report(&t);
+    assert!(t.failures.is_empty(), "{} of {} systems failed", t.failures.len(), t.count);
+}
+
+/// Seeds `HINF_LARGE_SEEDS` (`a..b`) of the large-order family, else `default`.
+fn large_seeds(default: std::ops::Range<u64>) -> std::ops::Range<u64> {
+    std::env::var("HINF_LARGE_SEEDS")
+        .ok()
+        .and_then(|s| s.split_once("..").and_then(|(a, b)| Some(a.parse().ok()?..b.parse().ok()?)))
+        .unwrap_or(default)
+}
+
+/// Members of the large family that main 7d158f7 got wrong (0.3 % to 1.8 % low): a pencil
+/// crossing mapped to ω = ∞ (188), crossings of narrow low-frequency peaks lost or misplaced by
+/// the squared spectrum (246, 323, 951).
+const LARGE_REGRESSIONS: [u64; 4] = [188, 246, 323, 951];
+
+#[test]
+fn hinf_norm_never_under_estimates_at_large_order_fast_subset() {
+    let t = match std::env::var("HINF_LARGE_SEEDS") {
+        Ok(_) => check(large, large_seeds(0..0)),
+        Err(_) => check(large, (0..20).chain(LARGE_REGRESSIONS)),
+    };
+    report(&t);
+    assert!(t.failures.is_empty(), "{} of {} systems failed", t.failures.len(), t.count);
+}
+
+#[test]
+#[ignore = "full large-order family (1500 systems, n = 30..60): run with --release -- --ignored --nocapture"]
+fn hinf_norm_never_under_estimates_at_large_order_full_family() {
+    let t = check(large, large_seeds(0..1500));
     report(&t);
     assert!(t.failures.is_empty(), "{} of {} systems failed", t.failures.len(), t.count);
 }

@@ -86,10 +86,28 @@ fn nn5_with_first_order_controller_finds_the_peak_near_zero() {
 /// peak. Reference: SLICOT AB13DD on each closed loop (tol 1e-12), re-checked by dense evaluation.
 #[test]
 fn ac4_warm_started_norms_reach_the_true_peak() {
-    let text = std::fs::read_to_string(fixture("ac4_warm_cases.json")).unwrap();
+    assert_cases_reach_reference("ac4_warm_cases.json", 5);
+}
+
+/// Systems of order 30 to 59 (the squared level-set path, issue 13) from the large-order property
+/// family, on which the cold or the hinted norm came out low by 2.7e-4 to 2.8e-2: the squared
+/// spectrum lost the crossings of narrow low-frequency peaks (seeds 323, 243, 850, 15) or placed
+/// them at the wrong frequency (1588), and the pencil's crossing mapped to ω = ∞ hid a peak at
+/// 9e3 rad/s (204). Reference: σmax at the peak of the family's independent modal sweep (dense
+/// numpy solve; AB13DD is itself low on four of them, see the fixture).
+#[test]
+fn large_order_norms_reach_the_true_peak() {
+    assert_cases_reach_reference("large_order_cases.json", 6);
+}
+
+/// Every case of the fixture `file` (keys A, B, C, D, reference, reference_freq, hints,
+/// old_warm_value, optional eval_tol): the reference is attained, the old value was low, and both the cold and the
+/// hinted norm reach the reference without exceeding it.
+fn assert_cases_reach_reference(file: &str, count: usize) {
+    let text = std::fs::read_to_string(fixture(file)).unwrap();
     let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
     let cases = doc["cases"].as_array().unwrap();
-    assert_eq!(cases.len(), 5);
+    assert_eq!(cases.len(), count);
     for (i, c) in cases.iter().enumerate() {
         let rows = |key: &str| c[key].as_array().unwrap().len();
         let cols = |key: &str| c[key][0].as_array().unwrap().len();
@@ -98,16 +116,19 @@ fn ac4_warm_started_norms_reach_the_true_peak() {
         let peak = c["reference"].as_f64().unwrap();
         let old = c["old_warm_value"].as_f64().unwrap();
         let hints: Vec<f64> = c["hints"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-        assert!((sigma_direct(&cl, c["reference_freq"].as_f64().unwrap()) - peak).abs() <= 1e-10 * peak, "case {i}");
-        assert!(old < peak * (1.0 - 5e-6), "case {i} must be one the old warm start got wrong");
+        // Two dense evaluations of a very sharp peak may differ by more than 1e-10 (`eval_tol`).
+        let tol = c["eval_tol"].as_f64().unwrap_or(1e-10);
+        let attained = sigma_direct(&cl, c["reference_freq"].as_f64().unwrap());
+        assert!((attained - peak).abs() <= tol * peak, "case {i}: σ at the reference frequency {attained} vs {peak}");
+        assert!(old < peak * (1.0 - (10.0 * tol).max(5e-6)), "case {i} must be one the old norm got wrong");
         for h in [hinf_norm_near(&cl, DEFAULT_HINF_TOL, &hints), hinf_norm(&cl, DEFAULT_HINF_TOL)] {
             assert!(
-                h.value >= peak * (1.0 - 1e-9),
+                h.value >= peak * (1.0 - tol.max(1e-9)),
                 "case {i}: ‖T‖∞ = {} at ω = {}, below the reference {peak}",
                 h.value,
                 h.peak_freq
             );
-            assert!(h.value <= peak * (1.0 + 1e-9), "case {i}: {} above the reference {peak}", h.value);
+            assert!(h.value <= peak * (1.0 + tol.max(1e-9)), "case {i}: {} above the reference {peak}", h.value);
         }
     }
 }
