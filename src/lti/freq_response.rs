@@ -342,21 +342,30 @@ mod tests {
         })
     }
 
+    /// Uniform numbers in [−½, ½) from a 64-bit LCG (Knuth's MMIX constants), seeded.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        }
+    }
+
+    /// A system of order n with m inputs and p outputs, entries from `rnd`.
+    fn random_system(rnd: &mut impl FnMut() -> f64, n: usize, m: usize, p: usize) -> StateSpace {
+        StateSpace {
+            a: Mat::from_fn(n, n, |_, _| rnd()),
+            b: Mat::from_fn(n, m, |_, _| rnd()),
+            c: Mat::from_fn(p, n, |_, _| rnd()),
+            d: Mat::from_fn(p, m, |_, _| rnd()),
+        }
+    }
+
     /// From order 30 on the split solve gives bit for bit the interleaved solve's G(iω).
     #[test]
     fn split_solve_has_the_interleaved_bits() {
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = uniform(11);
         for &(n, m, p) in &[(30, 1, 3), (45, 2, 4), (83, 3, 2)] {
-            let sys = StateSpace {
-                a: Mat::from_fn(n, n, |_, _| rnd()),
-                b: Mat::from_fn(n, m, |_, _| rnd()),
-                c: Mat::from_fn(p, n, |_, _| rnd()),
-                d: Mat::from_fn(p, m, |_, _| rnd()),
-            };
+            let sys = random_system(&mut rnd, n, m, p);
             let mut split = FreqResponse::new(&sys);
             assert!(split.large.is_some());
             let mut interleaved = FreqResponse::new(&sys);
@@ -375,18 +384,9 @@ mod tests {
 
     #[test]
     fn hessenberg_matches_direct_solve() {
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = uniform(7);
         for &(n, m, p) in &[(1, 1, 1), (2, 2, 3), (7, 3, 2), (40, 2, 2), (90, 4, 3)] {
-            let sys = StateSpace {
-                a: Mat::from_fn(n, n, |_, _| rnd()),
-                b: Mat::from_fn(n, m, |_, _| rnd()),
-                c: Mat::from_fn(p, n, |_, _| rnd()),
-                d: Mat::from_fn(p, m, |_, _| rnd()),
-            };
+            let sys = random_system(&mut rnd, n, m, p);
             let mut fr = FreqResponse::new(&sys);
             for &w in &[0.0, 0.3, 2.0, 17.0] {
                 let g1 = fr.eval(w).to_owned();
