@@ -38,7 +38,8 @@
 //! (`square_reduced.rs`: an orthogonal symplectic reduction, then an n×n Hessenberg QR instead
 //! of a 2n×2n one), as AB13DD also uses a structure-preserving method. Its eigenvalues μ = λ²
 //! are accurate to ε‖H‖² in absolute terms when well conditioned, and the imaginary-axis test
-//! below is applied to μ with that error added (`squared_crossings`), so it errs towards
+//! below is applied to μ with the bound `SquaredSpectrum::abs_error` (100·ε·‖H²‖_F, which
+//! understates ε‖H‖² when H is unbalanced) added (`squared_crossings`), so it errs towards
 //! reporting a crossing. Small μ near the crossings' half-line are not that accurate (clusters of
 //! a narrow low-frequency peak, or noise): with such *doubtful* eigenvalues the squared spectrum
 //! gives no verdict and the pencil decides at that γ (docs/ALGORITHMS.md §5.3, issue 13).
@@ -560,7 +561,8 @@ fn imaginary_axis_threshold(max_abs: f64) -> f64 {
     f64::EPSILON.sqrt() * (100.0 + max_abs).sqrt()
 }
 
-/// Multiple of the squared spectrum's error bound e (`SquaredSpectrum::abs_error`, ε‖H‖²)
+/// Multiple of the squared spectrum's error bound e (`SquaredSpectrum::abs_error`, 100·ε·‖H²‖_F,
+/// which understates the error ε‖H‖² of small μ when H is unbalanced)
 /// within which a small eigenvalue μ = λ² near the half-line of crossings is doubtful
 /// ([`squared_crossings`]). The bound holds for well-conditioned eigenvalues only: in the large
 /// property family (`tests/hinf_property.rs`, n = 30…80) clustered small μ were off by up to
