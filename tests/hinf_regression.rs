@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use hinfix::lti::{
-    closed_loop, closed_loop_hinf_grad, hinf_norm, hinf_norm_near, matrix_from_json, Controller, Plant, StateSpace,
-    DEFAULT_HINF_TOL,
+    closed_loop, closed_loop_hinf_grad, hinf_norm, hinf_norm_near, matrix_from_json, Controller, HinfNorm, Plant,
+    StateSpace, DEFAULT_HINF_TOL,
 };
 
 mod common;
@@ -25,31 +25,10 @@ fn fixture(name: &str) -> PathBuf {
 fn my3_with_second_order_controller_reaches_the_true_peak() {
     const PEAK: f64 = 1.84462227006357;
     const PEAK_FREQ: f64 = 7.366547824461476;
-    let plant = Plant::load(fixture("my3.json")).unwrap();
-    let k = Controller::load(fixture("my3_controller.json")).unwrap();
-    let cl = closed_loop(&plant, &k).unwrap();
-    // The reference is an attained value.
-    assert!((sigma_direct(&cl, PEAK_FREQ) - PEAK).abs() <= 1e-13 * PEAK);
+    let (cl, h) = assert_closed_loop_reaches_peak("my3", PEAK, PEAK_FREQ, 1e-13, 1e-12);
     let sigma_d = sigma_direct(&cl, f64::INFINITY);
     assert!(PEAK / sigma_d - 1.0 < 5e-6, "the case must stay in the γ ≈ σmax(D) regime");
-
-    let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
-    assert!(
-        h.value >= PEAK * (1.0 - 2.0 * DEFAULT_HINF_TOL),
-        "‖Tzw‖∞ = {} at ω = {}, below the peak {PEAK}",
-        h.value,
-        h.peak_freq
-    );
-    assert!(
-        (sigma_direct(&cl, h.peak_freq) - h.value).abs() <= 1e-12 * h.value,
-        "the value is attained at the returned frequency"
-    );
-    assert!(h.value <= PEAK * (1.0 + 1e-12), "{} exceeds the peak", h.value);
     assert!((h.peak_freq / PEAK_FREQ).ln().abs() < 1e-3, "peak at {} instead of {PEAK_FREQ}", h.peak_freq);
-
-    // The design objective's path (norm + gradient) gives the same value.
-    let (h2, _) = closed_loop_hinf_grad(&plant, &k, DEFAULT_HINF_TOL).unwrap();
-    assert!((h2.value - h.value).abs() <= 1e-12 * h.value);
 }
 
 /// COMPleib NN5 (v1.1, not a shipped plant) with a first-order controller from a design run
@@ -60,23 +39,41 @@ fn my3_with_second_order_controller_reaches_the_true_peak() {
 /// tol 1e-12) on this closed loop, re-checked below by a dense evaluation.
 #[test]
 fn nn5_with_first_order_controller_finds_the_peak_near_zero() {
-    const PEAK: f64 = 238.95750917874545;
-    const PEAK_FREQ: f64 = 0.05483152189579664;
-    let plant = Plant::load(fixture("nn5.json")).unwrap();
-    let k = Controller::load(fixture("nn5_controller.json")).unwrap();
+    assert_closed_loop_reaches_peak("nn5", 238.95750917874545, 0.05483152189579664, 1e-11, 1e-10);
+}
+
+/// The closed loop of the fixtures `{name}.json` (plant) and `{name}_controller.json`: the
+/// reference `peak` is attained at `peak_freq` (to `ref_tol`, relative), and ‖T‖∞ reaches it
+/// (to twice the norm's tolerance), does not exceed it (by more than `tol`), is attained at the
+/// returned frequency (to `tol`), and the design objective's path (norm + gradient) gives the same
+/// value. Returns the closed loop and its norm for case-specific checks.
+fn assert_closed_loop_reaches_peak(
+    name: &str,
+    peak: f64,
+    peak_freq: f64,
+    ref_tol: f64,
+    tol: f64,
+) -> (StateSpace, HinfNorm) {
+    let plant = Plant::load(fixture(&format!("{name}.json"))).unwrap();
+    let k = Controller::load(fixture(&format!("{name}_controller.json"))).unwrap();
     let cl = closed_loop(&plant, &k).unwrap();
-    assert!((sigma_direct(&cl, PEAK_FREQ) - PEAK).abs() <= 1e-11 * PEAK);
+    // The reference is an attained value.
+    assert!((sigma_direct(&cl, peak_freq) - peak).abs() <= ref_tol * peak, "{name}: reference not attained");
     let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
     assert!(
-        h.value >= PEAK * (1.0 - 2.0 * DEFAULT_HINF_TOL),
-        "‖Tzw‖∞ = {} at ω = {}, below {PEAK}",
+        h.value >= peak * (1.0 - 2.0 * DEFAULT_HINF_TOL),
+        "{name}: ‖Tzw‖∞ = {} at ω = {}, below the peak {peak}",
         h.value,
         h.peak_freq
     );
-    assert!(h.value <= PEAK * (1.0 + 1e-10), "{} exceeds the peak", h.value);
-    assert!((sigma_direct(&cl, h.peak_freq) - h.value).abs() <= 1e-10 * h.value, "attained at the returned frequency");
+    assert!(h.value <= peak * (1.0 + tol), "{name}: {} exceeds the peak", h.value);
+    assert!(
+        (sigma_direct(&cl, h.peak_freq) - h.value).abs() <= tol * h.value,
+        "{name}: not attained at the returned frequency"
+    );
     let (h2, _) = closed_loop_hinf_grad(&plant, &k, DEFAULT_HINF_TOL).unwrap();
-    assert!((h2.value - h.value).abs() <= 1e-12 * h.value);
+    assert!((h2.value - h.value).abs() <= 1e-12 * h.value, "{name}: the objective's path differs");
+    (cl, h)
 }
 
 /// Closed loops of COMPleib AC4 with second-order controllers, met in one design run (ε = 1e-3,
