@@ -430,6 +430,29 @@ mod tests {
         }
     }
 
+    /// H = [F s·G; K/s −Fᵀ] has the eigenvalues of [F G; K −Fᵀ] for any s > 0. Unbalanced
+    /// (s = 1e6), its unscaled square would carry errors ε‖H‖² ≈ 1e-4, far above the bound
+    /// 100·ε·‖H²‖_F; balanced, every μ stays within the bound of the balanced matrix.
+    #[test]
+    fn an_unbalanced_hamiltonian_keeps_its_accuracy() {
+        let n = 40;
+        let ([f, g, k], h) = random_hamiltonian(n, 21);
+        let truth = eigenvalues(h.as_ref()).unwrap();
+        let balanced = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
+        for s in [1e6, 1e-6, 3.3e5] {
+            let (gs, ks) = (&g * faer::Scale(s), &k * faer::Scale(1.0 / s));
+            assert_eq!(symplectic_balance_exponent(gs.norm_l2(), ks.norm_l2()), (s.log2()).round(), "s = {s}");
+            let sq = hamiltonian_squared_eigenvalues(f.as_ref(), gs.as_ref(), ks.as_ref()).unwrap();
+            assert!(sq.abs_error <= 2.0 * balanced.abs_error, "s = {s}: bound {:e}", sq.abs_error);
+            for mu in &sq.mu {
+                let off = truth.iter().map(|l| (l * l - mu).norm()).fold(f64::INFINITY, f64::min);
+                assert!(off <= 10.0 * sq.abs_error, "s = {s}: μ = {mu} off by {off:e} (bound {:e})", sq.abs_error);
+            }
+        }
+        assert_eq!(symplectic_balance_exponent(0.0, 1.0), 0.0);
+        assert_eq!(symplectic_balance_exponent(1.0, 0.0), 0.0);
+    }
+
     #[test]
     fn purely_imaginary_pairs_give_negative_real_squares() {
         // H = [0 I; −diag(ω²) 0]: eigenvalues ±iωₖ, so μ = −ωₖ² exactly.
