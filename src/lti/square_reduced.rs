@@ -37,9 +37,10 @@ use crate::numeric::dot_four_lanes;
 /// The eigenvalues μ = λ² of H² (one per pair ±λ of H) and a bound on their absolute error.
 pub(crate) struct SquaredSpectrum {
     pub mu: Vec<c64>,
-    /// c·ε·‖H²‖_F: rounding in the formation of H², the reduction and the QR. This is ε‖H‖² (module
-    /// docs) only when H is balanced; when its off-diagonal blocks differ much in size, ‖H²‖_F is
-    /// far below ‖H‖² and this understates the error of small μ (docs/ALGORITHMS.md §5.3).
+    /// c·ε·‖H²‖_F of the balanced H ([`hamiltonian_squared_eigenvalues`]): rounding in the
+    /// formation of H², the reduction and the QR. This is ε‖H‖² (module docs) only when ‖H‖² is
+    /// near ‖H²‖; the balancing makes the off-diagonal blocks equal, but a large F or cancellation
+    /// inside H² can still leave it below the error of small μ (docs/ALGORITHMS.md §5.3).
     pub abs_error: f64,
 }
 
