@@ -37,9 +37,10 @@ use crate::numeric::dot_four_lanes;
 /// The eigenvalues μ = λ² of H² (one per pair ±λ of H) and a bound on their absolute error.
 pub(crate) struct SquaredSpectrum {
     pub mu: Vec<c64>,
-    /// c·ε·‖H²‖_F: rounding in the formation of H², the reduction and the QR. This is ε‖H‖² (module
-    /// docs) only when H is balanced; when its off-diagonal blocks differ much in size, ‖H²‖_F is
-    /// far below ‖H‖² and this understates the error of small μ (docs/ALGORITHMS.md §5.3).
+    /// c·ε·‖H²‖_F of the balanced H ([`hamiltonian_squared_eigenvalues`]): rounding in the
+    /// formation of H², the reduction and the QR. This is ε‖H‖² (module docs) only when ‖H‖² is
+    /// near ‖H²‖; the balancing makes the off-diagonal blocks equal, but a large F or cancellation
+    /// inside H² can still leave it below the error of small μ (docs/ALGORITHMS.md §5.3).
     pub abs_error: f64,
 }
 
@@ -54,11 +55,22 @@ const ERROR_FACTOR: f64 = 100.0;
 
 /// λ(H)² for the real Hamiltonian H = [F G; K −Fᵀ] (G, K symmetric, all n×n); `None` if the
 /// data are not finite or the QR fails.
+///
+/// H is first balanced by the symplectic similarity diag(√s·I, I/√s) (see
+/// [`symplectic_balance_exponent`]), which turns G, K into G/s, s·K and leaves the eigenvalues
+/// unchanged.
 pub(crate) fn hamiltonian_squared_eigenvalues(
     f: MatRef<'_, f64>,
     g: MatRef<'_, f64>,
     k: MatRef<'_, f64>,
 ) -> Option<SquaredSpectrum> {
+    let (g_norm, k_norm) = (g.norm_l2(), k.norm_l2());
+    if !(g_norm.is_finite() && k_norm.is_finite()) {
+        return None;
+    }
+    let e = symplectic_balance_exponent(g_norm, k_norm);
+    let (g, k) = (g * faer::Scale((-e).exp2()), k * faer::Scale(e.exp2()));
+    let (g, k) = (g.as_ref(), k.as_ref());
     // M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], and GFᵀ = (FG)ᵀ, FᵀK = (KF)ᵀ.
     let (m11, m12, m21) = timed(Step::HamiltonianSquare, || {
         let m11 = f * f + g * k;
@@ -72,6 +84,24 @@ pub(crate) fn hamiltonian_squared_eigenvalues(
     }
     let mu = skew_hamiltonian_eigenvalues(m11.as_ref(), m12.as_ref(), m21.as_ref())?;
     Some(SquaredSpectrum { mu, abs_error: ERROR_FACTOR * f64::EPSILON * norm.max(f64::MIN_POSITIVE) })
+}
+
+/// The exponent t (an integer, as f64) of the symplectic scaling s = 2ᵗ ≈ √(‖G‖/‖K‖) that makes
+/// the off-diagonal blocks G/s and s·K of a Hamiltonian [F G; K −Fᵀ] equally large (0 if either
+/// is zero). A power of two, so the scaling is exact in floating point.
+///
+/// Why: the squared method's μ = λ² are backward stable for H², with absolute errors of order
+/// ε‖H‖² (Van Loan 1984). When ‖G‖ and ‖K‖ differ by orders of magnitude, H² cancels them
+/// (its blocks hold the products GK, FG, KF), so ‖H‖² is far above ‖H²‖ and the small μ are
+/// computed with errors far above the bound ε‖H²‖ (a converged BDT2 closed loop: ‖H‖₂² ≈ 3.4e10
+/// against ‖H²‖_F ≈ 2.2e6). Balanced, ‖H‖² shrinks towards ‖H²‖ (docs/ALGORITHMS.md §5.3).
+fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
+    if !(g_norm > 0.0 && k_norm > 0.0) {
+        return 0.0;
+    }
+    // ½(log₂‖G‖ − log₂‖K‖), each finite and ≥ −1075, so |t| ≤ ~1100: 2^±t stays representable
+    // only if clamped (the blocks' entries are then too far apart for any scaling to matter).
+    (0.5 * (g_norm.log2() - k_norm.log2())).round().clamp(-500.0, 500.0)
 }
 
 /// The n eigenvalues of the real skew-Hamiltonian matrix W = [A G; Q Aᵀ] (G, Q skew-symmetric,
@@ -399,6 +429,29 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// H = [F s·G; K/s −Fᵀ] has the eigenvalues of [F G; K −Fᵀ] for any s > 0. Unbalanced
+    /// (s = 1e6), its unscaled square would carry errors ε‖H‖² ≈ 1e-4, far above the bound
+    /// 100·ε·‖H²‖_F; balanced, every μ stays within the bound of the balanced matrix.
+    #[test]
+    fn an_unbalanced_hamiltonian_keeps_its_accuracy() {
+        let n = 40;
+        let ([f, g, k], h) = random_hamiltonian(n, 21);
+        let truth = eigenvalues(h.as_ref()).unwrap();
+        let balanced = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
+        for s in [1e6, 1e-6, 3.3e5] {
+            let (gs, ks) = (&g * faer::Scale(s), &k * faer::Scale(1.0 / s));
+            assert_eq!(symplectic_balance_exponent(gs.norm_l2(), ks.norm_l2()), (s.log2()).round(), "s = {s}");
+            let sq = hamiltonian_squared_eigenvalues(f.as_ref(), gs.as_ref(), ks.as_ref()).unwrap();
+            assert!(sq.abs_error <= 2.0 * balanced.abs_error, "s = {s}: bound {:e}", sq.abs_error);
+            for mu in &sq.mu {
+                let off = truth.iter().map(|l| (l * l - mu).norm()).fold(f64::INFINITY, f64::min);
+                assert!(off <= 10.0 * sq.abs_error, "s = {s}: μ = {mu} off by {off:e} (bound {:e})", sq.abs_error);
+            }
+        }
+        assert_eq!(symplectic_balance_exponent(0.0, 1.0), 0.0);
+        assert_eq!(symplectic_balance_exponent(1.0, 0.0), 0.0);
     }
 
     #[test]
