@@ -94,6 +94,9 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
     if !(opts.stall_rtol.is_finite() && opts.stall_rtol >= 0.0) {
         return Err(opt_err("stall_rtol", format!("must be finite and >= 0, got {}", opts.stall_rtol)));
     }
+    if !(opts.refine_rtol.is_finite() && opts.refine_rtol >= 0.0) {
+        return Err(opt_err("refine_rtol", format!("must be finite and >= 0 (0: none), got {}", opts.refine_rtol)));
+    }
     if let Some(bad) = opts.hop_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
         return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
     }
