@@ -793,17 +793,7 @@ mod tests {
     use super::*;
 
     fn end(f: f64, dnorm: f64, termination: Termination) -> OptimResult {
-        OptimResult {
-            x: vec![0.0],
-            f,
-            g: vec![0.0],
-            dnorm,
-            evaldist: 0.0,
-            termination,
-            iters: 1,
-            evals: 1,
-            cpu_s: 0.0,
-        }
+        OptimResult { x: vec![0.0], f, g: vec![0.0], dnorm, evaldist: 0.0, termination, iters: 1, evals: 1, cpu_s: 0.0 }
     }
 
     /// `refines`: only uncertified continued local searches that end within `refine_rtol` above
@@ -812,15 +802,8 @@ mod tests {
     fn near_misses_are_refined_only_within_the_tolerance() {
         let opts = DesignOptions { refine_rtol: 0.03, ..Default::default() };
         let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
-        let best = |f| Best {
-            x: vec![1.0],
-            f,
-            dnorm: 0.0,
-            evaldist: 0.0,
-            start: 0,
-            from: vec![1.0],
-            coords: Coords::Raw,
-        };
+        let best =
+            |f| Best { x: vec![1.0], f, dnorm: 0.0, evaldist: 0.0, start: 0, from: vec![1.0], coords: Coords::Raw };
         let mut st = State {
             opts: &opts,
             stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
