@@ -86,7 +86,7 @@ pub struct DesignArgs {
     /// Refine near-misses: a local search of the continued search that ends without a
     /// certificate at most this relative amount above the best controller gets gradient sampling
     /// from its end point, so that its basin is judged by a refined value, as the best one's is.
-    /// 0: none.
+    /// 0: none (the default; 0.03 is the value measured in docs/ALGORITHMS.md §8.3).
     #[arg(long, value_name = "R", default_value_t = DEFAULT_REFINE_RTOL, allow_negative_numbers = true)]
     pub refine_rtol: f64,
     /// Largest number of local searches (first starts included; deterministic).
