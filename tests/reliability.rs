@@ -591,7 +591,8 @@ fn item7_controller_norm_term_is_flagged() {
         let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
         assert!(o.gamma.is_finite(), "{o:?}");
         assert_eq!(o.controller_norm_active, active, "ε = {eps}: γ = {}, ε‖K‖∞ = {}", o.gamma, eps * o.k_hinf);
-        assert_eq!(o.controller_norm_active, eps * o.k_hinf >= o.gamma);
+        // Within the norms' tolerance: on the ridge ‖Tzw‖∞ = ε‖K‖∞ the larger one is rounding.
+        assert_eq!(o.controller_norm_active, eps * o.k_hinf >= o.gamma * (1.0 - opts.hinf_tol));
     }
     let dir = scratch("normflag");
     let k = dir.join("K.json");

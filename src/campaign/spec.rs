@@ -90,6 +90,7 @@ macro_rules! with_design_settings {
             continue_at_maxit: Option<bool>,
             continued_maxit: Option<Spanned<usize>>,
             return_gs_reserve: Option<bool>,
+            refine_rtol: Option<Spanned<f64>>,
             $($tail)*
         }
     };
@@ -406,6 +407,7 @@ struct Layered {
     continue_at_maxit: Option<bool>,
     continued_maxit: Setting<usize>,
     return_gs_reserve: Option<bool>,
+    refine_rtol: Setting<f64>,
 }
 
 impl Layered {
@@ -434,6 +436,7 @@ impl Layered {
             continue_at_maxit: p.continue_at_maxit.or(d.continue_at_maxit),
             continued_maxit: layer(&p.continued_maxit, &d.continued_maxit),
             return_gs_reserve: p.return_gs_reserve.or(d.return_gs_reserve),
+            refine_rtol: layer(&p.refine_rtol, &d.refine_rtol),
         }
     }
 
@@ -448,6 +451,7 @@ impl Layered {
         o.evaldist = value(&self.evaldist, o.evaldist);
         o.hinf_tol = value(&self.hinf_tol, o.hinf_tol);
         o.stall_rtol = value(&self.stall_rtol, o.stall_rtol);
+        o.refine_rtol = value(&self.refine_rtol, o.refine_rtol);
         o.nrand = count(&self.nrand, o.nrand);
         o.maxit = count(&self.maxit, o.maxit);
         o.continued_maxit = count(&self.continued_maxit, o.continued_maxit);
@@ -503,6 +507,7 @@ impl Layered {
             "evaldist" => span(&self.evaldist),
             "hinf_tol" => span(&self.hinf_tol),
             "stall_rtol" => span(&self.stall_rtol),
+            "refine_rtol" => span(&self.refine_rtol),
             "nrand" => span(&self.nrand),
             "maxit" => span(&self.maxit),
             "continued_maxit" => span(&self.continued_maxit),

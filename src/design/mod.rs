@@ -33,7 +33,7 @@ pub use objective::{
 };
 pub use options::{
     DesignOptions, ObjectiveKind, VariableScaling, DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES,
-    DEFAULT_RANDOM_SCALES, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
+    DEFAULT_RANDOM_SCALES, DEFAULT_REFINE_RTOL, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
     Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError,

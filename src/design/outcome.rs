@@ -230,9 +230,10 @@ pub struct DesignOutcome {
     /// Final objective: max(γ, ε‖K‖∞) (strong) or γ (plain).
     #[serde(with = "serde_f64_or_string")]
     pub objective: f64,
-    /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞): the
-    /// controller-norm penalty, not the closed loop, sets the objective (strong stabilisation
-    /// only; a smaller ε would let γ go lower).
+    /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞) (at least
+    /// ‖Tzw‖∞ within the norms' relative tolerance `hinf_tol`): the controller-norm penalty, not
+    /// the closed loop, sets the objective (strong stabilisation only; a smaller ε would let γ go
+    /// lower).
     #[serde(default)]
     pub controller_norm_active: bool,
     /// Optimality certificate of the final point, if the optimisation phase ran.

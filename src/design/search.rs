@@ -33,6 +33,14 @@
 //!    [`crate::design::DEFAULT_CONTINUED_MAXIT`]; 0: `maxit`), so that HIFOO's first starts and
 //!    every stabilisation keep HIFOO's `maxit`.
 //!
+//! # Refining near-misses (docs/ALGORITHMS.md §8.3)
+//! The incumbent is judged after gradient sampling, other local searches after BFGS alone, which
+//! stalls above the floor of a basin on a ridge of max(‖Tzw‖∞, ε‖K‖∞). An f_h local search of the
+//! continued search that ends uncertified (dnorm > normtol, not cut by a budget) at most a
+//! relative `refine_rtol` above the incumbent gets gradient sampling from its end point (same
+//! options and coordinates) before it is offered; it draws from the run's generator, so the run
+//! stays reproducible. The first starts are unchanged.
+//!
 //! # Coordinates (docs/ALGORITHMS.md §8.6)
 //! Each local search runs either on the controller's parameters x or, if the plant's channels
 //! are scaled (`design::scaling`), on plant-scaled variables x̃ (x = d ∘ x̃), by
@@ -210,6 +218,8 @@ struct State<'s> {
     perf_cut: bool,
     /// The continued search has begun: its f_h local searches use `continued_maxit`.
     continued: bool,
+    /// Near-misses refined by gradient sampling so far (`refine_rtol`).
+    refinements: usize,
 }
 
 impl State<'_> {
@@ -248,6 +258,22 @@ impl State<'_> {
                 matches!(r.termination, Termination::MaxIters | Termination::CpuBudget | Termination::EvalBudget);
         }
         better
+    }
+
+    /// Whether the f_h local search that ended at `r` is a near-miss to refine (module docs,
+    /// "Refining near-misses"): a local search of the continued search, not certified
+    /// (dnorm > normtol), not cut by a budget, and within a relative `refine_rtol` above the
+    /// incumbent (a point below it becomes the incumbent and has its gradient sampling anyway).
+    fn refines(&self, r: &OptimResult) -> bool {
+        let o = self.opts;
+        let Some(inc) = self.perf.as_ref().map(|b| b.f) else { return false };
+        self.continued
+            && o.gradient_sampling
+            && o.refine_rtol > 0.0
+            && r.dnorm > o.normtol
+            && stop_of(r.termination).is_none()
+            && r.f >= inc
+            && r.f <= inc + o.refine_rtol * inc.abs()
     }
 
     /// The start that resumes the incumbent's local search if `maxit` cut it (and
@@ -406,6 +432,9 @@ impl Search<'_, '_, '_> {
         match bfgs(obj, xs, k, &perf_bfgs_options(opts, st.continued), ctl, self.adapter) {
             Ok(mut r) => {
                 st.add(1, &r, c0, ctl.cpu_elapsed());
+                if st.refines(&r) {
+                    r = self.refine(st, r, c, ctl)?;
+                }
                 r.x = self.to_raw(&r.x, c);
                 let better = st.offer_perf(&r, &self.to_raw(xs, c), k, c);
                 Ok((stop_of(r.termination), better))
@@ -416,6 +445,31 @@ impl Search<'_, '_, '_> {
                 st.stats[1].evals += 1;
                 Ok((None, false))
             }
+            Err(e) => Err(optim_error(e)),
+        }
+    }
+
+    /// Gradient sampling on f_h from the end point `r` of a continued local search that
+    /// [`State::refines`] (module docs, "Refining near-misses"), in its coordinates `c`, under
+    /// `ctl`; returns its end point if it lowered f_h, else `r`.
+    fn refine(
+        &mut self,
+        st: &mut State<'_>,
+        r: OptimResult,
+        c: Coords,
+        ctl: &RunControl,
+    ) -> Result<OptimResult, DesignError> {
+        let opts = st.opts;
+        let obj = pick(self.perf_obj, &mut self.scaled, true, c);
+        self.adapter.set_evals_base(st.evals());
+        let c0 = ctl.cpu_elapsed();
+        match gradient_sampling(obj, &r.x, &gradsamp_options(opts, f64::NEG_INFINITY), self.rng, ctl, self.adapter) {
+            Ok(g) => {
+                st.add(2, &g, c0, ctl.cpu_elapsed());
+                st.refinements += 1;
+                Ok(if g.f < r.f { g } else { r })
+            }
+            Err(OptimError::NonFiniteStart { .. }) => Ok(r),
             Err(e) => Err(optim_error(e)),
         }
     }
@@ -589,6 +643,7 @@ impl Search<'_, '_, '_> {
             stall: 0,
             perf_cut: false,
             continued: false,
+            refinements: 0,
         };
         let mut k = 0usize; // local searches made
         let mut cycle = 0usize; // continued starts drawn from the hop / random cycle
@@ -702,7 +757,7 @@ impl Search<'_, '_, '_> {
         if st.stabilised {
             phases.push(s1);
         }
-        if rounds.ran {
+        if rounds.ran || st.refinements > 0 {
             phases.push(s2);
         }
         let stab = st.stab.unwrap_or_else(|| Best {
@@ -730,5 +785,52 @@ impl Search<'_, '_, '_> {
             stop,
         };
         Ok(SearchResult { perf: st.perf, stab, stabilised: st.stabilised, phases, summary, truncated })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn end(f: f64, dnorm: f64, termination: Termination) -> OptimResult {
+        OptimResult { x: vec![0.0], f, g: vec![0.0], dnorm, evaldist: 0.0, termination, iters: 1, evals: 1, cpu_s: 0.0 }
+    }
+
+    /// `refines`: only uncertified continued local searches that end within `refine_rtol` above
+    /// the incumbent and were not cut by a budget.
+    #[test]
+    fn near_misses_are_refined_only_within_the_tolerance() {
+        let opts = DesignOptions { refine_rtol: 0.03, ..Default::default() };
+        let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
+        let best =
+            |f| Best { x: vec![1.0], f, dnorm: 0.0, evaldist: 0.0, start: 0, from: vec![1.0], coords: Coords::Raw };
+        let mut st = State {
+            opts: &opts,
+            stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
+            perf: Some(best(1.0)),
+            stab: None,
+            stabilised: true,
+            stall: 0,
+            perf_cut: false,
+            continued: true,
+            refinements: 0,
+        };
+        let stalled = Termination::LineSearchFailed;
+        assert!(st.refines(&end(1.02, 0.1, stalled)));
+        assert!(st.refines(&end(1.0, 0.1, Termination::MaxIters)));
+        assert!(!st.refines(&end(1.04, 0.1, stalled)), "beyond refine_rtol");
+        assert!(!st.refines(&end(0.99, 0.1, stalled)), "below the incumbent: it becomes the incumbent");
+        assert!(!st.refines(&end(1.02, 1e-4, stalled)), "certified");
+        assert!(!st.refines(&end(1.02, 0.1, Termination::CpuBudget)), "cut by a budget");
+        assert!(!st.refines(&end(f64::INFINITY, 0.1, stalled)));
+        st.continued = false;
+        assert!(!st.refines(&end(1.02, 0.1, stalled)), "HIFOO's first starts are not refined");
+        st.continued = true;
+        st.perf = None;
+        assert!(!st.refines(&end(1.02, 0.1, stalled)), "no incumbent");
+        let off = DesignOptions { refine_rtol: 0.0, ..Default::default() };
+        st.opts = &off;
+        st.perf = Some(best(1.0));
+        assert!(!st.refines(&end(1.0, 0.1, stalled)), "refine_rtol = 0: off");
     }
 }
