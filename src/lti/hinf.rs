@@ -334,8 +334,9 @@ const MAX_LADDER_STEPS: usize = 60;
 /// ‖(iωI − A)⁻¹‖ ≤ 1/(ω − ‖A‖) (Neumann series), so
 /// σmax(G(iω)) ≤ σmax(D) + ‖C‖‖B‖/(ω − ‖A‖) < γ once ω > ‖A‖ + ‖C‖‖B‖/(γ − σmax(D))
 /// (Frobenius norms, which bound the spectral ones). Above ‖A‖ the response is an analytic
-/// function of 1/ω without resonances, so a geometric ladder sees a peak there; below ‖A‖ the
-/// crossings are within the pencil's resolution. At most [`MAX_LADDER_STEPS`] frequencies.
+/// function of 1/ω without resonances, so a geometric ladder is a fair probe there (not a proof);
+/// below ‖A‖ the crossings are within the pencil's resolution for shifts of the system's
+/// frequency scale. At most [`MAX_LADDER_STEPS`] frequencies.
 fn high_frequency_ladder(sys: &StateSpace, sigma_d: f64, gamma: f64, a: f64, out: &mut Vec<f64>) {
     let margin = gamma - sigma_d;
     let cap = if margin > 0.0 { sys.a.norm_l2() + sys.c.norm_l2() * sys.b.norm_l2() / margin } else { f64::INFINITY };
