@@ -459,17 +459,36 @@ impl Search<'_, '_, '_> {
         c: Coords,
         ctl: &RunControl,
     ) -> Result<OptimResult, DesignError> {
-        let opts = st.opts;
+        let Some(g) = self.gs_perf(st, &r.x, c, ctl)? else { return Ok(r) };
+        st.refinements += 1;
+        Ok(if g.f < r.f { g } else { r })
+    }
+
+    /// Gradient sampling on f_h from `x0`, in coordinates `c` (its end point too), under `ctl`,
+    /// counted in the gradient-sampling statistics; `None` if f_h is not finite at `x0`. Serves
+    /// the incumbent's gradient sampling ([`Self::gs_incumbent`]) and the near-misses'
+    /// ([`Self::refine`]).
+    fn gs_perf(
+        &mut self,
+        st: &mut State<'_>,
+        x0: &[f64],
+        c: Coords,
+        ctl: &RunControl,
+    ) -> Result<Option<OptimResult>, DesignError> {
         let obj = pick(self.perf_obj, &mut self.scaled, true, c);
+        self.adapter.switch(obj, Phase::Optimisation);
         self.adapter.set_evals_base(st.evals());
         let c0 = ctl.cpu_elapsed();
-        match gradient_sampling(obj, &r.x, &gradsamp_options(opts, f64::NEG_INFINITY), self.rng, ctl, self.adapter) {
-            Ok(g) => {
-                st.add(2, &g, c0, ctl.cpu_elapsed());
-                st.refinements += 1;
-                Ok(if g.f < r.f { g } else { r })
+        let gopts = gradsamp_options(st.opts, f64::NEG_INFINITY);
+        match gradient_sampling(obj, x0, &gopts, self.rng, ctl, self.adapter) {
+            Ok(r) => {
+                st.add(2, &r, c0, ctl.cpu_elapsed());
+                Ok(Some(r))
             }
-            Err(OptimError::NonFiniteStart { .. }) => Ok(r),
+            Err(OptimError::NonFiniteStart { .. }) => {
+                st.stats[2].evals += 1;
+                Ok(None)
+            }
             Err(e) => Err(optim_error(e)),
         }
     }
@@ -544,33 +563,19 @@ impl Search<'_, '_, '_> {
         // In the coordinates of the local search that found the best point.
         let c = best.coords;
         let x0 = self.to_coords(&best.x, c);
-        let obj = pick(self.perf_obj, &mut self.scaled, true, c);
-        self.adapter.switch(obj, Phase::Optimisation);
-        self.adapter.set_evals_base(st.evals());
-        let c0 = ctl.cpu_elapsed();
-        let gopts = gradsamp_options(opts, f64::NEG_INFINITY);
-        match gradient_sampling(obj, &x0, &gopts, self.rng, ctl, self.adapter) {
-            Ok(mut r) => {
-                st.add(2, &r, c0, ctl.cpu_elapsed());
-                r.x = self.to_raw(&r.x, c);
-                let b = st.perf.as_mut().expect("checked above");
-                if r.f < b.f {
-                    b.x = r.x;
-                    b.f = r.f;
-                    b.dnorm = r.dnorm;
-                    b.evaldist = r.evaldist;
-                } else if r.x == b.x && r.dnorm < b.dnorm {
-                    b.dnorm = r.dnorm;
-                    b.evaldist = r.evaldist;
-                }
-                Ok(true)
-            }
-            Err(OptimError::NonFiniteStart { .. }) => {
-                st.stats[2].evals += 1;
-                Ok(false)
-            }
-            Err(e) => Err(optim_error(e)),
+        let Some(mut r) = self.gs_perf(st, &x0, c, ctl)? else { return Ok(false) };
+        r.x = self.to_raw(&r.x, c);
+        let b = st.perf.as_mut().expect("checked above");
+        if r.f < b.f {
+            b.x = r.x;
+            b.f = r.f;
+            b.dnorm = r.dnorm;
+            b.evaldist = r.evaldist;
+        } else if r.x == b.x && r.dnorm < b.dnorm {
+            b.dnorm = r.dnorm;
+            b.evaldist = r.evaldist;
         }
+        Ok(true)
     }
 
     /// `return_gs_reserve`, after HIFOO's first starts and whenever the search has spent its share

@@ -647,17 +647,17 @@ fn squared_crossings(sq: &SquaredSpectrum, pole_sq: &[f64], peak_freq: f64) -> O
     let max_abs = sq.mu.iter().map(|m| m.norm()).fold(0.0, f64::max).sqrt();
     let thr = imaginary_axis_threshold(max_abs);
     let e = sq.abs_error;
-    let tiny = |m: &c64| m.norm() <= SQUARED_TINY_MU * e;
+    let noise = |x: f64| x <= SQUARED_TINY_MU * e;
+    let tiny = |m: &c64| noise(m.norm());
     let doubtful = |m: &c64| {
         let off_axis = if m.re <= 0.0 { m.im.abs() } else { m.re };
-        m.norm() > SQUARED_TINY_MU * e && m.norm() <= SQUARED_SMALL_MU * e && off_axis <= SQUARED_DOUBT_FACTOR * e
+        !tiny(m) && m.norm() <= SQUARED_SMALL_MU * e && off_axis <= SQUARED_DOUBT_FACTOR * e
     };
     let expected = known_peak_eigenvalues(&sq.mu, peak_freq, SQUARED_DOUBT_FACTOR * e, |m| tiny(m) || doubtful(m));
     let others = || sq.mu.iter().enumerate().filter(|(i, _)| !expected.contains(i)).map(|(_, m)| m);
     // Eigenvalues below the noise level are expected only from poles that small (H(γ) has
     // eigenvalues near ±p for weakly coupled modes p); any more may be crossings near ω = 0.
-    let unexplained =
-        others().filter(|m| tiny(m)).count() > pole_sq.iter().filter(|&&p2| p2 <= SQUARED_TINY_MU * e).count();
+    let unexplained = others().filter(|m| tiny(m)).count() > pole_sq.iter().filter(|&&p2| noise(p2)).count();
     if unexplained || others().any(doubtful) {
         return None;
     }
