@@ -6,8 +6,9 @@
 //! pivoting (backward stable, as for any GEPP on a Hessenberg matrix). This is the classical
 //! Laub (1981) approach and what makes the many test frequencies of the level-set method cheap.
 //! From order [`HESSENBERG_QR_FROM`] on the solve runs on split real and imaginary parts
-//! (`hessenberg_solve.rs`: the elimination vectorises; issue 13), with the same operations in the
-//! same order as the interleaved solve used below it, so both give the same bits.
+//! (`hessenberg_solve.rs`: the elimination and the back substitution vectorise; issue 13). It
+//! is the same elimination as the interleaved solve used below that order, with the back
+//! substitution's sums reassociated, so the two agree to rounding, not bit for bit.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg;
@@ -147,7 +148,7 @@ impl FreqResponse {
         }
         if let Some((solver, ct)) = &mut self.large {
             let (xr, xi) = solver.solve(&self.h, &self.bt, w);
-            // G = D + C̃X, summed in the interleaved path's order (the same bits).
+            // G = D + C̃X, summed in the interleaved path's order.
             for i in 0..p {
                 let row = &ct[i * n..(i + 1) * n];
                 for c in 0..m {
@@ -360,9 +361,9 @@ mod tests {
         }
     }
 
-    /// From order 30 on the split solve gives bit for bit the interleaved solve's G(iω).
+    /// From order 30 on the split solve gives the interleaved solve's G(iω) to rounding.
     #[test]
-    fn split_solve_has_the_interleaved_bits() {
+    fn split_solve_agrees_with_the_interleaved_solve() {
         let mut rnd = uniform(11);
         for &(n, m, p) in &[(30, 1, 3), (45, 2, 4), (83, 3, 2)] {
             let sys = random_system(&mut rnd, n, m, p);
@@ -372,10 +373,14 @@ mod tests {
             interleaved.large = None;
             for &w in &[0.0, 0.3, 2.0, 17.0] {
                 let (g1, g2) = (split.eval(w).to_owned(), interleaved.eval(w).to_owned());
+                let scale = (0..m)
+                    .flat_map(|j| (0..p).map(move |i| (i, j)))
+                    .map(|(i, j)| g2[(i, j)].norm())
+                    .fold(0.0, f64::max);
                 for j in 0..m {
                     for i in 0..p {
-                        assert_eq!(g1[(i, j)].re.to_bits(), g2[(i, j)].re.to_bits(), "n={n} w={w}");
-                        assert_eq!(g1[(i, j)].im.to_bits(), g2[(i, j)].im.to_bits(), "n={n} w={w}");
+                        let diff = (g1[(i, j)] - g2[(i, j)]).norm();
+                        assert!(diff <= 1e-13 * scale, "n={n} w={w}: {diff:e} against |G| = {scale:e}");
                     }
                 }
             }

@@ -1,16 +1,17 @@
 //! The solve (iωI − H) X = B̃ of the frequency response (`freq_response.rs`) for large orders,
 //! with real and imaginary parts in separate arrays.
 //!
-//! The method and the arithmetic are those of `FreqResponse::eval` (Gaussian elimination with
-//! adjacent-row partial pivoting on the upper Hessenberg iωI − H, then back substitution; backward
-//! stable), with the same operations in the same order, so the result has the same bits; only the
+//! The method is that of `FreqResponse::eval` (Gaussian elimination with adjacent-row partial
+//! pivoting on the upper Hessenberg iωI − H, then back substitution; backward stable); only the
 //! layout differs (issue 13): a row update r₁ ← r₁ − l·r₀ on split real and imaginary parts is
 //! independent per entry, and the compiler vectorises it where interleaved complex numbers kept it
-//! scalar. On x86-64 CPUs with AVX2 (detected at run time) the same code is compiled for 256-bit
-//! registers; without fused multiply–adds every lane rounds as the scalar code does, so both
-//! builds also give the same bits. The back substitution is a sequential sum per entry (kept, for
-//! the same bits) and stays scalar. Used from order `HESSENBERG_QR_FROM` on, where the elimination
-//! is long enough to pay for the split layout.
+//! scalar. The elimination has the interleaved solve's operations in its order; the back
+//! substitution's sums run over four partial sums ([`complex_dot`]) so that they vectorise too,
+//! which changes their rounding: the two solves agree to rounding, not bit for bit (the
+//! interleaved one serves below order `HESSENBERG_QR_FROM`, this one from it on, so no system sees
+//! both). On x86-64 CPUs with AVX2 (detected at run time) the same code is compiled for 256-bit
+//! registers; without fused multiply–adds every lane rounds as the scalar code does, and the order
+//! of every sum is fixed by the code, so both builds give the same bits.
 
 use faer::c64;
 
@@ -123,25 +124,47 @@ impl ShiftedHessenbergSolve {
                 xi[c * n + k + 1] -= lr * x_im + li * x_re;
             }
         }
-        // Back substitution in the interleaved solve's order (a sequential sum per entry), so the
-        // bits are the same; only the elimination above vectorises.
+        // Back substitution, row k: x_k = (y_k − Σ_{j>k} u_kj x_j) / u_kk. The sum runs over four
+        // interleaved partial sums (lanes j ≡ k+1+l mod 4, added pairwise at the end) so that it
+        // vectorises: the row of U and the column of X are both contiguous. The order of the
+        // additions is fixed by the code, not by the CPU, so every build gives the same bits.
         for k in (0..n).rev() {
             let row = k * n;
             let piv = c64::new(tr[row + k], ti[row + k]);
+            let (ur, ui) = (&tr[row + k + 1..row + n], &ti[row + k + 1..row + n]);
             for c in 0..m {
                 let col = c * n;
-                let (mut sr, mut si) = (xr[col + k], xi[col + k]);
-                for j in k + 1..n {
-                    let (a_re, a_im, b_re, b_im) = (tr[row + j], ti[row + j], xr[col + j], xi[col + j]);
-                    sr -= a_re * b_re - a_im * b_im;
-                    si -= a_re * b_im + a_im * b_re;
-                }
+                let (head_r, tail_r) = xr[col..col + n].split_at_mut(k + 1);
+                let (head_i, tail_i) = xi[col..col + n].split_at_mut(k + 1);
+                let (dr, di) = complex_dot(ur, ui, tail_r, tail_i);
+                let (sr, si) = (head_r[k] - dr, head_i[k] - di);
                 let x = if piv == c64::new(0.0, 0.0) { c64::new(f64::INFINITY, 0.0) } else { c64::new(sr, si) / piv };
-                xr[col + k] = x.re;
-                xi[col + k] = x.im;
+                head_r[k] = x.re;
+                head_i[k] = x.im;
             }
         }
     }
+}
+
+/// Σ_j (ar_j + i·ai_j)(br_j + i·bi_j) on split real and imaginary parts, in four partial sums
+/// (lane l takes j ≡ l mod 4; the tail goes to lane 0) added as (s₀ + s₁) + (s₂ + s₃).
+#[inline(always)]
+fn complex_dot(ar: &[f64], ai: &[f64], br: &[f64], bi: &[f64]) -> (f64, f64) {
+    const L: usize = 4;
+    let (mut pr, mut pi) = ([0.0f64; L], [0.0f64; L]);
+    let (car, cai, cbr, cbi) = (ar.chunks_exact(L), ai.chunks_exact(L), br.chunks_exact(L), bi.chunks_exact(L));
+    let rest = (car.remainder(), cai.remainder(), cbr.remainder(), cbi.remainder());
+    for (((a_re, a_im), b_re), b_im) in car.zip(cai).zip(cbr).zip(cbi) {
+        for l in 0..L {
+            pr[l] += a_re[l] * b_re[l] - a_im[l] * b_im[l];
+            pi[l] += a_re[l] * b_im[l] + a_im[l] * b_re[l];
+        }
+    }
+    for j in 0..rest.0.len() {
+        pr[0] += rest.0[j] * rest.2[j] - rest.1[j] * rest.3[j];
+        pi[0] += rest.0[j] * rest.3[j] + rest.1[j] * rest.2[j];
+    }
+    ((pr[0] + pr[1]) + (pr[2] + pr[3]), (pi[0] + pi[1]) + (pi[2] + pi[3]))
 }
 
 #[cfg(test)]
