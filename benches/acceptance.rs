@@ -93,6 +93,7 @@ fn usable(o: &DesignOutcome) -> bool {
 }
 
 fn main() {
+    hinfix::malloc_tuning::keep_freed_memory();
     let a = parse_args();
     std::fs::create_dir_all(&a.out).expect("output dir");
     let refs = load_reference(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(REFERENCE_CSV)).expect("reference CSV");

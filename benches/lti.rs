@@ -243,6 +243,7 @@ fn print_steps(s: &step_stats::StepStats, evals: usize, cpu_s: f64) {
 }
 
 fn main() {
+    hinfix::malloc_tuning::keep_freed_memory();
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
     let dump = args.iter().position(|a| a == "--dump").and_then(|i| args.get(i + 1)).map(PathBuf::from);

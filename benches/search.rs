@@ -446,6 +446,7 @@ fn spread(a: &Args) {
 }
 
 fn main() {
+    hinfix::malloc_tuning::keep_freed_memory();
     let a = parse_args();
     for part in &a.parts {
         match part.as_str() {

@@ -12,7 +12,8 @@
 //!
 //! Under all of them, used by any and using none: `numeric` (a few shared numeric helpers,
 //! crate-private), [`fs_atomic`] (atomic, durable file writes) and [`input`] (bounded reading of
-//! every input file, with documented size limits). The layers, a job's path through them and the
+//! every input file, with documented size limits), and [`malloc_tuning`] (the C allocator's reuse of
+//! freed memory, set by the binary). The layers, a job's path through them and the
 //! journal's guarantees are described in docs/ARCHITECTURE.md; the methods, with their
 //! references, in docs/ALGORITHMS.md.
 // `!(x > 0.0)` is this crate's NaN-aware comparison (true when x is NaN, which must count as a
@@ -26,5 +27,6 @@ pub mod design;
 pub mod fs_atomic;
 pub mod input;
 pub mod lti;
+pub mod malloc_tuning;
 pub(crate) mod numeric;
 pub mod optim;

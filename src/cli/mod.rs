@@ -85,6 +85,7 @@ pub fn main() -> ExitCode {
 /// their records, so they never pass for real ones. The `campaign` binary always passes `None`:
 /// no environment variable or option switches it to fake results.
 pub fn main_with(fake: Option<FakeRunner>) -> ExitCode {
+    crate::malloc_tuning::keep_freed_memory();
     let cli = Cli::parse();
     if !matches!(cli.command, Command::Run(_) | Command::Design(_) | Command::Plot(_)) {
         signals::end_quietly_on_closed_stdout();
