@@ -24,6 +24,7 @@ mod matrix_json;
 mod plant;
 mod plant_library;
 mod riccati;
+mod skew_symmetric;
 mod spectral;
 mod square_reduced;
 mod state_space;
