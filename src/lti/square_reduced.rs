@@ -26,11 +26,10 @@
 //! Written by hand: no Rust crate has a structure-preserving Hamiltonian eigensolver (faer's
 //! Hessenberg QR does the final n×n step).
 
-use faer::linalg::matmul::matmul;
-use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
+use faer::{c64, Mat, MatRef};
 
 use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
-use super::skew_symmetric::SkewLower;
+use super::pvl_update::{reflect_general, SkewLower};
 use super::spectral::eigenvalues;
 use super::step_stats::{timed, Step};
 use crate::numeric::dot_four_lanes;
@@ -45,11 +44,11 @@ pub(crate) struct SquaredSpectrum {
     pub abs_error: f64,
 }
 
-/// From this size n on, the reduction's reflections use faer's kernels for A and keep G and Q by
-/// their strict lower triangles ([`SkewLower`]; issue 13: CM4's evaluations −35 %, then the PVL
-/// step about halved); below it full storage and the hand-written loops, whose rounding the small
-/// plants' design results (the smoke campaign's table) were obtained with.
-const FAER_KERNELS_FROM: usize = 30;
+/// From this size n on, the reduction reflects A by merged passes ([`reflect_general`]) and keeps
+/// G and Q by their strict lower triangles ([`SkewLower`]) (issue 13: before, faer's level-2
+/// kernels on full storage); below it full storage and the hand-written loops, whose rounding the
+/// small plants' design results (the smoke campaign's table) were obtained with.
+const FAST_KERNELS_FROM: usize = 30;
 
 /// Safety factor on ε‖M‖_F in [`SquaredSpectrum::abs_error`] (the reduction applies 3n
 /// orthogonal transformations; their rounding grows like √n in practice).
@@ -114,7 +113,7 @@ pub(crate) fn skew_hamiltonian_eigenvalues(
     g: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
 ) -> Option<Vec<c64>> {
-    let mut w = if a.nrows() < FAER_KERNELS_FROM {
+    let mut w = if a.nrows() < FAST_KERNELS_FROM {
         let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
         timed(Step::Pvl, || blocks.pvl_reduce());
         blocks.a
@@ -170,15 +169,7 @@ impl ColMajor {
         &self.data[j * self.n..(j + 1) * self.n]
     }
 
-    fn view(&self) -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&self.data, self.n, self.n)
-    }
-
-    fn view_mut(&mut self) -> MatMut<'_, f64> {
-        MatMut::from_column_major_slice_mut(&mut self.data, self.n, self.n)
-    }
-
-    /// X ← P X P by hand-written loops, for small n ([`FAER_KERNELS_FROM`]): the same
+    /// X ← P X P by hand-written loops, for small n ([`FAST_KERNELS_FROM`]): the same
     /// arithmetic as before issue 13's third pass, so that small plants' results (the smoke
     /// campaign's) stay bit for bit what they were.
     fn reflect_two_sided_loops(
@@ -212,16 +203,9 @@ impl ColMajor {
 
     /// X ← P X P for P = I − β v vᵀ acting on indices r..n (v.len() = n − r). Columns before
     /// `first_col` are zero in rows r.. and are skipped on the left; rows before `first_row` are
-    /// zero in columns r.. and are skipped on the right. Left: t = X[r.., :]ᵀv,
-    /// X[r.., :] −= β v tᵀ; right: z = X[:, r..] v, X[:, r..] −= β z vᵀ: four level-2 passes
-    /// through faer's matrix–vector and rank-one kernels (SIMD chosen at run time) instead of
-    /// hand-written loops (issue 13). For the skew-symmetric G and Q the
-    /// identity P X P = X + β(v yᵀ − y vᵀ), y = Xv, would save a pass, but it was tried and lost
-    /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low), and so
-    /// did the general fused form P X P = X − v(βt)ᵀ − (βz − β²(vᵀz)v)vᵀ with t = Xᵀv, z = Xv
-    /// (three passes instead of four; issue 13, fourth pass, 5.4e-4 too low on the same fixture):
-    /// on badly scaled X the rounding of the scalar vᵀXv spreads over the whole trailing block.
-    /// Below n = [`FAER_KERNELS_FROM`] it runs [`Self::reflect_two_sided_loops`] instead.
+    /// zero in columns r.. and are skipped on the right. From n = [`FAST_KERNELS_FROM`] on by
+    /// [`reflect_general`] (two merged passes, issue 13; before it, four level-2 passes through
+    /// faer's kernels), below it by [`Self::reflect_two_sided_loops`].
     fn reflect_two_sided(
         &mut self,
         r: usize,
@@ -231,40 +215,15 @@ impl ColMajor {
         first_row: usize,
         buf: &mut [f64],
     ) {
-        if self.n < FAER_KERNELS_FROM {
+        if self.n < FAST_KERNELS_FROM {
             return self.reflect_two_sided_loops(r, v, beta, first_col, first_row, buf);
         }
-        let (n, len) = (self.n, v.len());
-        let vc = MatRef::from_column_major_slice(v, len, 1);
-        let nc = n - first_col;
-        let t = &mut buf[..nc];
-        matmul(
-            MatMut::from_column_major_slice_mut(t, nc, 1),
-            Accum::Replace,
-            self.view().submatrix(r, first_col, len, nc).transpose(),
-            vc,
-            1.0,
-            Par::Seq,
-        );
-        let t = MatRef::from_row_major_slice(&buf[..nc], 1, nc);
-        matmul(self.view_mut().submatrix_mut(r, first_col, len, nc), Accum::Add, vc, t, -beta, Par::Seq);
-        let nr = n - first_row;
-        let z = &mut buf[..nr];
-        matmul(
-            MatMut::from_column_major_slice_mut(z, nr, 1),
-            Accum::Replace,
-            self.view().submatrix(first_row, r, nr, len),
-            vc,
-            1.0,
-            Par::Seq,
-        );
-        let z = MatRef::from_column_major_slice(&buf[..nr], nr, 1);
-        matmul(self.view_mut().submatrix_mut(first_row, r, nr, len), Accum::Add, z, vc.transpose(), -beta, Par::Seq);
+        reflect_general(&mut self.data, r, v, beta, first_col, first_row, buf);
     }
 }
 
 /// Storage of the skew-symmetric blocks G and Q of a skew-Hamiltonian matrix: in full
-/// ([`ColMajor`], below [`FAER_KERNELS_FROM`]) or by the strict lower triangle ([`SkewLower`]).
+/// ([`ColMajor`], below [`FAST_KERNELS_FROM`]) or by the strict lower triangle ([`SkewLower`]).
 trait SkewBlock {
     fn at(&self, i: usize, j: usize) -> f64;
     fn set(&mut self, i: usize, j: usize, x: f64);
@@ -322,7 +281,7 @@ impl<S: SkewBlock> SkewHamiltonian<S> {
         let n = self.a.n;
         let mut v = vec![0.0; n];
         let mut w = vec![0.0; n];
-        let fast_norm = n >= FAER_KERNELS_FROM;
+        let fast_norm = n >= FAST_KERNELS_FROM;
         for j in 0..n.saturating_sub(1) {
             let r = j + 1;
             let len = n - r;
@@ -380,7 +339,7 @@ impl<S: SkewBlock> SkewHamiltonian<S> {
 
 /// The Householder vector (v₀ = 1) and β of P = I − β v vᵀ with P x = ∓‖x‖ e₁ (LAPACK `dlarfg`
 /// convention); `None` when x is already a multiple of e₁.
-/// From n = [`FAER_KERNELS_FROM`] on (`fast_norm`) the tail's norm is faer's (scaled, SIMD)
+/// From n = [`FAST_KERNELS_FROM`] on (`fast_norm`) the tail's norm is faer's (scaled, SIMD)
 /// instead of a `hypot` fold (libm's hypot was 2 % of a BDT2 design run).
 fn householder(x: &[f64], v: &mut [f64], fast_norm: bool) -> Option<f64> {
     let tail = if fast_norm {
@@ -501,7 +460,7 @@ mod tests {
         ]
     }
 
-    /// The triangular storage of G, Q (used from n = FAER_KERNELS_FROM on) against the full one
+    /// The triangular storage of G, Q (used from n = FAST_KERNELS_FROM on) against the full one
     /// and the unstructured solver of the 2n×2n matrix, on random and badly scaled
     /// skew-Hamiltonian matrices: the same PVL form and, eigenvalue for eigenvalue, an error
     /// against the truth (the unscaled matrix's spectrum) within the full storage's.
