@@ -23,6 +23,7 @@ mod mat_file;
 mod matrix_json;
 mod plant;
 mod plant_library;
+mod pvl_update;
 mod riccati;
 mod spectral;
 mod square_reduced;

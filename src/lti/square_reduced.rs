@@ -26,10 +26,10 @@
 //! Written by hand: no Rust crate has a structure-preserving Hamiltonian eigensolver (faer's
 //! Hessenberg QR does the final n×n step).
 
-use faer::linalg::matmul::matmul;
-use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
+use faer::{c64, Mat, MatRef};
 
 use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
+use super::pvl_update::{reflect_general, SkewLower};
 use super::spectral::eigenvalues;
 use super::step_stats::{timed, Step};
 use crate::numeric::dot_four_lanes;
@@ -44,10 +44,11 @@ pub(crate) struct SquaredSpectrum {
     pub abs_error: f64,
 }
 
-/// From this size n on, the reduction's reflections use faer's kernels (issue 13: CM4's
-/// evaluations −35 %); below it the hand-written loops, whose rounding the small plants' design
-/// results (the smoke campaign's table) were obtained with.
-const FAER_KERNELS_FROM: usize = 30;
+/// From this size n on, the reduction reflects A by merged passes ([`reflect_general`]) and keeps
+/// G and Q by their strict lower triangles ([`SkewLower`]) (issue 13: before, faer's level-2
+/// kernels on full storage); below it full storage and the hand-written loops, whose rounding the
+/// small plants' design results (the smoke campaign's table) were obtained with.
+const FAST_KERNELS_FROM: usize = 30;
 
 /// Safety factor on ε‖M‖_F in [`SquaredSpectrum::abs_error`] (the reduction applies 3n
 /// orthogonal transformations; their rounding grows like √n in practice).
@@ -112,17 +113,29 @@ pub(crate) fn skew_hamiltonian_eigenvalues(
     g: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
 ) -> Option<Vec<c64>> {
-    let n = a.nrows();
-    let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
-    timed(Step::Pvl, || blocks.pvl_reduce());
-    timed(Step::QrW, || {
-        if n >= HESSENBERG_QR_FROM {
-            // W's leading block is already Hessenberg: no second reduction (issue 13).
-            return hessenberg_eigenvalues(&mut blocks.a.data, n).ok();
-        }
-        let w = Mat::from_fn(n, n, |i, j| if i <= j + 1 { blocks.a.at(i, j) } else { 0.0 });
-        eigenvalues(w.as_ref())
-    })
+    let mut w = if a.nrows() < FAST_KERNELS_FROM {
+        let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
+        timed(Step::Pvl, || blocks.pvl_reduce());
+        blocks.a
+    } else {
+        let mut blocks =
+            SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) };
+        timed(Step::Pvl, || blocks.pvl_reduce());
+        blocks.a
+    };
+    timed(Step::QrW, || hessenberg_part_eigenvalues(&mut w))
+}
+
+/// The eigenvalues of the upper Hessenberg part of `w` (entries below the subdiagonal, the
+/// reduction's rounding, are not read).
+fn hessenberg_part_eigenvalues(w: &mut ColMajor) -> Option<Vec<c64>> {
+    let n = w.n;
+    if n >= HESSENBERG_QR_FROM {
+        // W's leading block is already Hessenberg: no second reduction (issue 13).
+        return hessenberg_eigenvalues(&mut w.data, n).ok();
+    }
+    let h = Mat::from_fn(n, n, |i, j| if i <= j + 1 { w.at(i, j) } else { 0.0 });
+    eigenvalues(h.as_ref())
 }
 
 /// A dense column-major square matrix with direct slice access to its columns (the reduction
@@ -156,19 +169,7 @@ impl ColMajor {
         &self.data[j * self.n..(j + 1) * self.n]
     }
 
-    fn row(&self, i: usize) -> Vec<f64> {
-        (0..self.n).map(|j| self.at(i, j)).collect()
-    }
-
-    fn view(&self) -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&self.data, self.n, self.n)
-    }
-
-    fn view_mut(&mut self) -> MatMut<'_, f64> {
-        MatMut::from_column_major_slice_mut(&mut self.data, self.n, self.n)
-    }
-
-    /// X ← P X P by hand-written loops, for small n ([`FAER_KERNELS_FROM`]): the same
+    /// X ← P X P by hand-written loops, for small n ([`FAST_KERNELS_FROM`]): the same
     /// arithmetic as before issue 13's third pass, so that small plants' results (the smoke
     /// campaign's) stay bit for bit what they were.
     fn reflect_two_sided_loops(
@@ -202,16 +203,9 @@ impl ColMajor {
 
     /// X ← P X P for P = I − β v vᵀ acting on indices r..n (v.len() = n − r). Columns before
     /// `first_col` are zero in rows r.. and are skipped on the left; rows before `first_row` are
-    /// zero in columns r.. and are skipped on the right. Left: t = X[r.., :]ᵀv,
-    /// X[r.., :] −= β v tᵀ; right: z = X[:, r..] v, X[:, r..] −= β z vᵀ: four level-2 passes
-    /// through faer's matrix–vector and rank-one kernels (SIMD chosen at run time) instead of
-    /// hand-written loops (issue 13). For the skew-symmetric G and Q the
-    /// identity P X P = X + β(v yᵀ − y vᵀ), y = Xv, would save a pass, but it was tried and lost
-    /// a crossing on a badly scaled SLICOT fixture (`scaled_random_1`, 5e-4 too low), and so
-    /// did the general fused form P X P = X − v(βt)ᵀ − (βz − β²(vᵀz)v)vᵀ with t = Xᵀv, z = Xv
-    /// (three passes instead of four; issue 13, fourth pass, 5.4e-4 too low on the same fixture):
-    /// on badly scaled X the rounding of the scalar vᵀXv spreads over the whole trailing block.
-    /// Below n = [`FAER_KERNELS_FROM`] it runs [`Self::reflect_two_sided_loops`] instead.
+    /// zero in columns r.. and are skipped on the right. From n = [`FAST_KERNELS_FROM`] on by
+    /// [`reflect_general`] (two merged passes, issue 13; before it, four level-2 passes through
+    /// faer's kernels), below it by [`Self::reflect_two_sided_loops`].
     fn reflect_two_sided(
         &mut self,
         r: usize,
@@ -221,46 +215,63 @@ impl ColMajor {
         first_row: usize,
         buf: &mut [f64],
     ) {
-        if self.n < FAER_KERNELS_FROM {
+        if self.n < FAST_KERNELS_FROM {
             return self.reflect_two_sided_loops(r, v, beta, first_col, first_row, buf);
         }
-        let (n, len) = (self.n, v.len());
-        let vc = MatRef::from_column_major_slice(v, len, 1);
-        let nc = n - first_col;
-        let t = &mut buf[..nc];
-        matmul(
-            MatMut::from_column_major_slice_mut(t, nc, 1),
-            Accum::Replace,
-            self.view().submatrix(r, first_col, len, nc).transpose(),
-            vc,
-            1.0,
-            Par::Seq,
-        );
-        let t = MatRef::from_row_major_slice(&buf[..nc], 1, nc);
-        matmul(self.view_mut().submatrix_mut(r, first_col, len, nc), Accum::Add, vc, t, -beta, Par::Seq);
-        let nr = n - first_row;
-        let z = &mut buf[..nr];
-        matmul(
-            MatMut::from_column_major_slice_mut(z, nr, 1),
-            Accum::Replace,
-            self.view().submatrix(first_row, r, nr, len),
-            vc,
-            1.0,
-            Par::Seq,
-        );
-        let z = MatRef::from_column_major_slice(&buf[..nr], nr, 1);
-        matmul(self.view_mut().submatrix_mut(first_row, r, nr, len), Accum::Add, z, vc.transpose(), -beta, Par::Seq);
+        reflect_general(&mut self.data, r, v, beta, first_col, first_row, buf);
+    }
+}
+
+/// Storage of the skew-symmetric blocks G and Q of a skew-Hamiltonian matrix: in full
+/// ([`ColMajor`], below [`FAST_KERNELS_FROM`]) or by the strict lower triangle ([`SkewLower`]).
+trait SkewBlock {
+    fn at(&self, i: usize, j: usize) -> f64;
+    fn set(&mut self, i: usize, j: usize, x: f64);
+    /// Entries from.. of column j (from > j).
+    fn col_below(&self, j: usize, from: usize) -> &[f64];
+    /// X ← P X P for P = I − β v vᵀ on the indices r..n; rows and columns before `first` are
+    /// zero outside the leading block and are skipped. `buf`: work space of length n.
+    fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]);
+}
+
+impl SkewBlock for ColMajor {
+    fn at(&self, i: usize, j: usize) -> f64 {
+        ColMajor::at(self, i, j)
+    }
+    fn set(&mut self, i: usize, j: usize, x: f64) {
+        ColMajor::set(self, i, j, x)
+    }
+    fn col_below(&self, j: usize, from: usize) -> &[f64] {
+        &self.col(j)[from..]
+    }
+    fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]) {
+        self.reflect_two_sided(r, v, beta, first, first, buf)
+    }
+}
+
+impl SkewBlock for SkewLower {
+    fn at(&self, i: usize, j: usize) -> f64 {
+        SkewLower::at(self, i, j)
+    }
+    fn set(&mut self, i: usize, j: usize, x: f64) {
+        SkewLower::set(self, i, j, x)
+    }
+    fn col_below(&self, j: usize, from: usize) -> &[f64] {
+        SkewLower::col_below(self, j, from)
+    }
+    fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]) {
+        self.reflect_two_sided(r, v, beta, first, buf)
     }
 }
 
 /// A skew-Hamiltonian matrix [A G; Q Aᵀ] stored by its three blocks (the fourth is Aᵀ).
-struct SkewHamiltonian {
+struct SkewHamiltonian<S> {
     a: ColMajor,
-    g: ColMajor,
-    q: ColMajor,
+    g: S,
+    q: S,
 }
 
-impl SkewHamiltonian {
+impl<S: SkewBlock> SkewHamiltonian<S> {
     /// Reduces to PVL form in place by orthogonal symplectic similarity (Kressner 2005,
     /// Alg. 4.8): for each column j, a Householder matrix diag(P, P) annihilates Q(j+2:n, j), a
     /// Givens rotation in the (j+1, n+j+1) plane annihilates Q(j+1, j), and a second diag(P, P)
@@ -270,11 +281,11 @@ impl SkewHamiltonian {
         let n = self.a.n;
         let mut v = vec![0.0; n];
         let mut w = vec![0.0; n];
-        let fast_norm = n >= FAER_KERNELS_FROM;
+        let fast_norm = n >= FAST_KERNELS_FROM;
         for j in 0..n.saturating_sub(1) {
             let r = j + 1;
             let len = n - r;
-            if let Some(beta) = householder(&self.q.col(j)[r..n], &mut v[..len], fast_norm) {
+            if let Some(beta) = householder(self.q.col_below(j, r), &mut v[..len], fast_norm) {
                 self.reflect(r, &v[..len], beta, j, &mut w);
             }
             let (a, b) = (self.a.at(r, j), self.q.at(r, j));
@@ -292,8 +303,8 @@ impl SkewHamiltonian {
     /// skew-symmetry, Q(0..j, :) = 0, so Q's update is confined to its trailing block.
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, j: usize, w: &mut [f64]) {
         self.a.reflect_two_sided(r, v, beta, j, 0, w);
-        self.g.reflect_two_sided(r, v, beta, 0, 0, w);
-        self.q.reflect_two_sided(r, v, beta, j, j, w);
+        self.g.reflect(r, v, beta, 0, w);
+        self.q.reflect(r, v, beta, j, w);
     }
 
     /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the full matrix M
@@ -301,12 +312,14 @@ impl SkewHamiltonian {
     /// = A(k, i) they are, from the old values,
     /// A(r,k) ← c A(r,k) + s Q(r,k),   Q(r,k) ← −s A(r,k) + c Q(r,k),   G(r,k) ← c G(r,k) + s A(k,r),
     /// A(i,r) ← c A(i,r) + s G(i,r),   G(i,r) ← −s A(i,r) + c G(i,r),   Q(i,r) ← c Q(i,r) + s A(r,i)
-    /// for i, k ≠ r, and the 2×2 block [A(r,r) G(r,r); Q(r,r) A(r,r)] ← R (·) Rᵀ.
+    /// for i, k ≠ r, and the 2×2 block [A(r,r) G(r,r); Q(r,r) A(r,r)] ← R (·) Rᵀ. With G, Q
+    /// stored as [`SkewLower`], setting G(r,k) also sets G(k,r) = −G(r,k); the two formulas give
+    /// exactly opposite values (rounding is symmetric), and the diagonal stays zero.
     fn rotate(&mut self, r: usize, c: f64, s: f64) {
         let n = self.a.n;
-        let (ar, ac) = (self.a.row(r), self.a.col(r).to_vec());
-        let (gr, gc) = (self.g.row(r), self.g.col(r).to_vec());
-        let (qr, qc) = (self.q.row(r), self.q.col(r).to_vec());
+        let (ar, ac): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (self.a.at(r, k), self.a.at(k, r))).unzip();
+        let (gr, gc): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (self.g.at(r, k), self.g.at(k, r))).unzip();
+        let (qr, qc): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (self.q.at(r, k), self.q.at(k, r))).unzip();
         for k in (0..n).filter(|&k| k != r) {
             self.a.set(r, k, c * ar[k] + s * qr[k]);
             self.q.set(r, k, -s * ar[k] + c * qr[k]);
@@ -326,7 +339,7 @@ impl SkewHamiltonian {
 
 /// The Householder vector (v₀ = 1) and β of P = I − β v vᵀ with P x = ∓‖x‖ e₁ (LAPACK `dlarfg`
 /// convention); `None` when x is already a multiple of e₁.
-/// From n = [`FAER_KERNELS_FROM`] on (`fast_norm`) the tail's norm is faer's (scaled, SIMD)
+/// From n = [`FAST_KERNELS_FROM`] on (`fast_norm`) the tail's norm is faer's (scaled, SIMD)
 /// instead of a `hypot` fold (libm's hypot was 2 % of a BDT2 design run).
 fn householder(x: &[f64], v: &mut [f64], fast_norm: bool) -> Option<f64> {
     let tail = if fast_norm {
@@ -384,30 +397,124 @@ mod tests {
         })
     }
 
-    #[test]
-    fn pvl_form_is_reached_and_similar() {
-        for (n, seed) in [(1usize, 1u64), (2, 2), (5, 3), (17, 4), (40, 5)] {
-            let (_, h) = random_hamiltonian(n, seed);
-            let m = &h * &h;
-            let block = |i0: usize, j0: usize| ColMajor::from(m.as_ref().submatrix(i0, j0, n, n));
-            let mut s = SkewHamiltonian { a: block(0, 0), g: block(0, n), q: block(n, 0) };
-            s.pvl_reduce();
-            let scale = m.norm_l2();
-            // Q = 0 and A upper Hessenberg, to rounding.
-            let mut off = 0.0f64;
-            for j in 0..n {
-                for i in 0..n {
-                    off = off.max(s.q.at(i, j).abs());
-                    if i > j + 1 {
-                        off = off.max(s.a.at(i, j).abs());
-                    }
+    /// Reduces [A G; Q Aᵀ] with G, Q stored as `S`; checks the PVL form (Q = 0 and A upper
+    /// Hessenberg to rounding) and the invariants of the similarity (Frobenius norm, trace).
+    fn reduce_and_check_form<S: SkewBlock>(mut s: SkewHamiltonian<S>, m: &Mat<f64>, what: &str) -> ColMajor {
+        let n = s.a.n;
+        let scale = m.norm_l2();
+        let trace: f64 = (0..n).map(|i| m[(i, i)]).sum();
+        s.pvl_reduce();
+        let mut off = 0.0f64;
+        for j in 0..n {
+            for i in 0..n {
+                off = off.max(s.q.at(i, j).abs());
+                if i > j + 1 {
+                    off = off.max(s.a.at(i, j).abs());
                 }
             }
-            assert!(off <= 1e-13 * scale, "n={n}: residual {off:e} vs ‖M‖ {scale:e}");
-            // Similarity: the Frobenius norm of [A G; 0 Aᵀ] equals that of M.
-            let fro = (2.0 * s.a.data.iter().map(|x| x * x).sum::<f64>() + s.g.data.iter().map(|x| x * x).sum::<f64>())
-                .sqrt();
-            assert!((fro - scale).abs() <= 1e-12 * scale, "n={n}: ‖·‖_F {fro} vs {scale}");
+        }
+        assert!(off <= 1e-13 * scale, "{what} n={n}: residual {off:e} vs ‖M‖ {scale:e}");
+        // Similarity: the Frobenius norm of [A G; 0 Aᵀ] equals that of M, trace(A) that of M₁₁.
+        let g2: f64 = (0..n).flat_map(|j| (0..n).map(move |i| (i, j))).map(|(i, j)| s.g.at(i, j).powi(2)).sum();
+        let fro = (2.0 * s.a.data.iter().map(|x| x * x).sum::<f64>() + g2).sqrt();
+        assert!((fro - scale).abs() <= 1e-12 * scale, "{what} n={n}: ‖·‖_F {fro} vs {scale}");
+        let t: f64 = (0..n).map(|i| s.a.at(i, i)).sum();
+        assert!((t - trace).abs() <= 1e-12 * scale, "{what} n={n}: trace {t} vs {trace}");
+        s.a
+    }
+
+    #[test]
+    fn pvl_form_is_reached_and_similar() {
+        for (n, seed) in [(1usize, 1u64), (2, 2), (5, 3), (17, 4), (40, 5), (64, 6)] {
+            let (_, h) = random_hamiltonian(n, seed);
+            let m = &h * &h;
+            let block = |i0: usize, j0: usize| m.as_ref().submatrix(i0, j0, n, n);
+            let full = SkewHamiltonian {
+                a: ColMajor::from(block(0, 0)),
+                g: ColMajor::from(block(0, n)),
+                q: ColMajor::from(block(n, 0)),
+            };
+            reduce_and_check_form(full, &m, "full");
+            let tri = SkewHamiltonian {
+                a: ColMajor::from(block(0, 0)),
+                g: SkewLower::from_lower(block(0, n)),
+                q: SkewLower::from_lower(block(n, 0)),
+            };
+            reduce_and_check_form(tri, &m, "triangular");
+        }
+    }
+
+    /// A random skew-Hamiltonian [A G; Q Aᵀ] (G, Q skew) after the symplectic diagonal
+    /// similarity diag(D, D⁻¹), D = diag(10^(−s/2) … 10^(s/2)): G → DGD, Q → D⁻¹QD⁻¹, A → DAD⁻¹,
+    /// same eigenvalues, entries spread over 2s decades.
+    fn random_skew_hamiltonian(n: usize, seed: u64, s: f64) -> [Mat<f64>; 3] {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut r = |_: usize, _: usize| -> f64 { StandardNormal.sample(&mut rng) };
+        let a = Mat::from_fn(n, n, &mut r);
+        let (g0, q0) = (Mat::from_fn(n, n, &mut r), Mat::from_fn(n, n, &mut r));
+        let d: Vec<f64> = (0..n).map(|i| 10f64.powf(s * (i as f64 / (n - 1) as f64 - 0.5))).collect();
+        [
+            Mat::from_fn(n, n, |i, j| d[i] * a[(i, j)] / d[j]),
+            Mat::from_fn(n, n, |i, j| d[i] * (g0[(i, j)] - g0[(j, i)]) * d[j]),
+            Mat::from_fn(n, n, |i, j| (q0[(i, j)] - q0[(j, i)]) / (d[i] * d[j])),
+        ]
+    }
+
+    /// The triangular storage of G, Q (used from n = FAST_KERNELS_FROM on) against the full one
+    /// and the unstructured solver of the 2n×2n matrix, on random and badly scaled
+    /// skew-Hamiltonian matrices: the same PVL form and, eigenvalue for eigenvalue, an error
+    /// against the truth (the unscaled matrix's spectrum) within the full storage's.
+    #[test]
+    fn triangular_storage_matches_full_storage() {
+        for (n, seed) in [(30usize, 31u64), (47, 32), (80, 33)] {
+            let unscaled = random_skew_hamiltonian(n, seed, 0.0);
+            let [a, g, q] = &unscaled;
+            let w = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+                (true, true) => a[(i, j)],
+                (true, false) => g[(i, j - n)],
+                (false, true) => q[(i - n, j)],
+                (false, false) => a[(j - n, i - n)],
+            });
+            let truth = eigenvalues(w.as_ref()).unwrap();
+            for s in [0.0, 4.0, 8.0] {
+                let [a, g, q] = random_skew_hamiltonian(n, seed, s);
+                let norm = (2.0 * a.squared_norm_l2() + g.squared_norm_l2() + q.squared_norm_l2()).sqrt();
+                let m = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+                    (true, true) => a[(i, j)],
+                    (true, false) => g[(i, j - n)],
+                    (false, true) => q[(i - n, j)],
+                    (false, false) => a[(j - n, i - n)],
+                });
+                let full = SkewHamiltonian {
+                    a: ColMajor::from(a.as_ref()),
+                    g: ColMajor::from(g.as_ref()),
+                    q: ColMajor::from(q.as_ref()),
+                };
+                let mut w_full = reduce_and_check_form(full, &m, "full");
+                let tri = SkewHamiltonian {
+                    a: ColMajor::from(a.as_ref()),
+                    g: SkewLower::from_lower(g.as_ref()),
+                    q: SkewLower::from_lower(q.as_ref()),
+                };
+                let mut w_tri = reduce_and_check_form(tri, &m, "triangular");
+                let err = |w: &mut ColMajor| -> f64 {
+                    let mu = hessenberg_part_eigenvalues(w).unwrap();
+                    assert_eq!(mu.len(), n);
+                    mu.iter()
+                        .map(|x| truth.iter().map(|t| (t - x).norm()).fold(f64::INFINITY, f64::min))
+                        .fold(0.0, f64::max)
+                };
+                let (e_full, e_tri) = (err(&mut w_full), err(&mut w_tri));
+                assert!(
+                    e_tri <= 10.0 * e_full + ERROR_FACTOR * f64::EPSILON * norm,
+                    "n={n} s={s}: triangular storage off by {e_tri:e}, full by {e_full:e} (ε‖W‖ = {:e})",
+                    f64::EPSILON * norm
+                );
+                eprintln!(
+                    "n={n} s={s}: max error triangular {e_tri:e}, full {e_full:e}, ε‖W‖_F {:e}",
+                    f64::EPSILON * norm
+                );
+            }
         }
     }
 
