@@ -34,6 +34,29 @@ pub(crate) fn dot_four_lanes(x: &[f64], y: &[f64]) -> f64 {
     s
 }
 
+/// Σ_j (ar_j + i·ai_j)(br_j + i·bi_j) on split real and imaginary parts, in four partial sums
+/// (lane l takes j ≡ l mod 4; the tail goes to lane 0) added as (s₀ + s₁) + (s₂ + s₃): the
+/// complex counterpart of [`dot_four_lanes`] in one pass (the back substitution of
+/// `lti::hessenberg_solve`; its tail, unlike there, joins lane 0 before the lanes are added).
+#[inline(always)]
+pub(crate) fn complex_dot_four_lanes(ar: &[f64], ai: &[f64], br: &[f64], bi: &[f64]) -> (f64, f64) {
+    const L: usize = 4;
+    let (mut pr, mut pi) = ([0.0f64; L], [0.0f64; L]);
+    let (car, cai, cbr, cbi) = (ar.chunks_exact(L), ai.chunks_exact(L), br.chunks_exact(L), bi.chunks_exact(L));
+    let rest = (car.remainder(), cai.remainder(), cbr.remainder(), cbi.remainder());
+    for (((a_re, a_im), b_re), b_im) in car.zip(cai).zip(cbr).zip(cbi) {
+        for l in 0..L {
+            pr[l] += a_re[l] * b_re[l] - a_im[l] * b_im[l];
+            pi[l] += a_re[l] * b_im[l] + a_im[l] * b_re[l];
+        }
+    }
+    for j in 0..rest.0.len() {
+        pr[0] += rest.0[j] * rest.2[j] - rest.1[j] * rest.3[j];
+        pi[0] += rest.0[j] * rest.3[j] + rest.1[j] * rest.2[j];
+    }
+    ((pr[0] + pr[1]) + (pr[2] + pr[3]), (pi[0] + pi[1]) + (pi[2] + pi[3]))
+}
+
 /// Whether every entry of a matrix is finite (no NaN, no ±∞).
 pub(crate) fn all_finite(m: MatRef<'_, f64>) -> bool {
     (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()))

@@ -6,7 +6,7 @@
 //! layout differs (issue 13): a row update r₁ ← r₁ − l·r₀ on split real and imaginary parts is
 //! independent per entry, and the compiler vectorises it where interleaved complex numbers kept it
 //! scalar. The elimination has the interleaved solve's operations in its order; the back
-//! substitution's sums run over four partial sums ([`complex_dot`]) so that they vectorise too,
+//! substitution's sums run over four partial sums (`numeric::complex_dot_four_lanes`) so that they vectorise too,
 //! which changes their rounding: the two solves agree to rounding, not bit for bit (the
 //! interleaved one serves below order `HESSENBERG_QR_FROM`, this one from it on, so no system sees
 //! both). On x86-64 CPUs with AVX2 (detected at run time) the same code is compiled for 256-bit
@@ -14,6 +14,8 @@
 //! of every sum is fixed by the code, so both builds give the same bits.
 
 use faer::c64;
+
+use crate::numeric::complex_dot_four_lanes;
 
 /// Work arrays and the result of [`ShiftedHessenbergSolve::solve`].
 pub(crate) struct ShiftedHessenbergSolve {
@@ -136,7 +138,7 @@ impl ShiftedHessenbergSolve {
                 let col = c * n;
                 let (head_r, tail_r) = xr[col..col + n].split_at_mut(k + 1);
                 let (head_i, tail_i) = xi[col..col + n].split_at_mut(k + 1);
-                let (dr, di) = complex_dot(ur, ui, tail_r, tail_i);
+                let (dr, di) = complex_dot_four_lanes(ur, ui, tail_r, tail_i);
                 let (sr, si) = (head_r[k] - dr, head_i[k] - di);
                 let x = if piv == c64::new(0.0, 0.0) { c64::new(f64::INFINITY, 0.0) } else { c64::new(sr, si) / piv };
                 head_r[k] = x.re;
@@ -144,27 +146,6 @@ impl ShiftedHessenbergSolve {
             }
         }
     }
-}
-
-/// Σ_j (ar_j + i·ai_j)(br_j + i·bi_j) on split real and imaginary parts, in four partial sums
-/// (lane l takes j ≡ l mod 4; the tail goes to lane 0) added as (s₀ + s₁) + (s₂ + s₃).
-#[inline(always)]
-fn complex_dot(ar: &[f64], ai: &[f64], br: &[f64], bi: &[f64]) -> (f64, f64) {
-    const L: usize = 4;
-    let (mut pr, mut pi) = ([0.0f64; L], [0.0f64; L]);
-    let (car, cai, cbr, cbi) = (ar.chunks_exact(L), ai.chunks_exact(L), br.chunks_exact(L), bi.chunks_exact(L));
-    let rest = (car.remainder(), cai.remainder(), cbr.remainder(), cbi.remainder());
-    for (((a_re, a_im), b_re), b_im) in car.zip(cai).zip(cbr).zip(cbi) {
-        for l in 0..L {
-            pr[l] += a_re[l] * b_re[l] - a_im[l] * b_im[l];
-            pi[l] += a_re[l] * b_im[l] + a_im[l] * b_re[l];
-        }
-    }
-    for j in 0..rest.0.len() {
-        pr[0] += rest.0[j] * rest.2[j] - rest.1[j] * rest.3[j];
-        pi[0] += rest.0[j] * rest.3[j] + rest.1[j] * rest.2[j];
-    }
-    ((pr[0] + pr[1]) + (pr[2] + pr[3]), (pi[0] + pi[1]) + (pi[2] + pi[3]))
 }
 
 #[cfg(test)]

@@ -114,14 +114,9 @@ pub(crate) fn skew_hamiltonian_eigenvalues(
     q: MatRef<'_, f64>,
 ) -> Option<Vec<c64>> {
     let mut w = if a.nrows() < FAST_KERNELS_FROM {
-        let mut blocks = SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) };
-        timed(Step::Pvl, || blocks.pvl_reduce());
-        blocks.a
+        SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) }.into_pvl_w()
     } else {
-        let mut blocks =
-            SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) };
-        timed(Step::Pvl, || blocks.pvl_reduce());
-        blocks.a
+        SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) }.into_pvl_w()
     };
     timed(Step::QrW, || hessenberg_part_eigenvalues(&mut w))
 }
@@ -272,6 +267,12 @@ struct SkewHamiltonian<S> {
 }
 
 impl<S: SkewBlock> SkewHamiltonian<S> {
+    /// [`Self::pvl_reduce`] (timed as [`Step::Pvl`]), then the block W = A of the PVL form.
+    fn into_pvl_w(mut self) -> ColMajor {
+        timed(Step::Pvl, || self.pvl_reduce());
+        self.a
+    }
+
     /// Reduces to PVL form in place by orthogonal symplectic similarity (Kressner 2005,
     /// Alg. 4.8): for each column j, a Householder matrix diag(P, P) annihilates Q(j+2:n, j), a
     /// Givens rotation in the (j+1, n+j+1) plane annihilates Q(j+1, j), and a second diag(P, P)
