@@ -221,16 +221,18 @@ fn print_steps(s: &step_stats::StepStats, evals: usize, cpu_s: f64) {
         }
         let per_norm = |st: Step| s.calls(st, large) as f64 / norms as f64;
         println!(
-            "    order {} {}: {norms} norms ({:.2} per evaluation), {} using the pencil; level-set tests per norm: {:.3} explicit, {:.3} pencil",
+            "    order {} {}: {norms} norms ({:.2} per evaluation), {} using the pencil; level-set tests per norm: {:.3} explicit ({:.3} doubtful), {:.3} pencil, {:.3} finding crossings",
             if large { ">=" } else { "<" },
             step_stats::LARGE_ORDER,
             norms as f64 / evals.max(1) as f64,
             s.calls(Step::NormUsingPencil, large),
             per_norm(Step::ExplicitLevelSet),
+            per_norm(Step::DoubtfulSquared),
             per_norm(Step::PencilLevelSet),
+            per_norm(Step::CrossingsFound),
         );
         println!("      {:<24} {:>9} {:>10} {:>9} {:>7}", "step", "calls", "CPU s", "ms/call", "% run");
-        for step in Step::ALL.into_iter().filter(|&st| st != Step::NormUsingPencil && s.calls(st, large) > 0) {
+        for step in Step::ALL.into_iter().filter(|&st| !st.count_only() && s.calls(st, large) > 0) {
             let (c, t) = (s.calls(step, large), s.cpu_s(step, large));
             println!(
                 "      {:<24} {c:>9} {t:>10.3} {:>9.4} {:>6.1}%",

@@ -276,6 +276,7 @@ fn hinf_norm_from(
         if ws.is_empty() {
             break;
         }
+        count(Step::CrossingsFound);
         let before = best.gamma;
         let mut mids: Vec<f64> = Vec::with_capacity(ws.len() + 2);
         // σ(∞) = σmax(D) < γ, so an odd count means a crossing was lost, and it may lie in any
@@ -536,7 +537,8 @@ impl<'s> Hamiltonian<'s> {
         // ω = 0 or tangent pairs keep their accuracy; cheap at that size): the squared spectrum
         // lost real crossings on AC4 closed loops of order 6 (`tests/hinf_regression.rs`).
         let explicit = self.sys.order() >= HESSENBERG_QR_FROM;
-        let squared = if explicit && kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND {
+        let try_squared = explicit && kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND;
+        let squared = if try_squared {
             timed(Step::ExplicitLevelSet, || {
                 let [f, g, k] = self.explicit_hamiltonian(gamma);
                 hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref())
@@ -549,6 +551,9 @@ impl<'s> Hamiltonian<'s> {
         let mut ws = match squared {
             Some(ws) => ws,
             None => {
+                if try_squared {
+                    count(Step::DoubtfulSquared);
+                }
                 if !self.used_pencil.replace(true) {
                     count(Step::NormUsingPencil);
                 }

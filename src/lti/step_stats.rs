@@ -50,11 +50,21 @@ pub enum Step {
     LowerBound,
     /// An H∞ norm computation that needed at least one pencil level-set test (count only).
     NormUsingPencil,
+    /// An explicit level-set test whose squared spectrum was doubtful, so that the pencil
+    /// decided at the same γ (count only).
+    DoubtfulSquared,
+    /// A level-set test that reported crossings, so that the level-set loop went on (count only).
+    CrossingsFound,
 }
 
 impl Step {
+    /// Whether the step is only counted, never timed.
+    pub fn count_only(self) -> bool {
+        matches!(self, Step::NormUsingPencil | Step::DoubtfulSquared | Step::CrossingsFound)
+    }
+
     /// All steps, in report order.
-    pub const ALL: [Step; 15] = [
+    pub const ALL: [Step; 17] = [
         Step::Norm,
         Step::Poles,
         Step::Hessenberg,
@@ -70,6 +80,8 @@ impl Step {
         Step::Gradient,
         Step::LowerBound,
         Step::NormUsingPencil,
+        Step::DoubtfulSquared,
+        Step::CrossingsFound,
     ];
 
     fn index(self) -> usize {
@@ -92,6 +104,8 @@ impl Step {
             Step::Gradient => "gradient vectors",
             Step::LowerBound => "lower bound (screen)",
             Step::NormUsingPencil => "norms using the pencil",
+            Step::DoubtfulSquared => "doubtful squared spectra",
+            Step::CrossingsFound => "tests finding crossings",
         }
     }
 }
