@@ -85,7 +85,7 @@ fn screened_evaluator_reuse_is_exact() {
         let mut slot = ResponseSlot::default();
         let cl = closed_loop(&plant, screened).unwrap();
         assert!(cl.order() >= 30, "the large-order path");
-        let lb = hinf_lower_bound_sharing(&cl, &hint, &mut slot);
+        let lb = hinf_lower_bound_sharing(&cl, &hint, f64::INFINITY, &mut slot);
         step_stats::reset();
         let shared =
             closed_loop_hinf_grad_sharing(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot).unwrap();

@@ -132,6 +132,11 @@ pub struct DesignObjective<'p> {
     /// Peak frequency of ‖Tzw‖∞ at the last finite performance evaluation (NaN: none yet), where
     /// σmax(Tzw(iω)) gives a line search's trial point a cheap lower bound of f.
     peak_hint: Cell<f64>,
+    /// The last peak frequency before `peak_hint` that was another peak (NaN: none yet). Near a
+    /// minimum where two peaks are equally high (the usual nonsmooth optimum), the peak jumps
+    /// between them from one evaluation to the next, and a trial point fails the line search's
+    /// test at either; the screen looks at both.
+    other_peak: Cell<f64>,
     /// The closed loop's frequency-response evaluator left by the last screened trial
     /// ([`Objective::eval_below`]), for its norm if it passes the screen (`lti::ResponseSlot`).
     screened: RefCell<ResponseSlot>,
@@ -168,6 +173,7 @@ impl<'p> DesignObjective<'p> {
             hinf_tol,
             cache,
             peak_hint: Cell::new(f64::NAN),
+            other_peak: Cell::new(f64::NAN),
             screened: RefCell::new(ResponseSlot::default()),
             stop: None,
             abandoned: Cell::new(false),
@@ -289,7 +295,10 @@ impl<'p> DesignObjective<'p> {
                     report(thread_cpu_time() - t0);
                 }
                 if norm.value.is_finite() {
-                    self.peak_hint.set(norm.peak_freq);
+                    let last = self.peak_hint.replace(norm.peak_freq);
+                    if other_peak(last, norm.peak_freq) {
+                        self.other_peak.set(last);
+                    }
                 }
                 (norm.value, Some(g))
             }
@@ -319,20 +328,36 @@ impl<'p> DesignObjective<'p> {
 
 impl DesignObjective<'_> {
     /// A lower bound of the performance objective at `k` without any eigenvalue computation of
-    /// the closed loop: max(σmax(Tzw(iω)) at ω = ∞ and the last peak frequency, ε‖K‖∞) (‖K‖∞ is
+    /// the closed loop: max(σmax(Tzw(iω)) at ω = ∞, at the last peak frequency and up the peak
+    /// next to it while below `threshold` (`lti::hinf_lower_bound_sharing`), ε‖K‖∞) (‖K‖∞ is
     /// of the small controller, computed in full). +∞ for an ill-posed loop. Exact: f(k) ≥ it
     /// whether or not the loop is stable (f = +∞ when it is not).
-    fn performance_lower_bound(&self, k: &Controller) -> f64 {
+    fn performance_lower_bound(&self, k: &Controller, threshold: f64) -> f64 {
         let mut lb = f64::NEG_INFINITY;
         if self.strong {
             let (norm, _) = controller_hinf_grad(k, self.hinf_tol);
             lb = self.eps * norm.value;
         }
         match closed_loop(self.plant, k) {
-            Ok(cl) => lb.max(hinf_lower_bound_sharing(&cl, &[self.peak_hint.get()], &mut self.screened.borrow_mut())),
+            Ok(cl) => lb.max(hinf_lower_bound_sharing(
+                &cl,
+                &[self.peak_hint.get(), self.other_peak.get()],
+                threshold,
+                &mut self.screened.borrow_mut(),
+            )),
             Err(_) => f64::INFINITY,
         }
     }
+}
+
+/// Whether the peak frequency `last` is another peak than `new` (not NaN, and more than 10 %
+/// away: the same peak drifts by less between evaluations), to be kept as the objective's
+/// `other_peak`.
+fn other_peak(last: f64, new: f64) -> bool {
+    if last.is_nan() || last == new {
+        return false;
+    }
+    !(last > 0.0 && new > 0.0 && last.is_finite() && new.is_finite() && (last / new).ln().abs() < 0.1)
 }
 
 fn scale(mut g: ControllerGradient, s: f64) -> ControllerGradient {
@@ -371,12 +396,12 @@ impl Objective for DesignObjective<'_> {
     }
 
     /// In the performance phase, a trial point whose cheap lower bound
-    /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and at the last peak, ε‖K‖∞) already
+    /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and up the last peak, ε‖K‖∞) already
     /// reaches `threshold` is rejected
     /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13).
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
         if self.phase == ObjectivePhase::Performance && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION {
-            let lb = self.performance_lower_bound(&self.controller(x));
+            let lb = self.performance_lower_bound(&self.controller(x), threshold);
             if lb >= threshold {
                 g.iter_mut().for_each(|v| *v = f64::NAN);
                 return lb;
