@@ -13,6 +13,7 @@ pub(crate) mod freq_response;
 pub use freq_response::ResponseSlot;
 mod full_order;
 mod gradient;
+mod hessenberg_aed;
 mod hessenberg_qr;
 mod hessenberg_solve;
 mod hinf;
@@ -24,6 +25,8 @@ mod matrix_json;
 mod plant;
 mod plant_library;
 mod pvl_update;
+#[doc(hidden)]
+pub mod qr_bench;
 mod riccati;
 mod spectral;
 mod square_reduced;
