@@ -32,8 +32,7 @@
 //! `dlahqr`); beyond that a [`HessenbergQrError`], never a panic or an endless loop.
 
 use faer::c64;
-
-use super::hessenberg_aed::{aggressive_deflation_eigenvalues, AGGRESSIVE_DEFLATION_FROM};
+use pulp::{Arch, Simd, WithSimd};
 
 /// From this size n on, the H∞ computation takes its eigenvalues from this QR (the closed loop's
 /// poles from the frequency response's Hessenberg form, the square-reduced method's W directly);
@@ -44,7 +43,7 @@ pub(crate) const HESSENBERG_QR_FROM: usize = 30;
 /// The iteration limit is this many times max(10, n) (as in LAPACK's `dlahqr`).
 pub(crate) const ITERATIONS_PER_EIGENVALUE: usize = 30;
 /// An exceptional shift every this many iterations without a deflation (`dlahqr`'s KEXSH).
-pub(super) const EXCEPTIONAL_SHIFT_EVERY: usize = 10;
+const EXCEPTIONAL_SHIFT_EVERY: usize = 10;
 /// The exceptional shift's coefficients (`dlahqr`'s DAT1, DAT2).
 const EXCEPTIONAL_DIAG: f64 = 0.75;
 const EXCEPTIONAL_OFF: f64 = -0.4375;
@@ -64,148 +63,125 @@ pub(crate) struct HessenbergQrError {
 /// The eigenvalues of the n×n upper Hessenberg matrix stored column-major in `h` (h[i + j·n] =
 /// H(i, j); entries below the first subdiagonal are ignored). `h` is overwritten. A complex
 /// conjugate pair is returned as (λ, λ̄) with Im λ > 0 first. The entries must be finite.
-///
-/// From [`AGGRESSIVE_DEFLATION_FROM`] on by the multishift iteration with aggressive early
-/// deflation (`hessenberg_aed.rs`), below it by the double-shift iteration of this file.
 pub(crate) fn hessenberg_eigenvalues(h: &mut [f64], n: usize) -> Result<Vec<c64>, HessenbergQrError> {
-    if n >= AGGRESSIVE_DEFLATION_FROM {
-        return aggressive_deflation_eigenvalues(h, n);
-    }
-    double_shift_eigenvalues(h, n)
-}
-
-/// [`hessenberg_eigenvalues`] by the double-shift iteration alone, at every size (the
-/// reference of the QR microbenchmark, `benches/lti.rs --qr`).
-pub(crate) fn double_shift_eigenvalues(h: &mut [f64], n: usize) -> Result<Vec<c64>, HessenbergQrError> {
-    hessenberg_eigenvalues_capped(h, n, iteration_limit(n))
-}
-
-/// The iteration limit per deflation for an n×n matrix.
-pub(super) fn iteration_limit(n: usize) -> usize {
-    ITERATIONS_PER_EIGENVALUE * n.max(10)
-}
-
-/// Sets the entries of the n×n column-major `h` below its first subdiagonal to zero (the
-/// bulge-chasing steps read them).
-pub(super) fn clear_below_subdiagonal(h: &mut [f64], n: usize) {
-    for j in 0..n {
-        for i in j + 2..n {
-            h[i + j * n] = 0.0;
-        }
-    }
+    hessenberg_eigenvalues_capped(h, n, ITERATIONS_PER_EIGENVALUE * n.max(10))
 }
 
 /// [`hessenberg_eigenvalues`] with an explicit iteration limit.
+///
+/// Compiled for the best instruction set the processor has (pulp's run-time dispatch, as the
+/// PVL kernels in `pvl_update.rs`): with AVX2 the column updates of the reflections run four
+/// lanes wide. The code makes no use of fused multiply-adds or reordered sums, so every
+/// instruction set gives the same result bit for bit.
 fn hessenberg_eigenvalues_capped(h: &mut [f64], n: usize, max_iters: usize) -> Result<Vec<c64>, HessenbergQrError> {
+    Arch::new().dispatch(Iteration { h, n, max_iters })
+}
+
+/// [`hessenberg_eigenvalues_capped`] for one instruction set.
+struct Iteration<'a> {
+    h: &'a mut [f64],
+    n: usize,
+    max_iters: usize,
+}
+
+impl WithSimd for Iteration<'_> {
+    type Output = Result<Vec<c64>, HessenbergQrError>;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) -> Self::Output {
+        let Iteration { h, n, max_iters } = self;
+        francis_iteration(h, n, max_iters)
+    }
+}
+
+/// The double-shift iteration (module docs); inlined into each instruction set's copy.
+#[inline(always)]
+fn francis_iteration(h: &mut [f64], n: usize, max_iters: usize) -> Result<Vec<c64>, HessenbergQrError> {
     assert_eq!(h.len(), n * n, "hessenberg_eigenvalues: storage does not match the size");
     let mut ev = vec![c64::new(0.0, 0.0); n];
     if n == 0 {
         return Ok(ev);
     }
-    clear_below_subdiagonal(h, n);
-    let mut qr = Window::values_only(h, n);
-    qr.converge_block(0, n - 1, &mut ev, max_iters)?;
-    Ok(ev)
+    // Entries below the subdiagonal are read by the first bulge-chasing step: clear them.
+    for j in 0..n {
+        for i in j + 2..n {
+            h[i + j * n] = 0.0;
+        }
+    }
+    let ulp = f64::EPSILON;
+    let smlnum = f64::MIN_POSITIVE * (n as f64 / ulp);
+    let mut qr = Window { h, n };
+    // Iterations since the last deflation (selects the exceptional shifts).
+    let mut since_deflation = 0usize;
+    // i: the bottom of the active window; everything below it has converged.
+    let mut i = n - 1;
+    loop {
+        let mut l = 0;
+        let mut deflated = false;
+        for _ in 0..=max_iters {
+            l = qr.small_subdiagonal(l, i, ulp, smlnum);
+            if l > 0 {
+                qr.set(l, l - 1, 0.0);
+            }
+            if l + 1 >= i {
+                deflated = true;
+                break;
+            }
+            since_deflation += 1;
+            let shifts = qr.shifts(l, i, since_deflation);
+            let (m, v) = qr.bulge_start(l, i, shifts, ulp);
+            qr.double_shift_step(l, m, i, v);
+        }
+        if !deflated {
+            let converged = n - 1 - i;
+            return Err(HessenbergQrError { n, converged, iterations: max_iters });
+        }
+        if l == i {
+            ev[i] = c64::new(qr.at(i, i), 0.0);
+        } else {
+            let [a, b] = eigenvalues_2x2(qr.at(i - 1, i - 1), qr.at(i - 1, i), qr.at(i, i - 1), qr.at(i, i));
+            ev[i - 1] = a;
+            ev[i] = b;
+        }
+        since_deflation = 0;
+        if l == 0 {
+            return Ok(ev);
+        }
+        i = l - 1;
+    }
 }
 
 /// The two shifts of a double-shift step as real and imaginary parts (a complex pair has
-/// `im1 = −im2`; two real shifts have im1 = im2 = 0).
+/// `im1 = −im2`; two real shifts are equal).
 #[derive(Clone, Copy)]
-pub(super) struct Shifts {
-    pub(super) re1: f64,
-    pub(super) im1: f64,
-    pub(super) re2: f64,
-    pub(super) im2: f64,
+struct Shifts {
+    re1: f64,
+    im1: f64,
+    re2: f64,
+    im2: f64,
 }
 
-/// The Hessenberg matrix being iterated on (column-major), with the orthogonal factor Z of a
-/// Schur form when one is wanted.
-pub(super) struct Window<'a> {
+/// The Hessenberg matrix being iterated on (column-major).
+struct Window<'a> {
     h: &'a mut [f64],
     n: usize,
-    /// `None`: values only, each step updates just the active window (module docs). `Some(Z)`
-    /// (n×n, column-major): the full Schur form, each step updates whole rows and columns of H
-    /// and accumulates its reflections into Z (H₀ = Z·T·Zᵀ).
-    z: Option<&'a mut [f64]>,
 }
 
-impl<'a> Window<'a> {
-    pub(super) fn values_only(h: &'a mut [f64], n: usize) -> Self {
-        Window { h, n, z: None }
-    }
-
-    /// The Schur form T of H, with the factor accumulated into `z` (pass the identity to get
-    /// H = Z·T·Zᵀ).
-    pub(super) fn schur_form(h: &'a mut [f64], z: &'a mut [f64], n: usize) -> Self {
-        Window { h, n, z: Some(z) }
-    }
-
-    /// The iteration on the diagonal block lo..=hi, decoupled from the rest (lo = 0 or
-    /// H(lo, lo−1) = 0; everything below hi converged): its eigenvalues into ev[lo..=hi], a
-    /// complex pair as (λ, λ̄), Im λ > 0 first. At most `max_iters` iterations per deflation.
-    pub(super) fn converge_block(
-        &mut self,
-        lo: usize,
-        hi: usize,
-        ev: &mut [c64],
-        max_iters: usize,
-    ) -> Result<(), HessenbergQrError> {
-        let ulp = f64::EPSILON;
-        let smlnum = f64::MIN_POSITIVE * (self.n as f64 / ulp);
-        // Iterations since the last deflation (selects the exceptional shifts).
-        let mut since_deflation = 0usize;
-        // i: the bottom of the active window; everything below it has converged.
-        let mut i = hi;
-        loop {
-            let mut l = lo;
-            let mut deflated = false;
-            for _ in 0..=max_iters {
-                l = self.small_subdiagonal(l, i, ulp, smlnum);
-                if l > lo {
-                    self.set(l, l - 1, 0.0);
-                }
-                if l + 1 >= i {
-                    deflated = true;
-                    break;
-                }
-                since_deflation += 1;
-                let shifts = self.shifts(l, i, since_deflation);
-                let (m, v) = self.bulge_start(l, i, shifts, ulp);
-                self.double_shift_step(l, m, i, v);
-            }
-            if !deflated {
-                let converged = hi - i;
-                return Err(HessenbergQrError { n: self.n, converged, iterations: max_iters });
-            }
-            if l == i {
-                ev[i] = c64::new(self.at(i, i), 0.0);
-            } else {
-                let [a, b] =
-                    eigenvalues_2x2(self.at(i - 1, i - 1), self.at(i - 1, i), self.at(i, i - 1), self.at(i, i));
-                ev[i - 1] = a;
-                ev[i] = b;
-            }
-            since_deflation = 0;
-            if l == lo {
-                return Ok(());
-            }
-            i = l - 1;
-        }
-    }
-
-    #[inline]
-    pub(super) fn at(&self, i: usize, j: usize) -> f64 {
+impl Window<'_> {
+    #[inline(always)]
+    fn at(&self, i: usize, j: usize) -> f64 {
         self.h[i + j * self.n]
     }
 
-    #[inline]
-    pub(super) fn set(&mut self, i: usize, j: usize, x: f64) {
+    #[inline(always)]
+    fn set(&mut self, i: usize, j: usize, x: f64) {
         self.h[i + j * self.n] = x;
     }
 
     /// The largest k in l+1..=i whose subdiagonal entry h_{k,k−1} is negligible (dlahqr's test,
     /// module docs), or l if there is none.
-    pub(super) fn small_subdiagonal(&self, l: usize, i: usize, ulp: f64, smlnum: f64) -> usize {
+    #[inline(always)]
+    fn small_subdiagonal(&self, l: usize, i: usize, ulp: f64, smlnum: f64) -> usize {
         let mut k = i;
         while k > l {
             let sub = self.at(k, k - 1).abs();
@@ -240,7 +216,8 @@ impl<'a> Window<'a> {
 
     /// The double shift for the window l..=i (l + 1 < i): the trailing 2×2 block's eigenvalues,
     /// or an exceptional shift every [`EXCEPTIONAL_SHIFT_EVERY`] iterations without deflation.
-    pub(super) fn shifts(&self, l: usize, i: usize, since_deflation: usize) -> Shifts {
+    #[inline(always)]
+    fn shifts(&self, l: usize, i: usize, since_deflation: usize) -> Shifts {
         let (h11, h12, h21, h22);
         if since_deflation.is_multiple_of(2 * EXCEPTIONAL_SHIFT_EVERY) {
             let s = self.at(i, i - 1).abs() + self.at(i - 1, i - 2).abs();
@@ -275,14 +252,24 @@ impl<'a> Window<'a> {
     /// Where the bulge starts: the largest m in l..=i−2 below which two consecutive subdiagonal
     /// entries are small enough to decouple the step (GVL §7.5.6), with the first column of
     /// (H − σ₁I)(H − σ₂I) restricted to rows m..m+2, scaled.
-    pub(super) fn bulge_start(&self, l: usize, i: usize, sh: Shifts, ulp: f64) -> (usize, [f64; 3]) {
+    #[inline(always)]
+    fn bulge_start(&self, l: usize, i: usize, sh: Shifts, ulp: f64) -> (usize, [f64; 3]) {
         let mut m = i - 2;
         loop {
-            let v = self.first_column(m, sh);
+            let hmm = self.at(m, m);
+            let h21s = self.at(m + 1, m);
+            let s = (hmm - sh.re2).abs() + sh.im2.abs() + h21s.abs();
+            let h21s = h21s / s;
+            let mut v = [
+                h21s * self.at(m, m + 1) + (hmm - sh.re1) * ((hmm - sh.re2) / s) - sh.im1 * (sh.im2 / s),
+                h21s * (hmm + self.at(m + 1, m + 1) - sh.re1 - sh.re2),
+                h21s * self.at(m + 2, m + 1),
+            ];
+            let s = v[0].abs() + v[1].abs() + v[2].abs();
+            v.iter_mut().for_each(|x| *x /= s);
             if m == l {
                 return (m, v);
             }
-            let hmm = self.at(m, m);
             let h00 = self.at(m, m - 1).abs() * (v[1].abs() + v[2].abs());
             let h01 = v[0].abs() * (self.at(m - 1, m - 1).abs() + hmm.abs() + self.at(m + 1, m + 1).abs());
             if h00 <= ulp * h01 {
@@ -292,143 +279,70 @@ impl<'a> Window<'a> {
         }
     }
 
-    /// Rows m..m+2 of the first column of (H − σ₁I)(H − σ₂I) for the block starting at m,
-    /// scaled to unit 1-norm.
-    pub(super) fn first_column(&self, m: usize, sh: Shifts) -> [f64; 3] {
-        let hmm = self.at(m, m);
-        let h21s = self.at(m + 1, m);
-        let s = (hmm - sh.re2).abs() + sh.im2.abs() + h21s.abs();
-        let h21s = h21s / s;
-        let mut v = [
-            h21s * self.at(m, m + 1) + (hmm - sh.re1) * ((hmm - sh.re2) / s) - sh.im1 * (sh.im2 / s),
-            h21s * (hmm + self.at(m + 1, m + 1) - sh.re1 - sh.re2),
-            h21s * self.at(m + 2, m + 1),
-        ];
-        let s = v[0].abs() + v[1].abs() + v[2].abs();
-        v.iter_mut().for_each(|x| *x /= s);
-        v
-    }
-
     /// One Francis double-shift step on the window l..=i, the bulge introduced at row m with the
     /// first-column vector `v` and chased to the bottom by 3×3 (last: 2×2) Householder
-    /// reflections (GVL Alg. 7.5.1). Values only: just rows and columns l..=i are updated.
-    pub(super) fn double_shift_step(&mut self, l: usize, m: usize, i: usize, v: [f64; 3]) {
-        self.chase(l, i, m, Some(v));
-        for k in m + 1..i {
-            self.chase(l, i, k, None);
-        }
-    }
-
-    /// One reflection of a bulge chase on the window l..=i at rows k..k+2 (k + 1 = i: rows
-    /// k..k+1): `first` is the shifted first column when the bulge is introduced at row k (GVL
-    /// Alg. 7.5.1), else the reflection annihilates the bulge in column k − 1 below row k.
-    pub(super) fn chase(&mut self, l: usize, i: usize, k: usize, first: Option<[f64; 3]>) {
-        let Some(u) = self.chase_reflector(l, i, k, first) else { return };
-        // Values only: rows and columns l..=i; Schur form: whole rows and columns.
+    /// reflections (GVL Alg. 7.5.1). Only rows and columns l..=i are updated (values only).
+    #[inline(always)]
+    fn double_shift_step(&mut self, l: usize, m: usize, i: usize, mut v: [f64; 3]) {
         let n = self.n;
-        let (first_row, end_col) = if self.z.is_some() { (0, n) } else { (l, i + 1) };
-        self.reflect(u, i, k, first_row, end_col);
-        if let Some(z) = self.z.as_deref_mut() {
-            u.apply_right(&mut z[k * n..(k + u.len) * n], n, 0..n);
-        }
-    }
-
-    /// The reflection of [`Self::chase`] at row k, with column k − 1 (unless `first`) set to its
-    /// image; `None` if it is the identity.
-    pub(super) fn chase_reflector(
-        &mut self,
-        l: usize,
-        i: usize,
-        k: usize,
-        first: Option<[f64; 3]>,
-    ) -> Option<Reflector> {
-        let nr = 3.min(i - k + 1);
-        let mut v = first.unwrap_or_else(|| {
-            let mut v = [0.0; 3];
-            for (r, x) in v.iter_mut().enumerate().take(nr) {
-                *x = self.at(k + r, k - 1);
+        for k in m..i {
+            let nr = 3.min(i - k + 1);
+            if k > m {
+                for (r, x) in v.iter_mut().enumerate().take(nr) {
+                    *x = self.at(k + r, k - 1);
+                }
             }
-            v
-        });
-        let (beta, tau) = householder(v[0], &mut v[1..nr]);
-        if first.is_none() {
-            self.set(k, k - 1, beta);
-            self.set(k + 1, k - 1, 0.0);
-            if k + 1 < i {
-                self.set(k + 2, k - 1, 0.0);
+            let (beta, tau) = householder(v[0], &mut v[1..nr]);
+            if k > m {
+                self.set(k, k - 1, beta);
+                self.set(k + 1, k - 1, 0.0);
+                if k + 1 < i {
+                    self.set(k + 2, k - 1, 0.0);
+                }
+            } else if m > l {
+                // (1 − τ)·h instead of −h: correct also when v₂, v₃ underflow (dlahqr).
+                let x = self.at(k, k - 1) * (1.0 - tau);
+                self.set(k, k - 1, x);
             }
-        } else if k > l {
-            // (1 − τ)·h instead of −h: correct also when v₂, v₃ underflow (dlahqr).
-            let x = self.at(k, k - 1) * (1.0 - tau);
-            self.set(k, k - 1, x);
-        }
-        (tau != 0.0).then_some(Reflector { v2: v[1], v3: if nr == 3 { v[2] } else { 0.0 }, tau, len: nr })
-    }
-
-    /// The similarity by the reflection `u` at row k of the bulge chase on a window ending at i,
-    /// restricted to columns k..end_col (from the left) and rows first_row..=min(k + 3, i) (from
-    /// the right).
-    pub(super) fn reflect(&mut self, u: Reflector, i: usize, k: usize, first_row: usize, end_col: usize) {
-        let n = self.n;
-        let last_row = (k + 3).min(i);
-        u.apply_left(&mut self.h[k * n..end_col * n], n, k);
-        u.apply_right(&mut self.h[k * n..(k + u.len) * n], n, first_row..last_row + 1);
-    }
-}
-
-/// A 3×3 (or 2×2) elementary reflector P = I − τ·u·uᵀ, u = [1, v₂, v₃] (v₃ unused when 2×2).
-#[derive(Clone, Copy)]
-pub(super) struct Reflector {
-    v2: f64,
-    v3: f64,
-    tau: f64,
-    /// 3, or 2 at the bottom of the window.
-    pub(super) len: usize,
-}
-
-impl Reflector {
-    /// P·X for the rows k..k+len of every column in `cols` (column-major, leading dimension n).
-    #[inline]
-    fn apply_left(&self, cols: &mut [f64], n: usize, k: usize) {
-        let (v2, v3, t1) = (self.v2, self.v3, self.tau);
-        let (t2, t3) = (t1 * v2, t1 * v3);
-        if self.len == 3 {
-            for col in cols.chunks_exact_mut(n) {
-                let x = &mut col[k..k + 3];
-                let sum = x[0] + v2 * x[1] + v3 * x[2];
-                x[0] -= sum * t1;
-                x[1] -= sum * t2;
-                x[2] -= sum * t3;
+            if tau == 0.0 {
+                continue;
             }
-        } else {
-            for col in cols.chunks_exact_mut(n) {
-                let x = &mut col[k..k + 2];
-                let sum = x[0] + v2 * x[1];
-                x[0] -= sum * t1;
-                x[1] -= sum * t2;
-            }
-        }
-    }
-
-    /// X·P for the `len` consecutive columns in `cols` (leading dimension n), rows `rows`.
-    #[inline]
-    pub(super) fn apply_right(&self, cols: &mut [f64], n: usize, rows: std::ops::Range<usize>) {
-        let (v2, v3, t1) = (self.v2, self.v3, self.tau);
-        let (t2, t3) = (t1 * v2, t1 * v3);
-        let (c0, rest) = cols.split_at_mut(n);
-        if self.len == 3 {
-            let (c1, c2) = rest.split_at_mut(n);
-            for ((a, b), c) in c0[rows.clone()].iter_mut().zip(&mut c1[rows.clone()]).zip(&mut c2[rows]) {
-                let sum = *a + v2 * *b + v3 * *c;
-                *a -= sum * t1;
-                *b -= sum * t2;
-                *c -= sum * t3;
-            }
-        } else {
-            for (a, b) in c0[rows.clone()].iter_mut().zip(&mut rest[rows]) {
-                let sum = *a + v2 * *b;
-                *a -= sum * t1;
-                *b -= sum * t2;
+            let (v2, t1) = (v[1], tau);
+            let t2 = t1 * v2;
+            let last_row = (k + 3).min(i);
+            if nr == 3 {
+                let v3 = v[2];
+                let t3 = t1 * v3;
+                // Rows k..k+2, columns k..=i.
+                for col in self.h[k * n..(i + 1) * n].chunks_exact_mut(n) {
+                    let x = &mut col[k..k + 3];
+                    let sum = x[0] + v2 * x[1] + v3 * x[2];
+                    x[0] -= sum * t1;
+                    x[1] -= sum * t2;
+                    x[2] -= sum * t3;
+                }
+                // Columns k..k+2, rows l..=min(k+3, i).
+                let (c0, rest) = self.h[k * n..(k + 3) * n].split_at_mut(n);
+                let (c1, c2) = rest.split_at_mut(n);
+                for ((a, b), c) in c0[l..=last_row].iter_mut().zip(&mut c1[l..=last_row]).zip(&mut c2[l..=last_row]) {
+                    let sum = *a + v2 * *b + v3 * *c;
+                    *a -= sum * t1;
+                    *b -= sum * t2;
+                    *c -= sum * t3;
+                }
+            } else {
+                for col in self.h[k * n..(i + 1) * n].chunks_exact_mut(n) {
+                    let x = &mut col[k..k + 2];
+                    let sum = x[0] + v2 * x[1];
+                    x[0] -= sum * t1;
+                    x[1] -= sum * t2;
+                }
+                let (c0, c1) = self.h[k * n..(k + 2) * n].split_at_mut(n);
+                for (a, b) in c0[l..=i].iter_mut().zip(&mut c1[l..=i]) {
+                    let sum = *a + v2 * *b;
+                    *a -= sum * t1;
+                    *b -= sum * t2;
+                }
             }
         }
     }
@@ -440,7 +354,8 @@ const SAFE_SQUARES_MAX: f64 = 1e150;
 
 /// An elementary reflector P = I − τ[1; x̂][1; x̂]ᵀ with P[α; x] = [β; 0] (LAPACK `dlarfg`): `x`
 /// is overwritten with x̂; returns (β, τ), τ = 0 (P = I) when x = 0.
-pub(super) fn householder(alpha: f64, x: &mut [f64]) -> (f64, f64) {
+#[inline(always)]
+fn householder(alpha: f64, x: &mut [f64]) -> (f64, f64) {
     // Norms by plain sums of squares when no square can overflow or matter by underflowing
     // (|entries| within 1e±150: an underflowed square is below ε² of the largest), else by
     // hypot (libm's hypot was 8 % of a BDT2 design run).
@@ -483,7 +398,8 @@ pub(super) fn householder(alpha: f64, x: &mut [f64]) -> (f64, f64) {
 /// The eigenvalues of the real 2×2 matrix [a b; c d] by LAPACK's `dlanv2` standardisation (a
 /// rotation making the diagonal equal, or the matrix triangular): a complex pair (Im > 0 first)
 /// or two real values, computed without cancellation.
-pub(super) fn eigenvalues_2x2(a: f64, b: f64, c: f64, d: f64) -> [c64; 2] {
+#[inline(always)]
+fn eigenvalues_2x2(a: f64, b: f64, c: f64, d: f64) -> [c64; 2] {
     let (mut a, mut b, mut c, mut d) = (a, b, c, d);
     const MULTPL: f64 = 4.0;
     let eps = f64::EPSILON;
@@ -724,6 +640,23 @@ mod tests {
             let got = crate::lti::freq_response::FreqResponse::new(&sys).poles().unwrap();
             let d = spectrum_distance(&got, &reference(&a));
             assert!(d <= 1e-10 * a.norm_l2(), "n = {n}: {d:e}");
+        }
+    }
+
+    #[test]
+    fn every_instruction_set_gives_the_same_bits() {
+        // The dispatched iteration (AVX2 where the processor has it) against the same code
+        // inlined here, compiled for the baseline instruction set.
+        for (n, seed) in [(31usize, 51u64), (83, 52), (166, 53)] {
+            let a = random(n, seed);
+            let g = |i: usize| 10f64.powf(-8.0 * i as f64 / n as f64);
+            for m in [hessenberg_part(&a), hessenberg_part(&Mat::from_fn(n, n, |i, j| a[(i, j)] * g(i) * g(j)))] {
+                let h: Vec<f64> = (0..n * n).map(|k| m[(k % n, k / n)]).collect();
+                let dispatched = hessenberg_eigenvalues(&mut h.clone(), n).unwrap();
+                let baseline = francis_iteration(&mut h.clone(), n, ITERATIONS_PER_EIGENVALUE * n.max(10)).unwrap();
+                let bits = |v: &[c64]| v.iter().flat_map(|z| [z.re.to_bits(), z.im.to_bits()]).collect::<Vec<_>>();
+                assert_eq!(bits(&dispatched), bits(&baseline), "n = {n}");
+            }
         }
     }
 

@@ -13,7 +13,6 @@ pub(crate) mod freq_response;
 pub use freq_response::ResponseSlot;
 mod full_order;
 mod gradient;
-mod hessenberg_aed;
 mod hessenberg_qr;
 mod hessenberg_solve;
 mod hinf;

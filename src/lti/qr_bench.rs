@@ -1,23 +1,17 @@
 //! Entry points of the Hessenberg QR microbenchmark (`benches/lti.rs --qr`, issue 13): the
 //! matrices the H∞ norm hands to the QR (the closed loop's Hessenberg form, the square-reduced
-//! method's W) and the QR itself, old and new. Not a stable API.
+//! method's W) and the QR itself. Not a stable API.
 
 use faer::{c64, MatRef};
 
 use super::freq_response;
-use super::hessenberg_qr::{double_shift_eigenvalues, hessenberg_eigenvalues};
+use super::hessenberg_qr::hessenberg_eigenvalues;
 use super::square_reduced::hamiltonian_squared_w;
 
 /// The eigenvalues of the n×n upper Hessenberg `h` (column-major, overwritten) as the H∞ norm
 /// computes them (`hessenberg_qr.rs`); `None` if the QR fails.
 pub fn eigenvalues(h: &mut [f64], n: usize) -> Option<Vec<c64>> {
     hessenberg_eigenvalues(h, n).ok()
-}
-
-/// The same by the double-shift iteration alone at every size (the method before aggressive
-/// early deflation).
-pub fn double_shift_only(h: &mut [f64], n: usize) -> Option<Vec<c64>> {
-    double_shift_eigenvalues(h, n).ok()
 }
 
 /// The Hessenberg form of the square `a` (column-major), by the frequency response's reduction.
