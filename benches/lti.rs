@@ -13,6 +13,11 @@
 //!   skips that table;
 //! * `--design-only [NAMES]`: just the last table, optionally only the plants in the
 //!   comma-separated NAMES (e.g. `BDT2,CM4`; for a profiler);
+//! * `--qr`: just the Hessenberg QR microbenchmark (issue 13): per-call thread-CPU time of the
+//!   eigenvalues of random Hessenberg matrices (n = 40, 83, 166, 241) and of the two matrices the
+//!   H∞ norm hands to the QR for BDT2 and CM4 closed loops (the Hessenberg form of A, the W of the
+//!   square-reduced method), our QR (`lti::qr_bench`) against faer's dense `evd_real` (values
+//!   only; it first reduces the matrix to Hessenberg form again), alternated in the same process;
 //! * `--steps`: after each design run of the last table, the H∞ steps it took (`lti::step_stats`:
 //!   norms, explicit and pencil level-set tests per norm, and the thread-CPU time of each step;
 //!   the timing adds two clock reads per step).
@@ -31,6 +36,7 @@ use hinfix::design::ComponentCache;
 use hinfix::design::{
     controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase,
 };
+use hinfix::lti::qr_bench;
 use hinfix::lti::step_stats::{self, Step};
 use hinfix::lti::{
     hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL,
@@ -264,6 +270,10 @@ fn main() {
             .filter(|s| !s.starts_with("--"))
             .map_or(Vec::new(), |s| s.split(',').map(String::from).collect())
     });
+    if args.iter().any(|a| a == "--qr") {
+        qr_table(quick);
+        return;
+    }
     if let Some(names) = &design_only {
         design_table(&args, names);
         return;
@@ -332,4 +342,85 @@ fn design_table(args: &[String], names: &[String]) {
             design_ratio(name, nk, cpumax, args.iter().any(|a| a == "--steps"));
         }
     }
+}
+
+/// The Hessenberg QR microbenchmark (`--qr`, module docs).
+fn qr_table(quick: bool) {
+    let mut cases: Vec<(String, usize, Vec<f64>)> = Vec::new();
+    for n in [40usize, 83, 166, 241] {
+        let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
+        let a = randn(&mut rng, n, n, 1.0);
+        let h = (0..n * n).map(|k| if k % n <= k / n + 1 { a[(k % n, k / n)] } else { 0.0 }).collect();
+        cases.push((format!("random Hessenberg n={n}"), n, h));
+    }
+    for name in ["BDT2", "CM4"] {
+        let p = plant(name);
+        let d = p.dims;
+        let k = output_free_controller(1, d.m2, d.p2, 1e-2);
+        let cl = hinfix::lti::closed_loop(&p, &k).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let n = cl.order();
+        cases.push((format!("{name} closed loop, Hessenberg form of A"), n, qr_bench::hessenberg_form(cl.a.as_ref())));
+        // The Hamiltonian [A, BBᵀ/γ; −CᵀC/γ, −Aᵀ] (the D = 0 form) at twice the norm.
+        let gamma = 2.0 * hinf_norm(&cl, DEFAULT_HINF_TOL).value.max(1.0);
+        let g = &cl.b * cl.b.transpose() * faer::Scale(1.0 / gamma);
+        let kk = cl.c.transpose() * &cl.c * faer::Scale(-1.0 / gamma);
+        let w = qr_bench::hamiltonian_w(cl.a.as_ref(), g.as_ref(), kk.as_ref()).expect("finite W");
+        cases.push((format!("{name} closed loop, W at γ = 2‖T‖∞"), n, w));
+    }
+    let rounds = if quick { 5 } else { 15 };
+    println!("Hessenberg QR, eigenvalues only: thread-CPU ms per call, median [min–max] of {rounds} alternated rounds");
+    println!(
+        "{:<44} {:>5} {:>26} {:>26} {:>7} {:>10}",
+        "matrix", "n", "faer evd_real", "ours", "ratio", "max |Δλ|/‖H‖"
+    );
+    for (what, n, h) in &cases {
+        let n = *n;
+        let norm = h.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // Calls per timing so that one timing is ≥ ~20 ms.
+        let calls = (20_000_000 / (n * n * n)).max(1);
+        let (mut old, mut new) = (Vec::new(), Vec::new());
+        let mut diff = 0.0f64;
+        for _ in 0..rounds {
+            for (times, qr) in [
+                (&mut old, faer_eigenvalues as fn(&mut [f64], usize) -> Option<Vec<faer::c64>>),
+                (&mut new, qr_bench::eigenvalues),
+            ] {
+                let t0 = thread_cpu_time();
+                for _ in 0..calls {
+                    let mut x = h.clone();
+                    std::hint::black_box(qr(&mut x, n).expect("QR converges"));
+                }
+                times.push((thread_cpu_time() - t0) * 1e3 / calls as f64);
+            }
+        }
+        // Each new eigenvalue's distance to the nearest old one not yet matched.
+        let a = faer_eigenvalues(&mut h.clone(), n).expect("QR converges");
+        let b = qr_bench::eigenvalues(&mut h.clone(), n).expect("QR converges");
+        let mut used = vec![false; n];
+        for y in &b {
+            let (k, d) = a
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| !used[*k])
+                .map(|(k, x)| (k, (x - y).norm()))
+                .fold((0, f64::INFINITY), |m, x| if x.1 < m.1 { x } else { m });
+            used[k] = true;
+            diff = diff.max(d / norm);
+        }
+        let span = |v: &[f64]| {
+            let (lo, hi) = v.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &t| (l.min(t), h.max(t)));
+            format!("{:.3} [{lo:.3}–{hi:.3}]", median(v.to_vec()))
+        };
+        println!(
+            "{what:<44} {n:>5} {:>26} {:>26} {:>7.2} {diff:>10.1e}",
+            span(&old),
+            span(&new),
+            median(old.clone()) / median(new.clone())
+        );
+    }
+}
+
+/// faer's eigenvalues of the n×n column-major `h` (entries below the subdiagonal as zero).
+fn faer_eigenvalues(h: &mut [f64], n: usize) -> Option<Vec<faer::c64>> {
+    Mat::from_fn(n, n, |i, j| if i <= j + 1 { h[i + j * n] } else { 0.0 }).eigenvalues().ok()
 }

@@ -125,6 +125,11 @@ impl FreqResponse {
 
     /// [`Self::poles`] without the step count.
     fn poles_uncounted(&self) -> Option<Vec<c64>> {
+        hessenberg_eigenvalues(&mut self.hessenberg_column_major(), self.n).ok()
+    }
+
+    /// The Hessenberg form H of A, column-major (zero below the subdiagonal).
+    pub(crate) fn hessenberg_column_major(&self) -> Vec<f64> {
         let n = self.n;
         let mut h = vec![0.0; n * n];
         for i in 0..n {
@@ -132,7 +137,7 @@ impl FreqResponse {
                 h[i + j * n] = self.h[i * n + j];
             }
         }
-        hessenberg_eigenvalues(&mut h, n).ok()
+        h
     }
 
     /// G(iω) (p×m); D for ω = +∞. Entries are +∞ if iωI − H is exactly singular.
@@ -275,9 +280,15 @@ fn same_bits(x: &StateSpace, y: &StateSpace) -> bool {
 /// our Francis QR: bit for bit [`FreqResponse::poles`] of any system with this A, so the
 /// stability decision and the H∞ norm's poles agree exactly. `None` if the QR does not converge.
 pub(crate) fn hessenberg_qr_eigenvalues(a: MatRef<'_, f64>) -> Option<Vec<c64>> {
+    of_matrix(a).poles()
+}
+
+/// The frequency response of the system with this A and no inputs or outputs: its Hessenberg
+/// form (and poles).
+pub(crate) fn of_matrix(a: MatRef<'_, f64>) -> FreqResponse {
     let n = a.nrows();
     let sys = StateSpace { a: a.to_owned(), b: Mat::zeros(n, 0), c: Mat::zeros(0, n), d: Mat::zeros(0, 0) };
-    FreqResponse::new(&sys).poles()
+    FreqResponse::new(&sys)
 }
 
 /// Largest singular value of a small complex matrix (closed forms for vectors and 2-column or

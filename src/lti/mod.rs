@@ -24,6 +24,8 @@ mod matrix_json;
 mod plant;
 mod plant_library;
 mod pvl_update;
+#[doc(hidden)]
+pub mod qr_bench;
 mod riccati;
 mod spectral;
 mod square_reduced;

@@ -65,6 +65,14 @@ pub(crate) fn hamiltonian_squared_eigenvalues(
     g: MatRef<'_, f64>,
     k: MatRef<'_, f64>,
 ) -> Option<SquaredSpectrum> {
+    let ([m11, m12, m21], norm) = balanced_square(f, g, k)?;
+    let mu = skew_hamiltonian_eigenvalues(m11.as_ref(), m12.as_ref(), m21.as_ref())?;
+    Some(SquaredSpectrum { mu, abs_error: ERROR_FACTOR * f64::EPSILON * norm.max(f64::MIN_POSITIVE) })
+}
+
+/// The blocks [M₁₁, M₁₂, M₂₁] of M = H² for the balanced H (see
+/// [`hamiltonian_squared_eigenvalues`]) and ‖M‖_F; `None` if not finite.
+fn balanced_square(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<([Mat<f64>; 3], f64)> {
     let (g_norm, k_norm) = (g.norm_l2(), k.norm_l2());
     if !(g_norm.is_finite() && k_norm.is_finite()) {
         return None;
@@ -80,11 +88,7 @@ pub(crate) fn hamiltonian_squared_eigenvalues(
         (m11, &fg - fg.transpose(), &kf - kf.transpose())
     });
     let norm = (2.0 * m11.squared_norm_l2() + m12.squared_norm_l2() + m21.squared_norm_l2()).sqrt();
-    if !norm.is_finite() {
-        return None;
-    }
-    let mu = skew_hamiltonian_eigenvalues(m11.as_ref(), m12.as_ref(), m21.as_ref())?;
-    Some(SquaredSpectrum { mu, abs_error: ERROR_FACTOR * f64::EPSILON * norm.max(f64::MIN_POSITIVE) })
+    norm.is_finite().then_some(([m11, m12, m21], norm))
 }
 
 /// The exponent t (an integer, as f64) of the symplectic scaling s = 2ᵗ ≈ √(‖G‖/‖K‖) that makes
@@ -105,6 +109,14 @@ fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
     (0.5 * (g_norm.log2() - k_norm.log2())).round().clamp(-500.0, 500.0)
 }
 
+/// The W (n×n upper Hessenberg, column-major) of the PVL reduction of H² for the Hamiltonian
+/// H = [F G; K −Fᵀ], as [`hamiltonian_squared_eigenvalues`] computes it (for the QR
+/// microbenchmark, `lti::qr_bench`); `None` if not finite.
+pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
+    let ([m11, m12, m21], _) = balanced_square(f, g, k)?;
+    Some(skew_hamiltonian_w(m11.as_ref(), m12.as_ref(), m21.as_ref()).data)
+}
+
 /// The n eigenvalues of the real skew-Hamiltonian matrix W = [A G; Q Aᵀ] (G, Q skew-symmetric,
 /// all n×n; W has each of them twice), by the PVL reduction and an n×n Hessenberg QR. Backward
 /// stable for W: errors of order ε‖W‖. `None` if the QR fails.
@@ -113,12 +125,18 @@ pub(crate) fn skew_hamiltonian_eigenvalues(
     g: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
 ) -> Option<Vec<c64>> {
-    let mut w = if a.nrows() < FAST_KERNELS_FROM {
+    let mut w = skew_hamiltonian_w(a, g, q);
+    timed(Step::QrW, || hessenberg_part_eigenvalues(&mut w))
+}
+
+/// The Hessenberg W of the PVL reduction of [A G; Q Aᵀ] (entries below its subdiagonal are
+/// the reduction's rounding).
+fn skew_hamiltonian_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> ColMajor {
+    if a.nrows() < FAST_KERNELS_FROM {
         SkewHamiltonian { a: ColMajor::from(a), g: ColMajor::from(g), q: ColMajor::from(q) }.into_pvl_w()
     } else {
         SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) }.into_pvl_w()
-    };
-    timed(Step::QrW, || hessenberg_part_eigenvalues(&mut w))
+    }
 }
 
 /// The eigenvalues of the upper Hessenberg part of `w` (entries below the subdiagonal, the
