@@ -18,6 +18,12 @@
 //!   H∞ norm hands to the QR for BDT2 and CM4 closed loops (the Hessenberg form of A, the W of the
 //!   square-reduced method), our QR (`lti::qr_bench`) against faer's dense `evd_real` (values
 //!   only; it first reduces the matrix to Hessenberg form again), alternated in the same process;
+//! * `--pvl`: just the per-call table of the PVL reduction of the square-reduced method
+//!   (`lti::pvl_w_for_bench`), alternated with faer's Hessenberg reduction of the same A as a
+//!   yardstick (a quarter of the flops), on random skew-Hamiltonian matrices (n = 40, 83, 166,
+//!   241) and on H² of the BDT2
+//!   and CM4 closed loops at γ = 1.01‖Tzw‖∞ (controllers `benches/fixtures/{BDT2,CM4}_nk1.json`:
+//!   `campaign design --order 1 --eps 1e-3 --seed 1`, BDT2 `--maxevals 1500`, CM4 200);
 //! * `--steps`: after each design run of the last table, the H∞ steps it took (`lti::step_stats`:
 //!   norms, explicit and pencil level-set tests per norm, and the thread-CPU time of each step;
 //!   the timing adds two clock reads per step).
@@ -31,6 +37,7 @@ use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
 
+use faer::linalg::solvers::DenseSolveCore;
 use faer::Mat;
 use hinfix::design::ComponentCache;
 use hinfix::design::{
@@ -278,6 +285,10 @@ fn main() {
         design_table(&args, names);
         return;
     }
+    if args.iter().any(|a| a == "--pvl") {
+        pvl_table();
+        return;
+    }
 
     for (family, make) in [
         ("random stable (A = M/√n − 1.2 I)", random_stable as fn(usize, usize, usize, u64) -> StateSpace),
@@ -325,6 +336,94 @@ fn main() {
         return;
     }
     design_table(&args, &[]);
+}
+
+/// The blocks [A, G, Q] of a random skew-Hamiltonian [A G; Q Aᵀ] of size 2n (G, Q skew).
+fn random_skew_hamiltonian(n: usize, seed: u64) -> [Mat<f64>; 3] {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let a = randn(&mut rng, n, n, 1.0);
+    let (g, q) = (randn(&mut rng, n, n, 1.0), randn(&mut rng, n, n, 1.0));
+    [a, &g - g.transpose(), &q - q.transpose()]
+}
+
+/// The blocks of H² for the Hamiltonian H = [F Gₕ; K −Fᵀ] of `sys` at level γ (D ≠ 0 allowed):
+/// R = γ²I − DᵀD, F = A + BR⁻¹DᵀC, Gₕ = BR⁻¹Bᵀ, K = −Cᵀ(I + DR⁻¹Dᵀ)C; H² = [F² + GₕK,
+/// FGₕ − (FGₕ)ᵀ; KF − (KF)ᵀ, ·].
+fn squared_hamiltonian(sys: &StateSpace, gamma: f64) -> [Mat<f64>; 3] {
+    let (a, b, c, d) = (&sys.a, &sys.b, &sys.c, &sys.d);
+    let r = Mat::<f64>::identity(d.ncols(), d.ncols()) * faer::Scale(gamma * gamma) - d.transpose() * d;
+    let r_inv = r.as_ref().partial_piv_lu().inverse();
+    let f = a + b * &r_inv * d.transpose() * c;
+    let gh = b * &r_inv * b.transpose();
+    let k = -(c.transpose() * (Mat::<f64>::identity(d.nrows(), d.nrows()) + d * &r_inv * d.transpose()) * c);
+    let (fg, kf) = (&f * &gh, &k * &f);
+    [&f * &f + &gh * &k, &fg - fg.transpose(), &kf - kf.transpose()]
+}
+
+/// Thread-CPU ms of faer's Hessenberg reduction (values only, no Q) of a copy of `a`.
+fn faer_hessenberg_ms(a: &Mat<f64>) -> f64 {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::hessenberg;
+    let n = a.nrows();
+    let block = 32.min(n.saturating_sub(1)).max(1);
+    let par = faer::Par::Seq;
+    let mut mem = MemBuffer::new(hessenberg::hessenberg_in_place_scratch::<f64>(n, block, par, Default::default()));
+    let (mut h, mut tau) = (a.clone(), Mat::<f64>::zeros(block, n.saturating_sub(1)));
+    let t0 = thread_cpu_time();
+    hessenberg::hessenberg_in_place(h.as_mut(), tau.as_mut(), par, MemStack::new(&mut mem), Default::default());
+    (thread_cpu_time() - t0) * 1e3
+}
+
+/// The `--pvl` table (module docs): thread-CPU ms per PVL reduction and per faer Hessenberg
+/// reduction, medians of rounds that alternate the two, and their flop rates.
+fn pvl_table() {
+    let mut cases: Vec<(String, [Mat<f64>; 3])> = [40usize, 83, 166, 241]
+        .iter()
+        .map(|&n| (format!("random n={n}"), random_skew_hamiltonian(n, n as u64)))
+        .collect();
+    for name in ["BDT2", "CM4"] {
+        let p = plant(name);
+        let k = Controller::load(
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("benches/fixtures/{name}_nk1.json")),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let sys = hinfix::lti::closed_loop(&p, &k).unwrap();
+        let norm = hinf_norm(&sys, DEFAULT_HINF_TOL).value;
+        assert!(norm.is_finite(), "{name}: closed loop not stable");
+        cases.push((format!("{name} H² n={}", sys.a.nrows()), squared_hamiltonian(&sys, 1.01 * norm)));
+    }
+    println!("PVL reduction per call (as used from closed-loop order 30) and faer's Hessenberg reduction of the");
+    println!("block A alone, alternated; thread CPU ms, median (range); GFlop/s: PVL 40n³/3 flops, Hessenberg 10n³/3");
+    println!(
+        "{:<16} {:>24} {:>24} {:>8} {:>8} {:>9}",
+        "case", "PVL", "faer Hessenberg", "GF/s PVL", "GF/s H", "PVL/Hess"
+    );
+    for (what, [a, g, q]) in &cases {
+        let n = a.nrows();
+        let reps = if n > 150 { 15 } else { 61 };
+        let (mut pvl, mut hess) = (Vec::new(), Vec::new());
+        for _ in 0..reps {
+            let t0 = thread_cpu_time();
+            let w = hinfix::lti::pvl_w_for_bench(a.as_ref(), g.as_ref(), q.as_ref());
+            pvl.push((thread_cpu_time() - t0) * 1e3);
+            assert!(w.iter().all(|x| x.is_finite()), "{what}: W not finite");
+            hess.push(faer_hessenberg_ms(a));
+        }
+        let range = |t: &[f64]| {
+            let (lo, hi) = t.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+            format!("{:.3} ({lo:.3}–{hi:.3})", median(t.to_vec()))
+        };
+        let (p, h) = (median(pvl.clone()), median(hess.clone()));
+        let n3 = (n as f64).powi(3) / 3.0 * 1e-6;
+        println!(
+            "{what:<16} {:>24} {:>24} {:>8.1} {:>8.1} {:>9.2}",
+            range(&pvl),
+            range(&hess),
+            40.0 * n3 / p,
+            10.0 * n3 / h,
+            p / h
+        );
+    }
 }
 
 /// The design-run table (module docs) for the plants `names` (all three if empty).

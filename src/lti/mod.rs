@@ -67,4 +67,6 @@ pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::abscissa_of;
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
 pub use spectral::{is_stable, spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
+#[doc(hidden)]
+pub use square_reduced::pvl_w_for_bench;
 pub use state_space::StateSpace;

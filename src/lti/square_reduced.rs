@@ -139,6 +139,14 @@ fn skew_hamiltonian_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>
     }
 }
 
+/// For the `--pvl` table of `benches/lti.rs` only: W of the PVL form of [A G; Q Aᵀ] (n ≥ 1)
+/// as [`skew_hamiltonian_eigenvalues`] computes it from n = [`FAST_KERNELS_FROM`] on (G and Q
+/// kept by their strict lower triangles), column-major n×n.
+#[doc(hidden)]
+pub fn pvl_w_for_bench(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
+    SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) }.into_pvl_w().data
+}
+
 /// The eigenvalues of the upper Hessenberg part of `w` (entries below the subdiagonal, the
 /// reduction's rounding, are not read).
 fn hessenberg_part_eigenvalues(w: &mut ColMajor) -> Option<Vec<c64>> {
@@ -597,5 +605,73 @@ mod tests {
             assert!((g - w).abs() <= 1e-12 * 100.0, "{got:?} vs {want:?}");
         }
         assert!(sq.mu.iter().all(|m| m.im.abs() <= sq.abs_error));
+    }
+
+    /// The blocks [A, G, Q] of a skew-Hamiltonian matrix.
+    type Blocks = [Mat<f64>; 3];
+
+    /// The dense 2n×2n matrix [A G; Q Aᵀ].
+    fn dense_skew_hamiltonian([a, g, q]: &Blocks) -> Mat<f64> {
+        let n = a.nrows();
+        Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, true) => a[(i, j)],
+            (true, false) => g[(i, j - n)],
+            (false, true) => q[(i - n, j)],
+            (false, false) => a[(j - n, i - n)],
+        })
+    }
+
+    /// The eigenvalues of W from the reduction used from n = FAST_KERNELS_FROM on (triangular
+    /// storage), each taken twice, against faer's of the dense 2n×2n matrix, matched one to one
+    /// (nearest first) within 10⁻⁸‖M‖_F: random matrices, badly scaled ones (entries over 8 and
+    /// 16 decades; compared with the spectrum of the unscaled matrix they are similar to), and
+    /// ones that make the reduction skip transformations: Q = 0 (no P₁, no rotation), Q nonzero
+    /// only next to its diagonal (no P₁, a rotation per step), A tridiagonal with Q = 0 (nothing).
+    #[test]
+    fn reduction_keeps_the_spectrum_each_eigenvalue_twice() {
+        for (n, seed) in [(30usize, 51u64), (64, 52)] {
+            let [a, g, q] = random_skew_hamiltonian(n, seed + 100, 0.0);
+            let zero = Mat::<f64>::zeros(n, n);
+            let near = Mat::from_fn(n, n, |i, j| match i.cmp(&j) {
+                _ if i.abs_diff(j) != 1 => 0.0,
+                std::cmp::Ordering::Greater => q[(i, j)],
+                _ => -q[(j, i)],
+            });
+            // Symmetric tridiagonal: Hessenberg with well-conditioned eigenvalues (the Hessenberg
+            // part of a random matrix has eigenvalues too ill-conditioned for a dense reference).
+            let hess = Mat::from_fn(n, n, |i, j| if i.abs_diff(j) <= 1 { a[(i, j)] + a[(j, i)] } else { 0.0 });
+            let mut cases: Vec<(Blocks, Blocks)> = [0.0, 4.0, 8.0]
+                .iter()
+                .map(|&s| (random_skew_hamiltonian(n, seed, 0.0), random_skew_hamiltonian(n, seed, s)))
+                .collect();
+            for blocks in [[a.clone(), g.clone(), zero.clone()], [a.clone(), g.clone(), near], [hess, g.clone(), zero]]
+            {
+                cases.push((blocks.clone(), blocks));
+            }
+            for (k, (unscaled, blocks)) in cases.iter().enumerate() {
+                let truth = eigenvalues(dense_skew_hamiltonian(unscaled).as_ref()).unwrap();
+                let m = dense_skew_hamiltonian(blocks);
+                let [a, g, q] = blocks;
+                let tri = SkewHamiltonian {
+                    a: ColMajor::from(a.as_ref()),
+                    g: SkewLower::from_lower(g.as_ref()),
+                    q: SkewLower::from_lower(q.as_ref()),
+                };
+                let mut w = reduce_and_check_form(tri, &m, "triangular");
+                let mu = hessenberg_part_eigenvalues(&mut w).unwrap();
+                let mut left = truth.clone();
+                for x in mu.iter().chain(&mu) {
+                    let (at, d) = left.iter().map(|t| (t - x).norm()).enumerate().fold((0, f64::INFINITY), |b, c| {
+                        if c.1 < b.1 {
+                            c
+                        } else {
+                            b
+                        }
+                    });
+                    assert!(d <= 1e-8 * m.norm_l2(), "n={n} case {k}: μ = {x} off by {d:e}");
+                    left.swap_remove(at);
+                }
+            }
+        }
     }
 }
