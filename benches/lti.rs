@@ -16,10 +16,10 @@
 //! * `--qr`: just the Hessenberg QR microbenchmark (issue 13): per-call thread-CPU time of the
 //!   eigenvalues of random Hessenberg matrices (n = 40, 83, 166, 241) and of the two matrices the
 //!   H∞ norm hands to the QR for BDT2 and CM4 closed loops (the Hessenberg form of A, the W of the
-//!   square-reduced method), our QR (`lti::qr_bench`) against faer's dense `evd_real` (values
+//!   square-reduced method), our QR (`lti::kernel_bench`) against faer's dense `evd_real` (values
 //!   only; it first reduces the matrix to Hessenberg form again), alternated in the same process;
 //! * `--pvl`: just the per-call table of the PVL reduction of the square-reduced method
-//!   (`lti::pvl_w_for_bench`), alternated with faer's Hessenberg reduction of the same A as a
+//!   (`lti::kernel_bench::pvl_w`), alternated with faer's Hessenberg reduction of the same A as a
 //!   yardstick (a quarter of the flops), on random skew-Hamiltonian matrices (n = 40, 83, 166,
 //!   241) and on H² of the BDT2
 //!   and CM4 closed loops at γ = 1.01‖Tzw‖∞ (controllers `benches/fixtures/{BDT2,CM4}_nk1.json`:
@@ -43,7 +43,7 @@ use hinfix::design::ComponentCache;
 use hinfix::design::{
     controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase,
 };
-use hinfix::lti::qr_bench;
+use hinfix::lti::kernel_bench;
 use hinfix::lti::step_stats::{self, Step};
 use hinfix::lti::{
     hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL,
@@ -404,7 +404,7 @@ fn pvl_table() {
         let (mut pvl, mut hess) = (Vec::new(), Vec::new());
         for _ in 0..reps {
             let t0 = thread_cpu_time();
-            let w = hinfix::lti::pvl_w_for_bench(a.as_ref(), g.as_ref(), q.as_ref());
+            let w = kernel_bench::pvl_w(a.as_ref(), g.as_ref(), q.as_ref());
             pvl.push((thread_cpu_time() - t0) * 1e3);
             assert!(w.iter().all(|x| x.is_finite()), "{what}: W not finite");
             hess.push(faer_hessenberg_ms(a));
@@ -458,12 +458,16 @@ fn qr_table(quick: bool) {
         let k = output_free_controller(1, d.m2, d.p2, 1e-2);
         let cl = hinfix::lti::closed_loop(&p, &k).unwrap_or_else(|e| panic!("{name}: {e}"));
         let n = cl.order();
-        cases.push((format!("{name} closed loop, Hessenberg form of A"), n, qr_bench::hessenberg_form(cl.a.as_ref())));
+        cases.push((
+            format!("{name} closed loop, Hessenberg form of A"),
+            n,
+            kernel_bench::hessenberg_form(cl.a.as_ref()),
+        ));
         // The Hamiltonian [A, BBᵀ/γ; −CᵀC/γ, −Aᵀ] (the D = 0 form) at twice the norm.
         let gamma = 2.0 * hinf_norm(&cl, DEFAULT_HINF_TOL).value.max(1.0);
         let g = &cl.b * cl.b.transpose() * faer::Scale(1.0 / gamma);
         let kk = cl.c.transpose() * &cl.c * faer::Scale(-1.0 / gamma);
-        let w = qr_bench::hamiltonian_w(cl.a.as_ref(), g.as_ref(), kk.as_ref()).expect("finite W");
+        let w = kernel_bench::hamiltonian_w(cl.a.as_ref(), g.as_ref(), kk.as_ref()).expect("finite W");
         cases.push((format!("{name} closed loop, W at γ = 2‖T‖∞"), n, w));
     }
     let rounds = if quick { 5 } else { 15 };
@@ -482,7 +486,7 @@ fn qr_table(quick: bool) {
         for _ in 0..rounds {
             for (times, qr) in [
                 (&mut old, faer_eigenvalues as fn(&mut [f64], usize) -> Option<Vec<faer::c64>>),
-                (&mut new, qr_bench::eigenvalues),
+                (&mut new, kernel_bench::eigenvalues),
             ] {
                 let t0 = thread_cpu_time();
                 for _ in 0..calls {
@@ -494,7 +498,7 @@ fn qr_table(quick: bool) {
         }
         // Each new eigenvalue's distance to the nearest old one not yet matched.
         let a = faer_eigenvalues(&mut h.clone(), n).expect("QR converges");
-        let b = qr_bench::eigenvalues(&mut h.clone(), n).expect("QR converges");
+        let b = kernel_bench::eigenvalues(&mut h.clone(), n).expect("QR converges");
         let mut used = vec![false; n];
         for y in &b {
             let (k, d) = a

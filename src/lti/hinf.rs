@@ -115,7 +115,7 @@ const COARSE_REFINE_LOG_TOL: f64 = 1e-3;
 /// At most this many evaluations per climb of a further peak.
 const COARSE_REFINE_MAX_EVALS: usize = 12;
 /// At most this many evaluations in the climb of [`hinf_lower_bound_sharing`].
-pub const SCREEN_CLIMB_MAX_EVALS: usize = 12;
+const SCREEN_CLIMB_MAX_EVALS: usize = 12;
 
 /// The H∞ norm and where it is attained.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -212,7 +212,7 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
 }
 
 /// [`hinf_lower_bound`], then, while the bound is below `wanted`, a climb of the peak next to the
-/// best of `freqs` (Brent, as the norm's refinement, at most [`SCREEN_CLIMB_MAX_EVALS`]
+/// best of `freqs` (Brent, as the norm's refinement, at most `SCREEN_CLIMB_MAX_EVALS`
 /// evaluations, stopping once the bound reaches `wanted`; −∞: no climb). Leaves its
 /// frequency-response evaluator in `slot`, for the norm of the same system if it follows
 /// (`ResponseSlot`).

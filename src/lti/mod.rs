@@ -17,6 +17,8 @@ mod hessenberg_qr;
 mod hessenberg_solve;
 mod hinf;
 mod interrupt;
+#[doc(hidden)]
+pub mod kernel_bench;
 mod level_set_pencil;
 mod lyapunov;
 mod mat_file;
@@ -24,8 +26,6 @@ mod matrix_json;
 mod plant;
 mod plant_library;
 mod pvl_update;
-#[doc(hidden)]
-pub mod qr_bench;
 mod riccati;
 mod spectral;
 mod square_reduced;
@@ -67,6 +67,4 @@ pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::abscissa_of;
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
 pub use spectral::{is_stable, spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
-#[doc(hidden)]
-pub use square_reduced::pvl_w_for_bench;
 pub use state_space::StateSpace;

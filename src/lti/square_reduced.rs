@@ -111,7 +111,7 @@ fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
 
 /// The W (n×n upper Hessenberg, column-major) of the PVL reduction of H² for the Hamiltonian
 /// H = [F G; K −Fᵀ], as [`hamiltonian_squared_eigenvalues`] computes it (for the QR
-/// microbenchmark, `lti::qr_bench`); `None` if not finite.
+/// microbenchmark, `lti::kernel_bench`); `None` if not finite.
 pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
     let ([m11, m12, m21], _) = balanced_square(f, g, k)?;
     Some(skew_hamiltonian_w(m11.as_ref(), m12.as_ref(), m21.as_ref()).data)

@@ -1,12 +1,13 @@
-//! Entry points of the Hessenberg QR microbenchmark (`benches/lti.rs --qr`, issue 13): the
-//! matrices the H∞ norm hands to the QR (the closed loop's Hessenberg form, the square-reduced
-//! method's W) and the QR itself. Not a stable API.
+//! Entry points of the per-call microbenchmarks of `benches/lti.rs` (issue 13): `--qr`, the
+//! matrices the H∞ norm hands to the Hessenberg QR (the closed loop's Hessenberg form, the
+//! square-reduced method's W) and the QR itself; `--pvl`, the PVL reduction. Not a stable API.
 
 use faer::{c64, MatRef};
 
 use super::freq_response;
 use super::hessenberg_qr::hessenberg_eigenvalues;
 use super::square_reduced::hamiltonian_squared_w;
+pub use super::square_reduced::pvl_w_for_bench as pvl_w;
 
 /// The eigenvalues of the n×n upper Hessenberg `h` (column-major, overwritten) as the H∞ norm
 /// computes them (`hessenberg_qr.rs`); `None` if the QR fails.
