@@ -15,8 +15,8 @@
 //!   comma-separated NAMES (e.g. `BDT2,CM4`; for a profiler);
 //! * `--qr`: just the Hessenberg QR microbenchmark (issue 13): per-call thread-CPU time of the
 //!   eigenvalues of random Hessenberg matrices (n = 40, 83, 166, 241) and of the two matrices the
-//!   H∞ norm hands to the QR for BDT2 and CM4 closed loops (the Hessenberg form of A, the W of the
-//!   square-reduced method), our QR (`lti::kernel_bench`) against faer's dense `evd_real` (values
+//!   H∞ norm hands to the QR for the BDT2 and CM4 closed loops with the designed controllers of
+//!   `--pvl` (the Hessenberg form of A, the W of the square-reduced method), our QR (`lti::kernel_bench`) against faer's dense `evd_real` (values
 //!   only; it first reduces the matrix to Hessenberg form again), alternated in the same process;
 //! * `--pvl`: just the per-call table of the PVL reduction of the square-reduced method
 //!   (`lti::kernel_bench::pvl_w`), alternated with faer's Hessenberg reduction of the same A as a
@@ -382,12 +382,7 @@ fn pvl_table() {
         .map(|&n| (format!("random n={n}"), random_skew_hamiltonian(n, n as u64)))
         .collect();
     for name in ["BDT2", "CM4"] {
-        let p = plant(name);
-        let k = Controller::load(
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("benches/fixtures/{name}_nk1.json")),
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
-        let sys = hinfix::lti::closed_loop(&p, &k).unwrap();
+        let sys = designed_closed_loop(name);
         let norm = hinf_norm(&sys, DEFAULT_HINF_TOL).value;
         assert!(norm.is_finite(), "{name}: closed loop not stable");
         cases.push((format!("{name} H² n={}", sys.a.nrows()), squared_hamiltonian(&sys, 1.01 * norm)));
@@ -443,6 +438,18 @@ fn design_table(args: &[String], names: &[String]) {
     }
 }
 
+/// The closed loop of plant `name` with its designed order-1 controller
+/// (`benches/fixtures/{name}_nk1.json`, module docs): the matrices of a converged design, which
+/// the microbenchmarks time (a made-up controller's closed loop splits into small blocks early
+/// in the QR: BDT2 ≈ 0.13 ms per QR against ≈ 0.97 ms in design runs).
+fn designed_closed_loop(name: &str) -> hinfix::lti::StateSpace {
+    let p = plant(name);
+    let k =
+        Controller::load(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("benches/fixtures/{name}_nk1.json")))
+            .unwrap_or_else(|e| panic!("{e}"));
+    hinfix::lti::closed_loop(&p, &k).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
 /// The Hessenberg QR microbenchmark (`--qr`, module docs).
 fn qr_table(quick: bool) {
     let mut cases: Vec<(String, usize, Vec<f64>)> = Vec::new();
@@ -453,10 +460,7 @@ fn qr_table(quick: bool) {
         cases.push((format!("random Hessenberg n={n}"), n, h));
     }
     for name in ["BDT2", "CM4"] {
-        let p = plant(name);
-        let d = p.dims;
-        let k = output_free_controller(1, d.m2, d.p2, 1e-2);
-        let cl = hinfix::lti::closed_loop(&p, &k).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let cl = designed_closed_loop(name);
         let n = cl.order();
         cases.push((
             format!("{name} closed loop, Hessenberg form of A"),
