@@ -284,21 +284,20 @@ fn hinf_norm_from(
     best.offer(0.0, fr.sigma_max(0.0));
 
     let hints: Vec<f64> = hints.iter().copied().filter(|w| w.is_finite() && *w > 0.0).collect();
-    let mut tested: Vec<f64> = vec![0.0];
     // Every (ω, σmax) of the scan, for the choice of further peaks to refine.
     let mut scan: Vec<(f64, f64)> = Vec::new();
     for &w in &hints {
         stop.poll()?;
         let s = fr.sigma_max(w);
         best.offer(w, s);
-        tested.push(w);
         scan.push((w, s));
     }
     // Always, hints or not: a hint sits on the previous peak, and a peak elsewhere that is only a
     // little higher has a near-tangent pair of crossings at the level γ_L would then stop at, which
     // the imaginary-axis test can miss (AC4 in `tests/hinf_regression.rs`: 6.6e-4 low).
-    mode_frequencies(poles, &mut fr, &mut best, &mut tested, &mut scan, stop)?;
+    mode_frequencies(poles, &mut fr, &mut best, &mut scan, stop)?;
     stop.poll()?;
+    let tested: Vec<f64> = std::iter::once(0.0).chain(scan.iter().map(|&(w, _)| w)).collect();
     let peaks = refined_peaks(sys.order());
     refine_best_peaks(&mut fr, &mut best, &tested, &scan, peaks);
     if !best.gamma.is_finite() {
@@ -396,13 +395,11 @@ fn high_frequency_ladder(sys: &StateSpace, sigma_d: f64, gamma: f64, a: f64, out
 }
 
 /// Offers σmax at one test frequency per mode, least damped first (at most
-/// [`MAX_POLE_TEST_FREQS`]; module docs, step 2), and records them in `tested` and, with their
-/// values, in `scan`.
+/// [`MAX_POLE_TEST_FREQS`]; module docs, step 2), and records them with their values in `scan`.
 fn mode_frequencies(
     poles: &[c64],
     fr: &mut FreqResponse,
     best: &mut Best,
-    tested: &mut Vec<f64>,
     scan: &mut Vec<(f64, f64)>,
     stop: Interrupt<'_>,
 ) -> Result<(), Interrupted> {
@@ -421,7 +418,6 @@ fn mode_frequencies(
         stop.poll()?;
         let s = fr.sigma_max(w);
         best.offer(w, s);
-        tested.push(w);
         scan.push((w, s));
     }
     Ok(())

@@ -6,8 +6,7 @@ use faer::{c64, MatRef};
 
 use super::freq_response;
 use super::hessenberg_qr::hessenberg_eigenvalues;
-use super::square_reduced::hamiltonian_squared_w;
-pub use super::square_reduced::pvl_w_for_bench as pvl_w;
+use super::square_reduced::{self, hamiltonian_squared_w};
 
 /// The eigenvalues of the n×n upper Hessenberg `h` (column-major, overwritten) as the H∞ norm
 /// computes them (`hessenberg_qr.rs`); `None` if the QR fails.
@@ -24,4 +23,10 @@ pub fn hessenberg_form(a: MatRef<'_, f64>) -> Vec<f64> {
 /// the subdiagonal the reduction's rounding); `None` if not finite.
 pub fn hamiltonian_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
     hamiltonian_squared_w(f, g, k)
+}
+
+/// The W of the PVL reduction of the skew-Hamiltonian [A G; Q Aᵀ] (column-major), as the
+/// square-reduced method computes it.
+pub fn pvl_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
+    square_reduced::pvl_w(a, g, q)
 }

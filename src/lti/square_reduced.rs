@@ -114,7 +114,13 @@ fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
 /// microbenchmark, `lti::kernel_bench`); `None` if not finite.
 pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
     let ([m11, m12, m21], _) = balanced_square(f, g, k)?;
-    Some(skew_hamiltonian_w(m11.as_ref(), m12.as_ref(), m21.as_ref()).data)
+    Some(pvl_w(m11.as_ref(), m12.as_ref(), m21.as_ref()))
+}
+
+/// The W (n×n upper Hessenberg, column-major) of the PVL reduction of [A G; Q Aᵀ], as
+/// [`skew_hamiltonian_eigenvalues`] computes it (for the microbenchmarks, `lti::kernel_bench`).
+pub(crate) fn pvl_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
+    skew_hamiltonian_w(a, g, q).data
 }
 
 /// The n eigenvalues of the real skew-Hamiltonian matrix W = [A G; Q Aᵀ] (G, Q skew-symmetric,
@@ -137,14 +143,6 @@ fn skew_hamiltonian_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>
     } else {
         SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) }.into_pvl_w()
     }
-}
-
-/// For the `--pvl` table of `benches/lti.rs` only: W of the PVL form of [A G; Q Aᵀ] (n ≥ 1)
-/// as [`skew_hamiltonian_eigenvalues`] computes it from n = [`FAST_KERNELS_FROM`] on (G and Q
-/// kept by their strict lower triangles), column-major n×n.
-#[doc(hidden)]
-pub fn pvl_w_for_bench(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
-    SkewHamiltonian { a: ColMajor::from(a), g: SkewLower::from_lower(g), q: SkewLower::from_lower(q) }.into_pvl_w().data
 }
 
 /// The eigenvalues of the upper Hessenberg part of `w` (entries below the subdiagonal, the
