@@ -27,6 +27,12 @@
 //! * `--steps`: after each design run of the last table, the H∞ steps it took (`lti::step_stats`:
 //!   norms, explicit and pencil level-set tests per norm, and the thread-CPU time of each step;
 //!   the timing adds two clock reads per step).
+//! * `--record FILE` (with `--design-only NAME`): also writes every closed-loop H∞ norm of the
+//!   design run (system, tolerance, peak hints; `lti::kernel_bench::record_norms`) to FILE;
+//! * `--replay FILE [--rounds R]`: computes those norms again, R times (default 3), and prints
+//!   the thread-CPU ms per norm (median over rounds), a checksum of the values and, with
+//!   `--steps`, the step table. A change to the norm is then timed on the same systems before
+//!   and after, independent of the design path it would otherwise change.
 //!
 //! The last table is machine-independent: CPU ms per objective evaluation over a whole design run
 //! (`cpu_s / evals` of the outcome) divided by the CPU time of one dense eigenvalue solve (faer,
@@ -200,7 +206,7 @@ fn dense_eig_seconds(size: usize, reps: usize) -> f64 {
 
 /// One design run (order `nk`, ε = 1e-3, seed 1, budget `cpumax`): CPU ms per evaluation and its
 /// ratio to one dense eigensolve of size 2(n + nK); with `steps`, the H∞ steps it took.
-fn design_ratio(name: &str, nk: usize, cpumax: f64, steps: bool) {
+fn design_ratio(name: &str, nk: usize, cpumax: f64, steps: bool, record: Option<&PathBuf>) {
     let p = plant(name);
     let size = 2 * (p.dims.n + nk);
     let reps = if size > 300 { 9 } else { 31 };
@@ -208,8 +214,16 @@ fn design_ratio(name: &str, nk: usize, cpumax: f64, steps: bool) {
     let opts = DesignOptions { order: nk, eps: 1e-3, seed: 1, cpumax, ..DesignOptions::default() };
     step_stats::reset();
     step_stats::set_timing(steps);
+    if record.is_some() {
+        kernel_bench::record_norms();
+    }
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap_or_else(|e| panic!("{name}: {e}"));
     step_stats::set_timing(false);
+    if let Some(path) = record {
+        let norms = kernel_bench::take_recorded_norms();
+        write_recorded(path, &norms).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        println!("recorded {} norms to {}", norms.len(), path.display());
+    }
     // The machine's speed drifts over a 20 s run (shared cores): the eig is timed before and after
     // the design run, and their mean is the unit.
     let eig_after = dense_eig_seconds(size, reps);
@@ -232,6 +246,116 @@ fn design_ratio(name: &str, nk: usize, cpumax: f64, steps: bool) {
     }
 }
 
+/// Writes recorded norms (`--record`): per norm, little-endian u64 n, m, p, number of hints,
+/// then f64 tol, the hints and A, B, C, D column-major.
+fn write_recorded(path: &PathBuf, norms: &[kernel_bench::RecordedNorm]) -> std::io::Result<()> {
+    let mut out: Vec<u8> = Vec::new();
+    for r in norms {
+        let s = &r.sys;
+        for k in [s.order(), s.inputs(), s.outputs(), r.hints.len()] {
+            out.extend((k as u64).to_le_bytes());
+        }
+        let mats = [&s.a, &s.b, &s.c, &s.d];
+        let values = std::iter::once(r.tol).chain(r.hints.iter().copied()).chain(
+            mats.into_iter().flat_map(|m| (0..m.ncols()).flat_map(move |j| (0..m.nrows()).map(move |i| m[(i, j)]))),
+        );
+        for x in values {
+            out.extend(x.to_le_bytes());
+        }
+    }
+    std::fs::write(path, out)
+}
+
+/// Reads what [`write_recorded`] wrote.
+fn read_recorded(path: &PathBuf) -> std::io::Result<Vec<kernel_bench::RecordedNorm>> {
+    let bytes = std::fs::read(path)?;
+    let mut norms = Vec::new();
+    let mut it = bytes.chunks_exact(8).map(|c| <[u8; 8]>::try_from(c).expect("8 bytes"));
+    while let Some(w) = it.next() {
+        let n = u64::from_le_bytes(w) as usize;
+        let mut next_int = || u64::from_le_bytes(it.next().expect("truncated record")) as usize;
+        let (m, p, nh) = (next_int(), next_int(), next_int());
+        let mut next = || f64::from_le_bytes(it.next().expect("truncated record"));
+        let tol = next();
+        let hints = (0..nh).map(|_| next()).collect();
+        let mut mat = |r: usize, c: usize| {
+            let v: Vec<f64> = (0..r * c).map(|_| next()).collect();
+            Mat::from_fn(r, c, |i, j| v[i + j * r])
+        };
+        let (a, b, c, d) = (mat(n, n), mat(n, m), mat(p, n), mat(p, m));
+        norms.push(kernel_bench::RecordedNorm { sys: StateSpace { a, b, c, d }, tol, hints });
+    }
+    Ok(norms)
+}
+
+/// `--compare FILE` of the replay: writes the values to FILE if it does not exist, else compares
+/// them with FILE's (from another build) and prints the largest relative differences.
+fn compare_values(file: &PathBuf, values: &[f64]) {
+    let Ok(text) = std::fs::read_to_string(file) else {
+        let text: String = values.iter().map(|v| format!("{v:e}\n")).collect();
+        std::fs::write(file, text).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        println!("values written to {}", file.display());
+        return;
+    };
+    let old: Vec<f64> = text.lines().map(|l| l.parse().expect("a number per line")).collect();
+    assert_eq!(old.len(), values.len(), "{}: another recording", file.display());
+    let (mut lower, mut higher, mut differ) = (0.0f64, 0.0f64, 0usize);
+    for (&o, &v) in old.iter().zip(values) {
+        if o.to_bits() != v.to_bits() {
+            differ += 1;
+        }
+        if o.is_finite() && v.is_finite() {
+            let r = v / o - 1.0;
+            lower = lower.min(r);
+            higher = higher.max(r);
+        } else if o.is_finite() != v.is_finite() {
+            println!("  finite/infinite mismatch: {o:e} against {v:e}");
+        }
+    }
+    println!("  against {}: {differ} values differ; new/old − 1 in [{lower:.3e}, {higher:.3e}]", file.display());
+}
+
+/// The replay (`--replay`, module docs).
+fn replay(path: &PathBuf, rounds: usize, steps: bool, compare: Option<&PathBuf>) {
+    let norms = read_recorded(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut times = Vec::new();
+    let mut sum = 0.0;
+    let mut bits: u64 = 0;
+    let mut values = Vec::with_capacity(norms.len());
+    for round in 0..rounds {
+        step_stats::reset();
+        step_stats::set_timing(steps && round + 1 == rounds);
+        let t0 = thread_cpu_time();
+        for r in &norms {
+            let h = hinfix::lti::hinf_norm_near(&r.sys, r.tol, &r.hints);
+            if round == 0 {
+                if h.value.is_finite() {
+                    sum += h.value;
+                }
+                bits = bits.rotate_left(5) ^ h.value.to_bits();
+                values.push(h.value);
+            }
+        }
+        let t = thread_cpu_time() - t0;
+        step_stats::set_timing(false);
+        times.push(t * 1e3 / norms.len().max(1) as f64);
+        if steps && round + 1 == rounds {
+            print_steps(&step_stats::snapshot(), norms.len(), t);
+        }
+    }
+    let order = norms.first().map_or(0, |r| r.sys.order());
+    if let Some(file) = compare {
+        compare_values(file, &values);
+    }
+    println!(
+        "replay {}: {} norms (order {order}), {:.4} ms/norm (median of {rounds}; {:?}), Σ finite ‖·‖∞ = {sum:.12e}, bits {bits:016x}",
+        path.display(),
+        norms.len(),
+        median(times.clone()),
+        times.iter().map(|t| format!("{t:.4}")).collect::<Vec<_>>()
+    );
+}
+
 /// The step table of `--steps` (module docs), for the small (order < 30: the controller's own
 /// norm on large plants) and the large systems.
 fn print_steps(s: &step_stats::StepStats, evals: usize, cpu_s: f64) {
@@ -242,7 +366,7 @@ fn print_steps(s: &step_stats::StepStats, evals: usize, cpu_s: f64) {
         }
         let per_norm = |st: Step| s.calls(st, large) as f64 / norms as f64;
         println!(
-            "    order {} {}: {norms} norms ({:.2} per evaluation), {} using the pencil; level-set tests per norm: {:.3} explicit ({:.3} doubtful), {:.3} pencil, {:.3} finding crossings",
+            "    order {} {}: {norms} norms ({:.2} per evaluation), {} using the pencil; level-set tests per norm: {:.3} explicit ({:.3} doubtful), {:.3} pencil, {:.3} finding crossings, {:.3} only probes ({:.3} raising γ_L)",
             if large { ">=" } else { "<" },
             step_stats::LARGE_ORDER,
             norms as f64 / evals.max(1) as f64,
@@ -251,6 +375,8 @@ fn print_steps(s: &step_stats::StepStats, evals: usize, cpu_s: f64) {
             per_norm(Step::DoubtfulSquared),
             per_norm(Step::PencilLevelSet),
             per_norm(Step::CrossingsFound),
+            per_norm(Step::Probe),
+            per_norm(Step::ProbeFound),
         );
         println!("      {:<24} {:>9} {:>10} {:>9} {:>7}", "step", "calls", "CPU s", "ms/call", "% run");
         for step in Step::ALL.into_iter().filter(|&st| !st.count_only() && s.calls(st, large) > 0) {
@@ -277,6 +403,13 @@ fn main() {
             .filter(|s| !s.starts_with("--"))
             .map_or(Vec::new(), |s| s.split(',').map(String::from).collect())
     });
+    if let Some(path) = args.iter().position(|a| a == "--replay").and_then(|i| args.get(i + 1)) {
+        let rounds =
+            args.iter().position(|a| a == "--rounds").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
+        let compare = args.iter().position(|a| a == "--compare").and_then(|i| args.get(i + 1)).map(PathBuf::from);
+        replay(&PathBuf::from(path), rounds.unwrap_or(3), args.iter().any(|a| a == "--steps"), compare.as_ref());
+        return;
+    }
     if args.iter().any(|a| a == "--qr") {
         qr_table(quick);
         return;
@@ -433,7 +566,8 @@ fn design_table(args: &[String], names: &[String]) {
     println!("Design run (order nK, ε = 1e-3, seed 1, cpumax {cpumax} s): ms per evaluation / one dense eig of size 2(n + nK)");
     for (name, nk) in [("HE1", 1), ("BDT2", 1), ("CM4", 1)] {
         if names.is_empty() || names.iter().any(|n| n == name) {
-            design_ratio(name, nk, cpumax, args.iter().any(|a| a == "--steps"));
+            let record = args.iter().position(|a| a == "--record").and_then(|i| args.get(i + 1)).map(PathBuf::from);
+            design_ratio(name, nk, cpumax, args.iter().any(|a| a == "--steps"), record.as_ref());
         }
     }
 }

@@ -83,7 +83,7 @@ fn assert_closed_loop_reaches_peak(
 /// peak. Reference: SLICOT AB13DD on each closed loop (tol 1e-12), re-checked by dense evaluation.
 #[test]
 fn ac4_warm_started_norms_reach_the_true_peak() {
-    assert_cases_reach_reference("ac4_warm_cases.json", 5);
+    assert_cases_reach_reference("ac4_warm_cases.json", 5, 5e-6);
 }
 
 /// Systems of order 30 to 59 (the squared level-set path, issue 13) from the large-order property
@@ -94,13 +94,24 @@ fn ac4_warm_started_norms_reach_the_true_peak() {
 /// numpy solve; AB13DD is itself low on four of them, see the fixture).
 #[test]
 fn large_order_norms_reach_the_true_peak() {
-    assert_cases_reach_reference("large_order_cases.json", 6);
+    assert_cases_reach_reference("large_order_cases.json", 6, 5e-6);
+}
+
+/// A system of order 45 from the large-order property family (seed 2313) on which the norm hinted
+/// at the runner-up peak came out 1.1e-6 low: at the level (1 + tol)·γ_L of that peak the true
+/// peak's two crossings were a near-tangent pair that rounding split off the imaginary axis by
+/// three times the axis threshold, so the squared spectrum reported none (issue 13). Eigenvalues
+/// that close to the axis are now probed. Reference: the family's modal sweep truth.
+#[test]
+fn near_tangent_crossings_split_off_the_axis_are_probed() {
+    assert_cases_reach_reference("near_tangent_cases.json", 1, 5e-7);
 }
 
 /// Every case of the fixture `file` (keys A, B, C, D, reference, reference_freq, hints,
-/// old_warm_value, optional eval_tol): the reference is attained, the old value was low, and both the cold and the
-/// hinted norm reach the reference without exceeding it.
-fn assert_cases_reach_reference(file: &str, count: usize) {
+/// old_warm_value, optional eval_tol): the reference is attained, the old value was low (by more
+/// than `old_gap` relative, or 10·eval_tol), and both the cold and the hinted norm reach the
+/// reference without exceeding it.
+fn assert_cases_reach_reference(file: &str, count: usize, old_gap: f64) {
     let text = std::fs::read_to_string(fixture(file)).unwrap();
     let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
     let cases = doc["cases"].as_array().unwrap();
@@ -117,7 +128,7 @@ fn assert_cases_reach_reference(file: &str, count: usize) {
         let tol = c["eval_tol"].as_f64().unwrap_or(1e-10);
         let attained = sigma_direct(&cl, c["reference_freq"].as_f64().unwrap());
         assert!((attained - peak).abs() <= tol * peak, "case {i}: σ at the reference frequency {attained} vs {peak}");
-        assert!(old < peak * (1.0 - (10.0 * tol).max(5e-6)), "case {i} must be one the old norm got wrong");
+        assert!(old < peak * (1.0 - (10.0 * tol).max(old_gap)), "case {i} must be one the old norm got wrong");
         for h in [hinf_norm_near(&cl, DEFAULT_HINF_TOL, &hints), hinf_norm(&cl, DEFAULT_HINF_TOL)] {
             assert!(
                 h.value >= peak * (1.0 - tol.max(1e-9)),

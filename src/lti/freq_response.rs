@@ -230,6 +230,11 @@ impl FreqResponse {
         self.g.as_ref()
     }
 
+    /// The order n of the system.
+    pub(crate) fn order(&self) -> usize {
+        self.n
+    }
+
     /// σmax(G(iω)) (+∞ if not finite).
     pub(crate) fn sigma_max(&mut self, w: f64) -> f64 {
         timed(Step::FreqEval, || {

@@ -55,16 +55,24 @@ pub enum Step {
     DoubtfulSquared,
     /// A level-set test that reported crossings, so that the level-set loop went on (count only).
     CrossingsFound,
+    /// A level-set test without crossings whose eigenvalues just off the axis were probed
+    /// (count only).
+    Probe,
+    /// A probe that raised the lower bound, so that the level-set loop went on (count only).
+    ProbeFound,
 }
 
 impl Step {
     /// Whether the step is only counted, never timed.
     pub fn count_only(self) -> bool {
-        matches!(self, Step::NormUsingPencil | Step::DoubtfulSquared | Step::CrossingsFound)
+        matches!(
+            self,
+            Step::NormUsingPencil | Step::DoubtfulSquared | Step::CrossingsFound | Step::Probe | Step::ProbeFound
+        )
     }
 
     /// All steps, in report order.
-    pub const ALL: [Step; 17] = [
+    pub const ALL: [Step; 19] = [
         Step::Norm,
         Step::Poles,
         Step::Hessenberg,
@@ -82,6 +90,8 @@ impl Step {
         Step::NormUsingPencil,
         Step::DoubtfulSquared,
         Step::CrossingsFound,
+        Step::Probe,
+        Step::ProbeFound,
     ];
 
     fn index(self) -> usize {
@@ -106,6 +116,8 @@ impl Step {
             Step::NormUsingPencil => "norms using the pencil",
             Step::DoubtfulSquared => "doubtful squared spectra",
             Step::CrossingsFound => "tests finding crossings",
+            Step::Probe => "tests with probes",
+            Step::ProbeFound => "probes raising γ_L",
         }
     }
 }
