@@ -469,9 +469,9 @@ fn mode_frequencies(
 /// are the near-tangent case (module docs, step 2), keep one test frequency each.
 fn thin_broad_modes(modes: &mut Vec<(f64, f64)>) {
     let mut kept: Vec<(f64, f64)> = Vec::with_capacity(modes.len());
-    let spacing = BROAD_MODE_SPACING.ln();
+    let near = |w: f64, v: f64| w < BROAD_MODE_SPACING * v && v < BROAD_MODE_SPACING * w;
     for &(zeta, w) in modes.iter() {
-        if zeta >= BROAD_MODE_DAMPING && kept.iter().any(|&(_, v)| (w / v).ln().abs() < spacing) {
+        if zeta >= BROAD_MODE_DAMPING && kept.iter().any(|&(_, v)| near(w, v)) {
             continue;
         }
         kept.push((zeta, w));
