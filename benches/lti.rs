@@ -319,8 +319,6 @@ fn compare_values(file: &PathBuf, values: &[f64]) {
 fn replay(path: &PathBuf, rounds: usize, steps: bool, compare: Option<&PathBuf>) {
     let norms = read_recorded(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut times = Vec::new();
-    let mut sum = 0.0;
-    let mut bits: u64 = 0;
     let mut values = Vec::with_capacity(norms.len());
     for round in 0..rounds {
         step_stats::reset();
@@ -329,10 +327,6 @@ fn replay(path: &PathBuf, rounds: usize, steps: bool, compare: Option<&PathBuf>)
         for r in &norms {
             let h = hinfix::lti::hinf_norm_near(&r.sys, r.tol, &r.hints);
             if round == 0 {
-                if h.value.is_finite() {
-                    sum += h.value;
-                }
-                bits = bits.rotate_left(5) ^ h.value.to_bits();
                 values.push(h.value);
             }
         }
@@ -344,6 +338,8 @@ fn replay(path: &PathBuf, rounds: usize, steps: bool, compare: Option<&PathBuf>)
         }
     }
     let order = norms.first().map_or(0, |r| r.sys.order());
+    let sum: f64 = values.iter().filter(|v| v.is_finite()).sum();
+    let bits = values.iter().fold(0u64, |b, v| b.rotate_left(5) ^ v.to_bits());
     if let Some(file) = compare {
         compare_values(file, &values);
     }

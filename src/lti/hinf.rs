@@ -386,7 +386,7 @@ fn hinf_norm_from(
         } else {
             count(Step::CrossingsFound);
         }
-        let mut all = ws.clone();
+        let mut all = ws;
         all.extend(&mids);
         all.sort_by(f64::total_cmp);
         stop.poll()?;
@@ -744,8 +744,8 @@ impl<'s> Hamiltonian<'s> {
         Hamiltonian { sys, sigma_d, freq_scale, d_u, d_s, d_v, pole_sq, used_pencil: std::cell::Cell::new(false) }
     }
 
-    /// Sorted nonnegative frequencies ω with iω an (numerically) imaginary eigenvalue of H(γ);
-    /// `None` if the eigensolver failed. `peak_freq`: where σmax(G(iω)) attains γ_L, the local
+    /// The sorted nonnegative frequencies ω with iω an (numerically) imaginary eigenvalue of H(γ),
+    /// and on the explicit path the probes ([`LevelSet`]); `None` if the eigensolver failed. `peak_freq`: where σmax(G(iω)) attains γ_L, the local
     /// peak just below γ ([`squared_crossings`]).
     fn crossings(&self, gamma: f64, peak_freq: f64) -> Option<LevelSet> {
         let kappa = gamma * gamma / ((gamma - self.sigma_d) * (gamma + self.sigma_d));
@@ -974,7 +974,7 @@ mod tests {
     /// allows but within the doubt window. At the known peak they are expected (and reported as
     /// candidate crossings); anywhere else they make the spectrum doubtful (the pencil decides).
     #[test]
-    fn the_known_peaks_pair_is_expected_and_probed() {
+    fn the_known_peaks_pair_is_expected_and_reported() {
         let wp = low_peak();
         let sq = spectrum(&[(-1e5, 50.0), (-1e5, -50.0)]);
         assert_close(&squared_crossings(&sq, &[], wp).unwrap().crossings, &[wp, wp, 2.0]);
