@@ -140,6 +140,29 @@ fn gradients_match_finite_differences() {
     assert!(checked_hinf >= 6, "too few stable random loops ({checked_hinf})");
 }
 
+/// From closed-loop order 30 on, the H∞ gradient's vectors come from the norm's Hessenberg form
+/// (`FreqResponse::transfer_vectors`) instead of a dense LU: the same finite-difference check, at
+/// orders 34 and 51 with D22 = 0 and D22 ≠ 0.
+#[test]
+fn large_order_hinf_gradient_matches_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(20261203);
+    let mut checked = 0;
+    for case in 0..4 {
+        let (n, nk) = [(33, 1), (49, 2)][case % 2];
+        let d22 = case >= 2;
+        let plant = random_plant(&mut rng, n, 2, 2, 3, 2, d22);
+        let k = random_controller(&mut rng, nk, 2, 2);
+        let (h, g) = closed_loop_hinf_grad(&plant, &k, FD_HINF_TOL).unwrap();
+        if !h.value.is_finite() {
+            continue;
+        }
+        let label = format!("case {case} (n={n}, nk={nk}, D22≠0: {d22}) ‖Tzw‖∞ (peak ω = {})", h.peak_freq);
+        check_fd(&label, &k, &g, |kk| hinf_norm(&closed_loop(&plant, kk).unwrap(), FD_HINF_TOL).value);
+        checked += 1;
+    }
+    assert!(checked >= 3, "too few stable random loops ({checked})");
+}
+
 #[test]
 fn ill_posed_loop_is_an_error() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);

@@ -36,9 +36,20 @@ pub(crate) struct FreqResponse {
     rhs: Vec<c64>,
     /// The last G(iω), p×m.
     g: Mat<c64>,
-    /// From order [`HESSENBERG_QR_FROM`] on: the split-complex solve (`hessenberg_solve.rs`) and
+    /// From order [`HESSENBERG_QR_FROM`] on: the split-complex solve and Q.
+    large: Option<Large>,
+}
+
+/// What [`FreqResponse`] keeps from order [`HESSENBERG_QR_FROM`] on.
+struct Large {
+    /// The split-complex solve (`hessenberg_solve.rs`).
+    solver: ShiftedHessenbergSolve,
     /// C̃ row-major (p×n).
-    large: Option<(ShiftedHessenbergSolve, Vec<f64>)>,
+    ct: Vec<f64>,
+    /// Q of A = Q H Qᵀ as faer's block Householder sequence: the reduced matrix (the reflectors
+    /// below its subdiagonal) and the block factors.
+    reflectors: Mat<f64>,
+    factors: Mat<f64>,
 }
 
 impl FreqResponse {
@@ -53,10 +64,11 @@ impl FreqResponse {
         let mut hm = sys.a.clone();
         let mut bt = sys.b.clone();
         let mut ct = sys.c.clone();
+        let mut hh = Mat::<f64>::zeros(0, 0);
         if n > 2 {
             let par = Par::Seq;
             let bs = faer::linalg::qr::no_pivoting::factor::recommended_block_size::<f64>(n - 1, n - 1).max(1);
-            let mut hh = Mat::<f64>::zeros(bs, n - 1);
+            hh = Mat::<f64>::zeros(bs, n - 1);
             let req = StackReq::any_of(&[
                 hessenberg::hessenberg_in_place_scratch::<f64>(n, bs, par, Default::default()),
                 householder::apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(
@@ -98,6 +110,12 @@ impl FreqResponse {
             }
         }
         let btv = (0..n * m).map(|k| bt[(k / m, k % m)]).collect();
+        let large = (n >= HESSENBERG_QR_FROM).then(|| Large {
+            solver: ShiftedHessenbergSolve::new(n, m),
+            ct: (0..p * n).map(|k| ct[(k / n, k % n)]).collect(),
+            reflectors: hm,
+            factors: hh,
+        });
         FreqResponse {
             n,
             m,
@@ -109,8 +127,7 @@ impl FreqResponse {
             work: vec![c64::new(0.0, 0.0); n * n],
             rhs: vec![c64::new(0.0, 0.0); n * m],
             g: Mat::zeros(p, m),
-            large: (n >= HESSENBERG_QR_FROM)
-                .then(|| (ShiftedHessenbergSolve::new(n, m), (0..p * n).map(|k| ct[(k / n, k % n)]).collect())),
+            large,
         }
     }
 
@@ -151,7 +168,7 @@ impl FreqResponse {
         if w.is_infinite() || n == 0 {
             return self.g.as_ref();
         }
-        if let Some((solver, ct)) = &mut self.large {
+        if let Some(Large { solver, ct, .. }) = &mut self.large {
             let (xr, xi) = solver.solve(&self.h, &self.bt, w);
             // G = D + C̃X, summed in the interleaved path's order.
             for i in 0..p {
@@ -230,6 +247,61 @@ impl FreqResponse {
         self.g.as_ref()
     }
 
+    /// a = (iωI − A)⁻ᴴ Cᵀ u and b = (iωI − A)⁻¹ B v for complex u (p) and v (m) and finite ω:
+    /// the vectors of the H∞ gradient (`gradient.rs`), through the Hessenberg form instead of a
+    /// dense complex LU of iωI − A (O(n²) instead of O(n³)); `None` below order
+    /// [`HESSENBERG_QR_FROM`] (no Q kept there) or if iωI − H is exactly singular.
+    ///
+    /// With iωI − A = Q(iωI − H)Qᵀ, B̃ = QᵀB and C̃ = CQ: b = Q b̃ with (iωI − H) b̃ = B̃v, and
+    /// a = Q ã with (iωI − H)ᴴ ã = C̃ᵀu. Conjugated, the second is (iωI − Hᵀ) ā = C̃ᵀū, and with
+    /// the reversal R (R Hᵀ R is upper Hessenberg) it is solved as (iωI − RHᵀR)(Rā) = RC̃ᵀū by
+    /// the same split solve. A complex right-hand side is solved as its real and imaginary parts.
+    pub(crate) fn transfer_vectors(&self, w: f64, u: &[c64], v: &[c64]) -> Option<(Vec<c64>, Vec<c64>)> {
+        let large = self.large.as_ref()?;
+        let (n, m, p) = (self.n, self.m, self.p);
+        let mut solver = ShiftedHessenbergSolve::new(n, 2);
+        // B̃v, row-major n×2 (Re, Im).
+        let mut rhs = vec![0.0; 2 * n];
+        for k in 0..n {
+            let row = &self.bt[k * m..(k + 1) * m];
+            let bv = row.iter().zip(v).fold(c64::new(0.0, 0.0), |s, (&b, &vj)| s + vj * b);
+            (rhs[2 * k], rhs[2 * k + 1]) = (bv.re, bv.im);
+        }
+        let b_tilde = split_solution(solver.solve(&self.h, &rhs, w), n, false)?;
+        // R C̃ᵀū and R Hᵀ R (row-major: (RHᵀR)(i, j) = H(n−1−j, n−1−i)).
+        for k in 0..n {
+            let col = n - 1 - k;
+            let ctu = (0..p).fold(c64::new(0.0, 0.0), |s, r| s + u[r].conj() * large.ct[r * n + col]);
+            (rhs[2 * k], rhs[2 * k + 1]) = (ctu.re, ctu.im);
+        }
+        let h_rev: Vec<f64> = (0..n * n).map(|k| self.h[(n - 1 - k % n) * n + (n - 1 - k / n)]).collect();
+        let mut a_tilde = split_solution(solver.solve(&h_rev, &rhs, w), n, true)?;
+        a_tilde.reverse();
+        // Back to the coordinates of A: columns Re ã, Im ã, Re b̃, Im b̃ times Q.
+        let mut cols = Mat::<f64>::from_fn(n, 4, |i, j| match j {
+            0 => a_tilde[i].re,
+            1 => a_tilde[i].im,
+            2 => b_tilde[i].re,
+            _ => b_tilde[i].im,
+        });
+        if n > 2 {
+            let bs = large.factors.nrows();
+            let req = householder::apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n - 1, bs, 4);
+            let mut mem = MemBuffer::new(req);
+            householder::apply_block_householder_sequence_on_the_left_in_place_with_conj(
+                large.reflectors.as_ref().submatrix(1, 0, n - 1, n - 1),
+                large.factors.as_ref(),
+                Conj::No,
+                cols.as_mut().subrows_mut(1, n - 1),
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+        }
+        let a = (0..n).map(|i| c64::new(cols[(i, 0)], cols[(i, 1)])).collect();
+        let b = (0..n).map(|i| c64::new(cols[(i, 2)], cols[(i, 3)])).collect();
+        Some((a, b))
+    }
+
     /// The order n of the system.
     pub(crate) fn order(&self) -> usize {
         self.n
@@ -246,6 +318,15 @@ impl FreqResponse {
             }
         })
     }
+}
+
+/// The complex solution x = X₀ + iX₁ of a right-hand side solved as its real (column 0) and
+/// imaginary (column 1) parts (`ShiftedHessenbergSolve::solve`'s Re X, Im X), conjugated if
+/// `conj`; `None` if not finite.
+fn split_solution((xr, xi): (&[f64], &[f64]), n: usize, conj: bool) -> Option<Vec<c64>> {
+    let sign = if conj { -1.0 } else { 1.0 };
+    let x: Vec<c64> = (0..n).map(|k| c64::new(xr[k] - xi[n + k], sign * (xi[k] + xr[n + k]))).collect();
+    x.iter().all(|z| z.re.is_finite() && z.im.is_finite()).then_some(x)
 }
 
 /// One frequency-response evaluator kept for the next H∞ computation on the same system: the

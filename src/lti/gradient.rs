@@ -10,7 +10,9 @@
 //!   ```text
 //!   G_A = Re(ā bᵀ),  G_B = Re(ā vᵀ),  G_C = Re(ū bᵀ),  G_D = Re(ū vᵀ)
 //!   ```
-//!   (docs/ALGORITHMS.md §6.1, in vector form; at ω = ∞ only G_D survives). One complex LU of Z gives both b and a.
+//!   (docs/ALGORITHMS.md §6.1, in vector form; at ω = ∞ only G_D survives). One complex LU of Z gives both b and a;
+//!   from order 30 on the norm's Hessenberg form Z = Q(iωI − H)Qᵀ does, in O(n²)
+//!   (`FreqResponse::transfer_vectors`).
 //! * Chain rule through the closed loop, D22 ≠ 0 included: `closed_loop.rs`
 //!   ([`ClosedLoop::chain_rule`]). For the controller's own quantities the matrix gradients are the
 //!   gradient (no chain rule).
@@ -22,11 +24,12 @@
 //! test frequencies; the gradient re-uses the norm's peak (no second norm computation).
 
 use faer::linalg::solvers::Solve;
-use faer::{c64, Mat};
+use faer::{c64, Mat, MatRef};
 
 use super::closed_loop::ClosedLoop;
 use super::freq_response::{FreqResponse, ResponseSlot};
-use super::hinf::{hinf_norm_of_finite, HinfNorm};
+use super::hessenberg_qr::HESSENBERG_QR_FROM;
+use super::hinf::{hinf_norm_keeping_response, HinfNorm};
 use super::interrupt::Interrupt;
 use super::spectral::rightmost_eigen;
 use super::step_stats::{for_order, timed, Step};
@@ -163,12 +166,47 @@ pub(crate) fn hinf_with_vectors(
     if !sys.is_finite() {
         return Ok(None);
     }
-    let norm = hinf_norm_of_finite(sys, tol, hints, stop, kept)?;
+    let (norm, fr) = hinf_norm_keeping_response(sys, tol, hints, stop, kept)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }
     stop.poll()?;
-    Ok(for_order(sys.order(), || timed(Step::Gradient, || peak_vectors(sys, norm.peak_freq))).map(|pv| (norm, pv)))
+    let w = norm.peak_freq;
+    let vectors = || match fr {
+        Some(mut fr) if sys.order() >= HESSENBERG_QR_FROM && w.is_finite() && sys.inputs().min(sys.outputs()) > 0 => {
+            peak_vectors_hessenberg(&mut fr, w)
+        }
+        _ => peak_vectors(sys, w),
+    };
+    Ok(for_order(sys.order(), || timed(Step::Gradient, vectors)).map(|pv| (norm, pv)))
+}
+
+/// u, v, a, b at the finite frequency w (module docs) through the Hessenberg form of `fr`
+/// (`FreqResponse::transfer_vectors`: O(n²) where [`peak_vectors`]' dense LU is O(n³)); `None`
+/// if the SVD fails or iωI − A is singular. From order [`HESSENBERG_QR_FROM`] on (issue 13: the
+/// dense LU was 2–3 % of a BDT2 or CM4 design run).
+fn peak_vectors_hessenberg(fr: &mut FreqResponse, w: f64) -> Option<PeakVectors> {
+    let (u, v) = leading_singular_pair(fr.eval(w))?;
+    let (a, b) = fr.transfer_vectors(w, &u, &v)?;
+    finite_vectors(PeakVectors { u, v, a, b })
+}
+
+/// The leading singular pair (u, v) of G (p×m, both nonzero): G v = σmax u; `None` if the SVD
+/// fails.
+fn leading_singular_pair(g: MatRef<'_, c64>) -> Option<(Vec<c64>, Vec<c64>)> {
+    let svd = g.thin_svd().ok()?;
+    let s = svd.S();
+    let k = (0..s.dim()).fold(0, |b, i| if s[i].re > s[b].re { i } else { b });
+    let u = (0..g.nrows()).map(|i| svd.U()[(i, k)]).collect();
+    let v = (0..g.ncols()).map(|j| svd.V()[(j, k)]).collect();
+    Some((u, v))
+}
+
+/// `pv` if all its entries are finite.
+fn finite_vectors(pv: PeakVectors) -> Option<PeakVectors> {
+    let PeakVectors { u, v, a, b } = &pv;
+    let finite = a.iter().chain(b).chain(u).chain(v).all(|z| z.re.is_finite() && z.im.is_finite());
+    finite.then_some(pv)
 }
 
 /// u, v, a, b at frequency w (module docs); `None` if an SVD fails.
@@ -189,11 +227,7 @@ pub(crate) fn peak_vectors(sys: &StateSpace, w: f64) -> Option<PeakVectors> {
     if p == 0 || m == 0 {
         return Some(PeakVectors { u: vec![zero; p], v: vec![zero; m], a: vec![zero; n], b: vec![zero; n] });
     }
-    let svd = g.thin_svd().ok()?;
-    let s = svd.S();
-    let k = (0..s.dim()).fold(0, |b, i| if s[i].re > s[b].re { i } else { b });
-    let u: Vec<c64> = (0..p).map(|i| svd.U()[(i, k)]).collect();
-    let v: Vec<c64> = (0..m).map(|j| svd.V()[(j, k)]).collect();
+    let (u, v) = leading_singular_pair(g.as_ref())?;
     let (a, b) = match lu_x {
         Some((lu, x)) => {
             let b: Vec<c64> = (0..n).map(|i| (0..m).fold(zero, |s, j| s + x[(i, j)] * v[j])).collect();
@@ -203,13 +237,51 @@ pub(crate) fn peak_vectors(sys: &StateSpace, w: f64) -> Option<PeakVectors> {
         }
         None => (vec![zero; n], vec![zero; n]),
     };
-    if a.iter().chain(&b).chain(&u).chain(&v).any(|z| !(z.re.is_finite() && z.im.is_finite())) {
-        return None;
-    }
-    Some(PeakVectors { u, v, a, b })
+    finite_vectors(PeakVectors { u, v, a, b })
 }
 
 fn nan_like(k: &Controller) -> Controller {
     let f = |m: &Mat<f64>| Mat::from_fn(m.nrows(), m.ncols(), |_, _| f64::NAN);
     Controller { ak: f(&k.ak), bk: f(&k.bk), ck: f(&k.ck), dk: f(&k.dk) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The matrix gradients Re(x̄ yᵀ) for the pairs (a, b), (a, v), (u, b), (u, v): invariant
+    /// under the phase of the singular pair, unlike the vectors.
+    fn outer_products(pv: &PeakVectors) -> Vec<f64> {
+        let outer = |x: &[c64], y: &[c64]| -> Vec<f64> {
+            x.iter().flat_map(|xi| y.iter().map(move |yj| (xi.conj() * yj).re)).collect()
+        };
+        [outer(&pv.a, &pv.b), outer(&pv.a, &pv.v), outer(&pv.u, &pv.b), outer(&pv.u, &pv.v)].concat()
+    }
+
+    /// The Hessenberg route gives the dense LU's gradient to rounding, with square and
+    /// non-square G, at frequencies near and far from the poles.
+    #[test]
+    fn hessenberg_vectors_match_the_dense_solve() {
+        let mut seed = 5u64;
+        let mut rnd = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for &(n, m, p) in &[(30usize, 1usize, 3usize), (47, 2, 2), (90, 3, 1)] {
+            let sys = StateSpace {
+                a: Mat::from_fn(n, n, |i, j| rnd() + if i == j { -0.5 * (1 + i % 7) as f64 } else { 0.0 }),
+                b: Mat::from_fn(n, m, |_, _| rnd()),
+                c: Mat::from_fn(p, n, |_, _| rnd()),
+                d: Mat::from_fn(p, m, |_, _| rnd()),
+            };
+            let mut fr = FreqResponse::new(&sys);
+            for w in [0.0, 0.4, 3.0, 25.0] {
+                let dense = outer_products(&peak_vectors(&sys, w).unwrap());
+                let ours = outer_products(&peak_vectors_hessenberg(&mut fr, w).unwrap());
+                let scale = dense.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+                let err = dense.iter().zip(&ours).fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
+                assert!(err <= 1e-11 * scale, "n={n} m={m} p={p} ω={w}: {err:e} against {scale:e}");
+            }
+        }
+    }
 }

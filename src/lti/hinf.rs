@@ -203,22 +203,33 @@ pub(crate) fn hinf_norm_of_finite(
     stop: Interrupt<'_>,
     kept: Option<FreqResponse>,
 ) -> Result<HinfNorm, Interrupted> {
+    hinf_norm_keeping_response(sys, tol, hints, stop, kept).map(|(norm, _)| norm)
+}
+
+/// [`hinf_norm_of_finite`], also returning the frequency-response evaluator of `sys` if one was
+/// made (for the gradient's vectors at the peak, `gradient.rs`).
+pub(crate) fn hinf_norm_keeping_response(
+    sys: &StateSpace,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+    kept: Option<FreqResponse>,
+) -> Result<(HinfNorm, Option<FreqResponse>), Interrupted> {
     stop.poll()?;
     for_order(sys.order(), || {
         timed(Step::Norm, || {
-            if sys.order() >= HESSENBERG_QR_FROM {
+            let mut fr = kept;
+            let poles = if sys.order() >= HESSENBERG_QR_FROM {
                 super::kernel_bench::note_norm(sys, tol, hints);
-                let fr = kept.unwrap_or_else(|| FreqResponse::new(sys));
-                match fr.poles() {
-                    Some(poles) => hinf_norm_from(sys, &poles, Some(fr), tol, hints, stop),
-                    None => Ok(HinfNorm::UNSTABLE),
-                }
+                fr.get_or_insert_with(|| FreqResponse::new(sys)).poles()
             } else {
-                match timed(Step::Poles, || eigenvalues(sys.a.as_ref())) {
-                    Some(poles) => hinf_norm_from(sys, &poles, kept, tol, hints, stop),
-                    None => Ok(HinfNorm::UNSTABLE),
-                }
-            }
+                timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
+            };
+            let norm = match poles {
+                Some(poles) => hinf_norm_from(sys, &poles, &mut fr, tol, hints, stop)?,
+                None => HinfNorm::UNSTABLE,
+            };
+            Ok((norm, fr))
         })
     })
 }
@@ -277,15 +288,16 @@ pub(crate) fn hinf_norm_with_poles_interruptible(
     tol: f64,
     stop: Interrupt<'_>,
 ) -> Result<HinfNorm, Interrupted> {
-    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, None, tol, &[], stop)))
+    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, &mut None, tol, &[], stop)))
 }
 
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
-/// evaluator `fr` of `sys` if given. The data must be finite.
+/// evaluator of `sys` in `fr` if there is one (and leaving the one it makes there). The data
+/// must be finite.
 fn hinf_norm_from(
     sys: &StateSpace,
     poles: &[c64],
-    fr: Option<FreqResponse>,
+    fr: &mut Option<FreqResponse>,
     tol: f64,
     hints: &[f64],
     stop: Interrupt<'_>,
@@ -299,7 +311,7 @@ fn hinf_norm_from(
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
     stop.poll()?;
-    let mut fr = fr.unwrap_or_else(|| FreqResponse::new(sys));
+    let fr = fr.get_or_insert_with(|| FreqResponse::new(sys));
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
 
@@ -315,11 +327,11 @@ fn hinf_norm_from(
     // Always, hints or not: a hint sits on the previous peak, and a peak elsewhere that is only a
     // little higher has a near-tangent pair of crossings at the level γ_L would then stop at, which
     // the imaginary-axis test can miss (AC4 in `tests/hinf_regression.rs`: 6.6e-4 low).
-    mode_frequencies(poles, &mut fr, &mut best, &mut scan, stop)?;
+    mode_frequencies(poles, fr, &mut best, &mut scan, stop)?;
     stop.poll()?;
     let tested: Vec<f64> = std::iter::once(0.0).chain(scan.iter().map(|&(w, _)| w)).collect();
     let peaks = refined_peaks(sys.order());
-    refine_best_peaks(&mut fr, &mut best, &tested, &scan, peaks);
+    refine_best_peaks(fr, &mut best, &tested, &scan, peaks);
     if !best.gamma.is_finite() {
         return Ok(HinfNorm { value: f64::INFINITY, peak_freq: best.freq });
     }
@@ -390,7 +402,7 @@ fn hinf_norm_from(
         all.extend(&mids);
         all.sort_by(f64::total_cmp);
         stop.poll()?;
-        refine_best_peaks(&mut fr, &mut best, &all, &scan, peaks);
+        refine_best_peaks(fr, &mut best, &all, &scan, peaks);
         if !(best.gamma >= before * (1.0 + 0.1 * tol)) {
             break; // no progress: the crossings were spurious
         }
