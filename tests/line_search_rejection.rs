@@ -99,3 +99,43 @@ fn screened_evaluator_reuse_is_exact() {
         }
     }
 }
+
+/// `closed_loop_hinf_grad_unless` (the norm of a trial point that passed the screen): with the
+/// level above the norm it gives bit for bit the full norm and gradient; with a level below the
+/// norm it stops at an attained value that reaches the level, at most the norm, with no gradient
+/// and (the level being below the scan's best) no level-set test.
+#[test]
+fn norm_stopping_at_a_level_is_exact_or_a_bound() {
+    use hinfix::lti::step_stats::{self, Step};
+    use hinfix::lti::{
+        closed_loop_hinf_grad_near, closed_loop_hinf_grad_unless, resolve_plant, Controller, Interrupt, Plant,
+        ResponseSlot, DEFAULT_HINF_TOL,
+    };
+    let plant = resolve_plant("CM4").and_then(Plant::load).unwrap();
+    let d = plant.dims;
+    let mut k = Controller::zeros(1, d.m2, d.p2);
+    k.ak[(0, 0)] = -2.0;
+    k.bk[(0, 0)] = 0.01;
+    let hint = [0.7];
+    let (norm, grad) = closed_loop_hinf_grad_near(&plant, &k, DEFAULT_HINF_TOL, &hint).unwrap();
+    assert!(norm.value.is_finite(), "the test loop must be stable");
+    let unless = |enough: f64| {
+        let mut slot = ResponseSlot::default();
+        closed_loop_hinf_grad_unless(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot, enough).unwrap()
+    };
+    let above = unless(norm.value * (1.0 + 1e-9));
+    assert_eq!(above.0.value.to_bits(), norm.value.to_bits());
+    assert_eq!(above.1, grad);
+    step_stats::reset();
+    let below = unless(0.5 * norm.value);
+    let tests = step_stats::snapshot().calls(Step::ExplicitLevelSet, true)
+        + step_stats::snapshot().calls(Step::PencilLevelSet, true);
+    assert!(
+        below.0.value >= 0.5 * norm.value && below.0.value <= norm.value,
+        "{} against {}",
+        below.0.value,
+        norm.value
+    );
+    assert!(below.1.dk[(0, 0)].is_nan(), "no gradient for a rejected point");
+    assert_eq!(tests, 0, "no level-set test once the scan reached the level");
+}

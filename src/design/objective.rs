@@ -36,7 +36,7 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_unless, controller_abscissa_grad,
     controller_hinf_grad, hinf_lower_bound_sharing, spectral_abscissa, Controller, ControllerGradient, Interrupt,
     LtiError, Plant, ResponseSlot,
 };
@@ -144,6 +144,10 @@ pub struct DesignObjective<'p> {
     stop: Option<StopHook>,
     /// Whether the last evaluation was abandoned because `stop` fired.
     abandoned: Cell<bool>,
+    /// While [`Objective::eval_below`] evaluates a trial point that passed the screen: its
+    /// threshold, at which the closed-loop norm stops early (`lti::closed_loop_hinf_grad_unless`);
+    /// +∞ otherwise.
+    reject_at: Cell<f64>,
     /// Told the CPU seconds of every complete closed-loop evaluation where `stop` applies (large
     /// plants), so the run can hold back what recomputing its result will cost.
     on_eval_cpu: Option<Rc<dyn Fn(f64)>>,
@@ -177,6 +181,7 @@ impl<'p> DesignObjective<'p> {
             screened: RefCell::new(ResponseSlot::default()),
             stop: None,
             abandoned: Cell::new(false),
+            reject_at: Cell::new(f64::INFINITY),
             on_eval_cpu: None,
             scaling: None,
         }
@@ -289,28 +294,36 @@ impl<'p> DesignObjective<'p> {
         let hint = [self.peak_hint.get()];
         let cpu0 = hook.map(|_| thread_cpu_time());
         let slot = &mut self.screened.borrow_mut();
-        let (gamma, g_cl) = match closed_loop_hinf_grad_sharing(self.plant, k, self.hinf_tol, &hint, stop, slot) {
-            Ok((norm, g)) => {
-                if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
-                    report(thread_cpu_time() - t0);
+        let reject_at = self.reject_at.get();
+        let (gamma, g_cl) =
+            match closed_loop_hinf_grad_unless(self.plant, k, self.hinf_tol, &hint, stop, slot, reject_at) {
+                Ok((norm, _)) if norm.value >= reject_at => {
+                    // A lower bound that fails the line search's test: no gradient, no new peak.
+                    c.gamma = norm.value;
+                    c.f = norm.value.max(k_term.0);
+                    return (c, None);
                 }
-                if norm.value.is_finite() {
-                    let last = self.peak_hint.replace(norm.peak_freq);
-                    if other_peak(last, norm.peak_freq) {
-                        self.other_peak.set(last);
+                Ok((norm, g)) => {
+                    if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
+                        report(thread_cpu_time() - t0);
                     }
+                    if norm.value.is_finite() {
+                        let last = self.peak_hint.replace(norm.peak_freq);
+                        if other_peak(last, norm.peak_freq) {
+                            self.other_peak.set(last);
+                        }
+                    }
+                    (norm.value, Some(g))
                 }
-                (norm.value, Some(g))
-            }
-            Err(LtiError::Interrupted(_)) => {
-                // Abandoned: no value (module docs).
-                self.abandoned.set(true);
-                c.f = f64::NAN;
-                c.k_hinf = f64::NAN;
-                return (c, None);
-            }
-            Err(_) => (f64::INFINITY, None),
-        };
+                Err(LtiError::Interrupted(_)) => {
+                    // Abandoned: no value (module docs).
+                    self.abandoned.set(true);
+                    c.f = f64::NAN;
+                    c.k_hinf = f64::NAN;
+                    return (c, None);
+                }
+                Err(_) => (f64::INFINITY, None),
+            };
         c.gamma = gamma;
         if !gamma.is_finite() {
             c.f = f64::INFINITY;
@@ -327,6 +340,32 @@ impl<'p> DesignObjective<'p> {
 }
 
 impl DesignObjective<'_> {
+    /// [`Objective::eval`], with the closed-loop norm stopping once it reaches `reject_at`
+    /// (`lti::closed_loop_hinf_grad_unless`): a value f ≥ `reject_at` may then be a lower bound,
+    /// comes with a NaN gradient and is not cached (the line search only needs to know that f
+    /// fails its test there).
+    fn eval_unless(&mut self, x: &[f64], g: &mut [f64], reject_at: f64) -> f64 {
+        let k = self.controller(x);
+        self.abandoned.set(false);
+        self.reject_at.set(reject_at);
+        let (c, grad) = self.components(&k, true);
+        self.reject_at.set(f64::INFINITY);
+        match grad {
+            Some(gk) if c.f.is_finite() => {
+                self.shape.write_x(&gk, g);
+                if let Some(d) = &self.scaling {
+                    g.iter_mut().zip(d.iter()).for_each(|(v, s)| *v *= s);
+                }
+            }
+            _ => g.iter_mut().for_each(|v| *v = f64::NAN),
+        }
+        let rejected = reject_at < f64::INFINITY && c.f >= reject_at;
+        if !self.abandoned.get() && !rejected {
+            self.cache.borrow_mut().insert(x, c);
+        }
+        c.f
+    }
+
     /// A lower bound of the performance objective at `k` without any eigenvalue computation of
     /// the closed loop: max(σmax(Tzw(iω)) at ω = ∞, at the last peak frequency and up the peak
     /// next to it while below `threshold` (`lti::hinf_lower_bound_sharing`), ε‖K‖∞) (‖K‖∞ is
@@ -377,22 +416,7 @@ impl Objective for DesignObjective<'_> {
     }
 
     fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        let k = self.controller(x);
-        self.abandoned.set(false);
-        let (c, grad) = self.components(&k, true);
-        match grad {
-            Some(gk) if c.f.is_finite() => {
-                self.shape.write_x(&gk, g);
-                if let Some(d) = &self.scaling {
-                    g.iter_mut().zip(d.iter()).for_each(|(v, s)| *v *= s);
-                }
-            }
-            _ => g.iter_mut().for_each(|v| *v = f64::NAN),
-        }
-        if !self.abandoned.get() {
-            self.cache.borrow_mut().insert(x, c);
-        }
-        c.f
+        self.eval_unless(x, g, f64::INFINITY)
     }
 
     /// In the performance phase, a trial point whose cheap lower bound
@@ -406,6 +430,7 @@ impl Objective for DesignObjective<'_> {
                 g.iter_mut().for_each(|v| *v = f64::NAN);
                 return lb;
             }
+            return self.eval_unless(x, g, threshold);
         }
         self.eval(x, g)
     }

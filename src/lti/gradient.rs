@@ -118,18 +118,36 @@ pub fn closed_loop_hinf_grad_sharing(
     stop: Interrupt<'_>,
     slot: &mut ResponseSlot,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    closed_loop_hinf_grad_unless(plant, k, tol, hints, stop, slot, f64::INFINITY)
+}
+
+/// [`closed_loop_hinf_grad_sharing`] that stops as soon as ‖Tzw‖∞ is known to reach `enough`:
+/// a value at or above `enough` is then an attained σmax(Tzw(iω)) (a lower bound of the norm),
+/// returned with a NaN gradient, as for an unstable loop. For the line search's exact rejection of
+/// trial points (`design::objective`); below `enough` the result is that of
+/// [`closed_loop_hinf_grad_sharing`].
+pub fn closed_loop_hinf_grad_unless(
+    plant: &Plant,
+    k: &Controller,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+    slot: &mut ResponseSlot,
+    enough: f64,
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
     let kept = slot.take_for(&cl.sys);
-    let Some((norm, pv)) = hinf_with_vectors(&cl.sys, tol, hints, stop, kept)? else {
-        return Ok((HinfNorm::UNSTABLE, nan_like(k)));
-    };
-    Ok((norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))))
+    Ok(match hinf_with_vectors(&cl.sys, tol, hints, stop, kept, enough)? {
+        Some((norm, Some(pv))) => (norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))),
+        Some((norm, None)) => (norm, nan_like(k)),
+        None => (HinfNorm::UNSTABLE, nan_like(k)),
+    })
 }
 
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Ok(Some((norm, pv))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER, None) else {
+    let Ok(Some((norm, Some(pv)))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER, None, f64::INFINITY) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -155,20 +173,25 @@ pub(crate) struct PeakVectors {
 }
 
 /// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `stop` fires.
-/// `kept`: the evaluator of `sys` if one was made already.
+/// `kept`: the evaluator of `sys` if one was made already. A value at or above `enough` comes
+/// without vectors (`hinf_norm_keeping_response`: it may be a lower bound of the norm).
 pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
     tol: f64,
     hints: &[f64],
     stop: Interrupt<'_>,
     kept: Option<FreqResponse>,
-) -> Result<Option<(HinfNorm, PeakVectors)>, LtiError> {
+    enough: f64,
+) -> Result<Option<(HinfNorm, Option<PeakVectors>)>, LtiError> {
     if !sys.is_finite() {
         return Ok(None);
     }
-    let (norm, fr) = hinf_norm_keeping_response(sys, tol, hints, stop, kept)?;
+    let (norm, fr) = hinf_norm_keeping_response(sys, tol, hints, stop, kept, enough)?;
     if !norm.value.is_finite() {
         return Ok(None);
+    }
+    if norm.value >= enough {
+        return Ok(Some((norm, None)));
     }
     stop.poll()?;
     let w = norm.peak_freq;
@@ -178,7 +201,7 @@ pub(crate) fn hinf_with_vectors(
         }
         _ => peak_vectors(sys, w),
     };
-    Ok(for_order(sys.order(), || timed(Step::Gradient, vectors)).map(|pv| (norm, pv)))
+    Ok(for_order(sys.order(), || timed(Step::Gradient, vectors)).map(|pv| (norm, Some(pv))))
 }
 
 /// u, v, a, b at the finite frequency w (module docs) through the Hessenberg form of `fr`
