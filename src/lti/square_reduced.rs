@@ -251,6 +251,11 @@ trait SkewBlock {
     /// X ← P X P for P = I − β v vᵀ on the indices r..n; rows and columns before `first` are
     /// zero outside the leading block and are skipped. `buf`: work space of length n.
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]);
+    /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the skew-Hamiltonian
+    /// M = [A G; Q Aᵀ] with this storage of G and Q ([`rotate_by_entries`]).
+    fn rotate(a: &mut ColMajor, g: &mut Self, q: &mut Self, r: usize, c: f64, s: f64)
+    where
+        Self: Sized;
 }
 
 impl SkewBlock for ColMajor {
@@ -266,6 +271,9 @@ impl SkewBlock for ColMajor {
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]) {
         self.reflect_two_sided(r, v, beta, first, first, buf)
     }
+    fn rotate(a: &mut ColMajor, g: &mut Self, q: &mut Self, r: usize, c: f64, s: f64) {
+        rotate_by_entries(a, g, q, r, c, s)
+    }
 }
 
 impl SkewBlock for SkewLower {
@@ -280,6 +288,24 @@ impl SkewBlock for SkewLower {
     }
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]) {
         self.reflect_two_sided(r, v, beta, first, buf)
+    }
+    /// [`rotate_by_entries`] in one pass without work arrays (issue 13: its reads through `at`
+    /// were ~5 % of a BDT2 design run's norms). G(k, r) = −G(r, k) and Q(k, r) = −Q(r, k) are one
+    /// stored entry each, and the two formulas that set it give exactly opposite values (negation
+    /// and the commutativity of a sum are exact), so each is computed once: the same bits.
+    fn rotate(a: &mut ColMajor, g: &mut Self, q: &mut Self, r: usize, c: f64, s: f64) {
+        let n = a.n;
+        let old = [a.at(r, r), 0.0, 0.0];
+        for k in (0..n).filter(|&k| k != r) {
+            let (ar, ac) = (a.data[k * n + r], a.data[r * n + k]);
+            let (gr, qr) = (g.at(r, k), q.at(r, k));
+            let (gc, qc) = (-gr, -qr);
+            a.data[k * n + r] = c * ar + s * qr;
+            a.data[r * n + k] = c * ac + s * gc;
+            g.set(r, k, c * gr + s * ac);
+            q.set(k, r, c * qc + s * ar);
+        }
+        rotate_diagonal_block(a, g, q, r, c, s, old);
     }
 }
 
@@ -333,33 +359,51 @@ impl<S: SkewBlock> SkewHamiltonian<S> {
     }
 
     /// M ← R M Rᵀ for the rotation R = [c s; −s c] in the (r, n+r) plane of the full matrix M
-    /// (orthogonal and symplectic). Only rows and columns r and n+r of M change; with M[n+i, n+k]
-    /// = A(k, i) they are, from the old values,
-    /// A(r,k) ← c A(r,k) + s Q(r,k),   Q(r,k) ← −s A(r,k) + c Q(r,k),   G(r,k) ← c G(r,k) + s A(k,r),
-    /// A(i,r) ← c A(i,r) + s G(i,r),   G(i,r) ← −s A(i,r) + c G(i,r),   Q(i,r) ← c Q(i,r) + s A(r,i)
-    /// for i, k ≠ r, and the 2×2 block [A(r,r) G(r,r); Q(r,r) A(r,r)] ← R (·) Rᵀ. With G, Q
-    /// stored as [`SkewLower`], setting G(r,k) also sets G(k,r) = −G(r,k); the two formulas give
-    /// exactly opposite values (rounding is symmetric), and the diagonal stays zero.
+    /// (orthogonal and symplectic); see [`SkewBlock::rotate`].
     fn rotate(&mut self, r: usize, c: f64, s: f64) {
-        let n = self.a.n;
-        let (ar, ac): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (self.a.at(r, k), self.a.at(k, r))).unzip();
-        let (gr, gc): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (self.g.at(r, k), self.g.at(k, r))).unzip();
-        let (qr, qc): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (self.q.at(r, k), self.q.at(k, r))).unzip();
-        for k in (0..n).filter(|&k| k != r) {
-            self.a.set(r, k, c * ar[k] + s * qr[k]);
-            self.q.set(r, k, -s * ar[k] + c * qr[k]);
-            self.g.set(r, k, c * gr[k] + s * ac[k]);
-            self.a.set(k, r, c * ac[k] + s * gc[k]);
-            self.g.set(k, r, -s * ac[k] + c * gc[k]);
-            self.q.set(k, r, c * qc[k] + s * ar[k]);
-        }
-        let (al, g, q) = (ar[r], gr[r], qr[r]);
-        let (t00, t01) = (c * al + s * q, c * g + s * al);
-        let (t10, t11) = (-s * al + c * q, -s * g + c * al);
-        self.a.set(r, r, t00 * c + t01 * s);
-        self.g.set(r, r, -t00 * s + t01 * c);
-        self.q.set(r, r, t10 * c + t11 * s);
+        S::rotate(&mut self.a, &mut self.g, &mut self.q, r, c, s)
     }
+}
+
+/// [`SkewBlock::rotate`] through `at` and `set` (full storage, below [`FAST_KERNELS_FROM`]).
+/// Only rows and columns r and n+r of M change; with M[n+i, n+k] = A(k, i) they are, from the
+/// old values,
+/// A(r,k) ← c A(r,k) + s Q(r,k),   Q(r,k) ← −s A(r,k) + c Q(r,k),   G(r,k) ← c G(r,k) + s A(k,r),
+/// A(i,r) ← c A(i,r) + s G(i,r),   G(i,r) ← −s A(i,r) + c G(i,r),   Q(i,r) ← c Q(i,r) + s A(r,i)
+/// for i, k ≠ r, and the 2×2 block [A(r,r) G(r,r); Q(r,r) A(r,r)] ← R (·) Rᵀ.
+fn rotate_by_entries<S: SkewBlock>(a: &mut ColMajor, g: &mut S, q: &mut S, r: usize, c: f64, s: f64) {
+    let n = a.n;
+    let (ar, ac): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (a.at(r, k), a.at(k, r))).unzip();
+    let (gr, gc): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (g.at(r, k), g.at(k, r))).unzip();
+    let (qr, qc): (Vec<f64>, Vec<f64>) = (0..n).map(|k| (q.at(r, k), q.at(k, r))).unzip();
+    for k in (0..n).filter(|&k| k != r) {
+        a.set(r, k, c * ar[k] + s * qr[k]);
+        q.set(r, k, -s * ar[k] + c * qr[k]);
+        g.set(r, k, c * gr[k] + s * ac[k]);
+        a.set(k, r, c * ac[k] + s * gc[k]);
+        g.set(k, r, -s * ac[k] + c * gc[k]);
+        q.set(k, r, c * qc[k] + s * ar[k]);
+    }
+    rotate_diagonal_block(a, g, q, r, c, s, [ar[r], gr[r], qr[r]]);
+}
+
+/// The 2×2 block [A(r,r) G(r,r); Q(r,r) A(r,r)] ← R (·) Rᵀ of [`rotate_by_entries`], from the
+/// old values `[A(r,r), G(r,r), Q(r,r)]`.
+fn rotate_diagonal_block<S: SkewBlock>(
+    a: &mut ColMajor,
+    g: &mut S,
+    q: &mut S,
+    r: usize,
+    c: f64,
+    s: f64,
+    old: [f64; 3],
+) {
+    let [al, g0, q0] = old;
+    let (t00, t01) = (c * al + s * q0, c * g0 + s * al);
+    let (t10, t11) = (-s * al + c * q0, -s * g0 + c * al);
+    a.set(r, r, t00 * c + t01 * s);
+    g.set(r, r, -t00 * s + t01 * c);
+    q.set(r, r, t10 * c + t11 * s);
 }
 
 /// The Householder vector (v₀ = 1) and β of P = I − β v vᵀ with P x = ∓‖x‖ e₁ (LAPACK `dlarfg`
