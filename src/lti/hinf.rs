@@ -83,7 +83,7 @@ use super::hessenberg_qr::HESSENBERG_QR_FROM;
 use super::interrupt::{Interrupt, Interrupted};
 use super::level_set_pencil::pencil_crossings;
 use super::spectral::eigenvalues;
-use super::square_reduced::{hamiltonian_squared_eigenvalues, SquaredSpectrum};
+use super::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
 use super::step_stats::{count, for_order, timed, Step};
 use super::StateSpace;
 
@@ -785,8 +785,11 @@ impl<'s> Hamiltonian<'s> {
         let try_squared = explicit && kappa.is_finite() && kappa > 0.0 && kappa <= MAX_EXPLICIT_HAMILTONIAN_COND;
         let squared = if try_squared {
             timed(Step::ExplicitLevelSet, || {
-                let [f, g, k] = self.explicit_hamiltonian(gamma);
-                hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref())
+                let ExplicitHamiltonian { h11, g_factors: [gl, gr], k_factors: [kl, kr] } =
+                    self.explicit_hamiltonian(gamma);
+                let g = LowRank { left: gl.as_ref(), right: gr.as_ref() };
+                let k = LowRank { left: kl.as_ref(), right: kr.as_ref() };
+                hamiltonian_squared_eigenvalues(h11.as_ref(), g, k)
                     .map(|sq| squared_crossings(&sq, &self.pole_sq, peak_freq))
             })?
         } else {
@@ -818,10 +821,10 @@ impl<'s> Hamiltonian<'s> {
         Some(LevelSet { crossings: ws, probes })
     }
 
-    /// The blocks [H11, H12, H21] of the explicit Hamiltonian (H22 = −H11ᵀ), with R⁻¹, S⁻¹
-    /// through the SVD of D:
+    /// The explicit Hamiltonian [H11 H12; H21 −H11ᵀ] with its off-diagonal blocks by factors of
+    /// rank m and p ([`ExplicitHamiltonian`]), R⁻¹ and S⁻¹ through the SVD of D:
     /// −R⁻¹ = V diag(1/(γ²−σᵢ²)) Vᵀ, −S⁻¹ = U diag(1/(γ²−σᵢ²)) Uᵀ (σᵢ = 0 beyond min(p,m)).
-    fn explicit_hamiltonian(&self, gamma: f64) -> [Mat<f64>; 3] {
+    fn explicit_hamiltonian(&self, gamma: f64) -> ExplicitHamiltonian {
         let s = self.sys;
         let (m, p) = (s.inputs(), s.outputs());
         let g2 = gamma * gamma;
@@ -838,12 +841,20 @@ impl<'s> Hamiltonian<'s> {
         let dtc = s.d.transpose() * &s.c; // DᵀC
                                           // H11 = A − B R⁻¹ DᵀC = A + (−BR⁻¹) DᵀC; H22 = −Aᵀ + Cᵀ D R⁻¹ Bᵀ = −H11ᵀ
         let h11 = &s.a + &br * &dtc;
-        // H12 = −γ B R⁻¹ Bᵀ
-        let h12 = (&br * s.b.transpose()) * faer::Scale(gamma);
-        // H21 = γ Cᵀ S⁻¹ C = −γ Cᵀ (−S⁻¹) C
-        let h21 = (s.c.transpose() * &sinv_neg * &s.c) * faer::Scale(-gamma);
-        [h11, h12, h21]
+        // H12 = −γ B R⁻¹ Bᵀ = (γ(−BR⁻¹)) Bᵀ;  H21 = γ Cᵀ S⁻¹ C = Cᵀ (−γ(−S⁻¹)C)
+        let g_factors = [&br * faer::Scale(gamma), s.b.clone()];
+        let k_factors = [s.c.transpose().to_owned(), (&sinv_neg * &s.c).transpose() * faer::Scale(-gamma)];
+        ExplicitHamiltonian { h11, g_factors, k_factors }
     }
+}
+
+/// H(γ) = [H11 G; K −H11ᵀ] with G = G_L G_Rᵀ (n×m factors) and K = K_L K_Rᵀ (n×p factors).
+struct ExplicitHamiltonian {
+    h11: Mat<f64>,
+    /// [G_L, G_R].
+    g_factors: [Mat<f64>; 2],
+    /// [K_L, K_R].
+    k_factors: [Mat<f64>; 2],
 }
 
 /// AB13DD's imaginary-axis threshold on |Re λ| for a spectrum of modulus up to `max_abs`.

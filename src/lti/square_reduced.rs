@@ -54,41 +54,52 @@ const FAST_KERNELS_FROM: usize = 30;
 /// orthogonal transformations; their rounding grows like √n in practice).
 const ERROR_FACTOR: f64 = 100.0;
 
-/// λ(H)² for the real Hamiltonian H = [F G; K −Fᵀ] (G, K symmetric, all n×n); `None` if the
-/// data are not finite or the QR fails.
+/// λ(H)² for the real Hamiltonian H = [F G; K −Fᵀ] (G, K symmetric, all n×n) with G and K
+/// given by factors ([`LowRank`]); `None` if the data are not finite or the QR fails.
 ///
 /// H is first balanced by the symplectic similarity diag(√s·I, I/√s) (see
 /// [`symplectic_balance_exponent`]), which turns G, K into G/s, s·K and leaves the eigenvalues
 /// unchanged.
 pub(crate) fn hamiltonian_squared_eigenvalues(
     f: MatRef<'_, f64>,
-    g: MatRef<'_, f64>,
-    k: MatRef<'_, f64>,
+    g: LowRank<'_>,
+    k: LowRank<'_>,
 ) -> Option<SquaredSpectrum> {
     let ([m11, m12, m21], norm) = balanced_square(f, g, k)?;
     let mu = skew_hamiltonian_eigenvalues(m11.as_ref(), m12.as_ref(), m21.as_ref())?;
     Some(SquaredSpectrum { mu, abs_error: ERROR_FACTOR * f64::EPSILON * norm.max(f64::MIN_POSITIVE) })
 }
 
+/// An off-diagonal block X = L Rᵀ of a Hamiltonian by its factors (n×r each): the H∞
+/// Hamiltonian's −γBR⁻¹Bᵀ and γCᵀS⁻¹C have ranks m and p ≪ n. A dense X is L = X, R = I.
+#[derive(Clone, Copy)]
+pub(crate) struct LowRank<'a> {
+    pub left: MatRef<'a, f64>,
+    pub right: MatRef<'a, f64>,
+}
+
 /// The blocks [M₁₁, M₁₂, M₂₁] of M = H² for the balanced H (see
 /// [`hamiltonian_squared_eigenvalues`]) and ‖M‖_F; `None` if not finite.
-fn balanced_square(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<([Mat<f64>; 3], f64)> {
-    let (g_norm, k_norm) = (g.norm_l2(), k.norm_l2());
-    if !(g_norm.is_finite() && k_norm.is_finite()) {
-        return None;
-    }
-    let e = symplectic_balance_exponent(g_norm, k_norm);
-    let (g, k) = (g * faer::Scale((-e).exp2()), k * faer::Scale(e.exp2()));
-    let (g, k) = (g.as_ref(), k.as_ref());
-    // M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], and GFᵀ = (FG)ᵀ, FᵀK = (KF)ᵀ.
-    let (m11, m12, m21) = timed(Step::HamiltonianSquare, || {
-        let m11 = f * f + g * k;
-        let fg = f * g;
-        let kf = k * f;
-        (m11, &fg - fg.transpose(), &kf - kf.transpose())
-    });
-    let norm = (2.0 * m11.squared_norm_l2() + m12.squared_norm_l2() + m21.squared_norm_l2()).sqrt();
-    norm.is_finite().then_some(([m11, m12, m21], norm))
+///
+/// M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], with GFᵀ = (FG)ᵀ and FᵀK = (KF)ᵀ. GK, FG
+/// and KF are formed from the factors, O(n²r), so that F² is the only O(n³) product (issue 13:
+/// four dense products were 4 % of a CM4 design run). The balancing scales G by 2⁻ᵗ and K by 2ᵗ:
+/// GK is unchanged, FG and KF are scaled after the product (exact, a power of two).
+fn balanced_square(f: MatRef<'_, f64>, g: LowRank<'_>, k: LowRank<'_>) -> Option<([Mat<f64>; 3], f64)> {
+    timed(Step::HamiltonianSquare, || {
+        let (g_norm, k_norm) = ((g.left * g.right.transpose()).norm_l2(), (k.left * k.right.transpose()).norm_l2());
+        if !(g_norm.is_finite() && k_norm.is_finite()) {
+            return None;
+        }
+        let e = symplectic_balance_exponent(g_norm, k_norm);
+        let gk = g.left * ((g.right.transpose() * k.left) * k.right.transpose());
+        let fg = (f * g.left) * g.right.transpose() * faer::Scale((-e).exp2());
+        let kf = k.left * (k.right.transpose() * f) * faer::Scale(e.exp2());
+        let m11 = f * f + gk;
+        let (m12, m21) = (&fg - fg.transpose(), &kf - kf.transpose());
+        let norm = (2.0 * m11.squared_norm_l2() + m12.squared_norm_l2() + m21.squared_norm_l2()).sqrt();
+        norm.is_finite().then_some(([m11, m12, m21], norm))
+    })
 }
 
 /// The exponent t (an integer, as f64) of the symplectic scaling s = 2ᵗ ≈ √(‖G‖/‖K‖) that makes
@@ -113,7 +124,9 @@ fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
 /// H = [F G; K −Fᵀ], as [`hamiltonian_squared_eigenvalues`] computes it (for the QR
 /// microbenchmark, `lti::kernel_bench`); `None` if not finite.
 pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
-    let ([m11, m12, m21], _) = balanced_square(f, g, k)?;
+    let id = Mat::<f64>::identity(f.nrows(), f.nrows());
+    let dense = |x| LowRank { left: x, right: id.as_ref() };
+    let ([m11, m12, m21], _) = balanced_square(f, dense(g), dense(k))?;
     Some(pvl_w(m11.as_ref(), m12.as_ref(), m21.as_ref()))
 }
 
@@ -587,12 +600,59 @@ mod tests {
         }
     }
 
+    /// [`hamiltonian_squared_eigenvalues`] for dense G and K (factors G·I and K·I).
+    fn dense_squared_eigenvalues(
+        f: MatRef<'_, f64>,
+        g: MatRef<'_, f64>,
+        k: MatRef<'_, f64>,
+    ) -> Option<SquaredSpectrum> {
+        let id = Mat::<f64>::identity(f.nrows(), f.nrows());
+        hamiltonian_squared_eigenvalues(
+            f,
+            LowRank { left: g, right: id.as_ref() },
+            LowRank { left: k, right: id.as_ref() },
+        )
+    }
+
+    /// Low-rank G = G_L G_Rᵀ and K = K_L K_Rᵀ (the H∞ Hamiltonian's form) give the eigenvalues
+    /// of the dense blocks to rounding.
+    #[test]
+    fn low_rank_blocks_give_the_dense_eigenvalues() {
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        let mut r = |rows: usize, cols: usize| {
+            Mat::<f64>::from_fn(rows, cols, |_, _| {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                z
+            })
+        };
+        for (n, rank) in [(30usize, 1usize), (45, 3)] {
+            let f = r(n, n);
+            let (gl, kl) = (r(n, rank), r(n, rank));
+            let (wg, wk) = (r(rank, rank), r(rank, rank));
+            // Symmetric G = G_L W G_Lᵀ and K = K_L W K_Lᵀ (W symmetric).
+            let (wg, wk) = (&wg + wg.transpose(), &wk + wk.transpose());
+            let (gr, kr) = (&gl * &wg, &kl * &wk);
+            let (g, k) = (&gl * gr.transpose(), &kl * kr.transpose());
+            let dense = dense_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
+            let low = hamiltonian_squared_eigenvalues(
+                f.as_ref(),
+                LowRank { left: gl.as_ref(), right: gr.as_ref() },
+                LowRank { left: kl.as_ref(), right: kr.as_ref() },
+            )
+            .unwrap();
+            for mu in &low.mu {
+                let off = dense.mu.iter().map(|d| (d - mu).norm()).fold(f64::INFINITY, f64::min);
+                assert!(off <= 10.0 * dense.abs_error, "n = {n}: μ = {mu} off by {off:e}");
+            }
+        }
+    }
+
     #[test]
     fn squared_eigenvalues_match_the_unstructured_solver() {
         for (n, seed) in [(1usize, 11u64), (3, 12), (8, 13), (30, 14)] {
             let ([f, g, k], h) = random_hamiltonian(n, seed);
             let full = eigenvalues(h.as_ref()).unwrap();
-            let sq = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
+            let sq = dense_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
             assert_eq!(sq.mu.len(), n);
             // Every μ is the square of some eigenvalue of H, within the stated error (×10 for
             // the unstructured solver's own rounding).
@@ -615,11 +675,11 @@ mod tests {
         let n = 40;
         let ([f, g, k], h) = random_hamiltonian(n, 21);
         let truth = eigenvalues(h.as_ref()).unwrap();
-        let balanced = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
+        let balanced = dense_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
         for s in [1e6, 1e-6, 3.3e5] {
             let (gs, ks) = (&g * faer::Scale(s), &k * faer::Scale(1.0 / s));
             assert_eq!(symplectic_balance_exponent(gs.norm_l2(), ks.norm_l2()), (s.log2()).round(), "s = {s}");
-            let sq = hamiltonian_squared_eigenvalues(f.as_ref(), gs.as_ref(), ks.as_ref()).unwrap();
+            let sq = dense_squared_eigenvalues(f.as_ref(), gs.as_ref(), ks.as_ref()).unwrap();
             assert!(sq.abs_error <= 2.0 * balanced.abs_error, "s = {s}: bound {:e}", sq.abs_error);
             for mu in &sq.mu {
                 let off = truth.iter().map(|l| (l * l - mu).norm()).fold(f64::INFINITY, f64::min);
@@ -638,7 +698,7 @@ mod tests {
         let f = Mat::<f64>::zeros(n, n);
         let g = Mat::<f64>::identity(n, n);
         let k = Mat::from_fn(n, n, |i, j| if i == j { -omegas[i] * omegas[i] } else { 0.0 });
-        let sq = hamiltonian_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
+        let sq = dense_squared_eigenvalues(f.as_ref(), g.as_ref(), k.as_ref()).unwrap();
         let mut got: Vec<f64> = sq.mu.iter().map(|m| m.re).collect();
         got.sort_by(f64::total_cmp);
         let mut want: Vec<f64> = omegas.iter().map(|w| -w * w).collect();
