@@ -87,8 +87,16 @@ fn screened_evaluator_reuse_is_exact() {
         assert!(cl.order() >= 30, "the large-order path");
         let lb = hinf_lower_bound_sharing(&cl, &hint, f64::INFINITY, &mut slot);
         step_stats::reset();
-        let shared =
-            closed_loop_hinf_grad_sharing(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot).unwrap();
+        let shared = closed_loop_hinf_grad_sharing(
+            &plant,
+            &k,
+            DEFAULT_HINF_TOL,
+            &hint,
+            Interrupt::NEVER,
+            &mut slot,
+            f64::INFINITY,
+        )
+        .unwrap();
         let reductions = step_stats::snapshot().calls(Step::Hessenberg, true);
         assert_eq!(reductions, u64::from(!std::ptr::eq(screened, &k)), "Hessenberg reductions of the norm");
         assert_eq!(shared.0.value.to_bits(), fresh.0.value.to_bits());
@@ -100,7 +108,7 @@ fn screened_evaluator_reuse_is_exact() {
     }
 }
 
-/// `closed_loop_hinf_grad_unless` (the norm of a trial point that passed the screen): with the
+/// `closed_loop_hinf_grad_sharing` with a level (the norm of a trial point that passed the screen): with the
 /// level above the norm it gives bit for bit the full norm and gradient; with a level below the
 /// norm it stops at an attained value that reaches the level, at most the norm, with no gradient
 /// and (the level being below the scan's best) no level-set test.
@@ -108,7 +116,7 @@ fn screened_evaluator_reuse_is_exact() {
 fn norm_stopping_at_a_level_is_exact_or_a_bound() {
     use hinfix::lti::step_stats::{self, Step};
     use hinfix::lti::{
-        closed_loop_hinf_grad_near, closed_loop_hinf_grad_unless, resolve_plant, Controller, Interrupt, Plant,
+        closed_loop_hinf_grad_near, closed_loop_hinf_grad_sharing, resolve_plant, Controller, Interrupt, Plant,
         ResponseSlot, DEFAULT_HINF_TOL,
     };
     let plant = resolve_plant("CM4").and_then(Plant::load).unwrap();
@@ -121,7 +129,7 @@ fn norm_stopping_at_a_level_is_exact_or_a_bound() {
     assert!(norm.value.is_finite(), "the test loop must be stable");
     let unless = |enough: f64| {
         let mut slot = ResponseSlot::default();
-        closed_loop_hinf_grad_unless(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot, enough).unwrap()
+        closed_loop_hinf_grad_sharing(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot, enough).unwrap()
     };
     let above = unless(norm.value * (1.0 + 1e-9));
     assert_eq!(above.0.value.to_bits(), norm.value.to_bits());

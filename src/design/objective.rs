@@ -36,7 +36,7 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_unless, controller_abscissa_grad,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
     controller_hinf_grad, hinf_lower_bound_sharing, spectral_abscissa, Controller, ControllerGradient, Interrupt,
     LtiError, Plant, ResponseSlot,
 };
@@ -145,7 +145,7 @@ pub struct DesignObjective<'p> {
     /// Whether the last evaluation was abandoned because `stop` fired.
     abandoned: Cell<bool>,
     /// While [`Objective::eval_below`] evaluates a trial point that passed the screen: its
-    /// threshold, at which the closed-loop norm stops early (`lti::closed_loop_hinf_grad_unless`);
+    /// threshold, at which the closed-loop norm stops early (`lti::closed_loop_hinf_grad_sharing`);
     /// +∞ otherwise.
     reject_at: Cell<f64>,
     /// Told the CPU seconds of every complete closed-loop evaluation where `stop` applies (large
@@ -296,7 +296,7 @@ impl<'p> DesignObjective<'p> {
         let slot = &mut self.screened.borrow_mut();
         let reject_at = self.reject_at.get();
         let (gamma, g_cl) =
-            match closed_loop_hinf_grad_unless(self.plant, k, self.hinf_tol, &hint, stop, slot, reject_at) {
+            match closed_loop_hinf_grad_sharing(self.plant, k, self.hinf_tol, &hint, stop, slot, reject_at) {
                 Ok((norm, _)) if norm.value >= reject_at => {
                     // A lower bound that fails the line search's test: no gradient, no new peak.
                     c.gamma = norm.value;
@@ -341,7 +341,7 @@ impl<'p> DesignObjective<'p> {
 
 impl DesignObjective<'_> {
     /// [`Objective::eval`], with the closed-loop norm stopping once it reaches `reject_at`
-    /// (`lti::closed_loop_hinf_grad_unless`): a value f ≥ `reject_at` may then be a lower bound,
+    /// (`lti::closed_loop_hinf_grad_sharing`): a value f ≥ `reject_at` may then be a lower bound,
     /// comes with a NaN gradient and is not cached (the line search only needs to know that f
     /// fails its test there).
     fn eval_unless(&mut self, x: &[f64], g: &mut [f64], reject_at: f64) -> f64 {

@@ -103,30 +103,17 @@ pub fn closed_loop_hinf_grad_near_interruptible(
     hints: &[f64],
     stop: Interrupt<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_sharing(plant, k, tol, hints, stop, &mut ResponseSlot::default())
+    closed_loop_hinf_grad_sharing(plant, k, tol, hints, stop, &mut ResponseSlot::default(), f64::INFINITY)
 }
 
 /// [`closed_loop_hinf_grad_near_interruptible`] taking the closed loop's frequency-response
 /// evaluator from `slot` if it holds that of this very closed loop (left there by
 /// [`hinf_lower_bound_sharing`](super::hinf_lower_bound_sharing); the same result, one Hessenberg
-/// reduction fewer).
-pub fn closed_loop_hinf_grad_sharing(
-    plant: &Plant,
-    k: &Controller,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
-    slot: &mut ResponseSlot,
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_unless(plant, k, tol, hints, stop, slot, f64::INFINITY)
-}
-
-/// [`closed_loop_hinf_grad_sharing`] that stops as soon as ‖Tzw‖∞ is known to reach `enough`:
-/// a value at or above `enough` is then an attained σmax(Tzw(iω)) (a lower bound of the norm),
+/// reduction fewer), and stopping as soon as ‖Tzw‖∞ is known to reach `enough` (+∞: never): a
+/// value at or above `enough` is then an attained σmax(Tzw(iω)) (a lower bound of the norm),
 /// returned with a NaN gradient, as for an unstable loop. For the line search's exact rejection of
-/// trial points (`design::objective`); below `enough` the result is that of
-/// [`closed_loop_hinf_grad_sharing`].
-pub fn closed_loop_hinf_grad_unless(
+/// trial points (`design::objective`); below `enough` the result does not depend on it.
+pub fn closed_loop_hinf_grad_sharing(
     plant: &Plant,
     k: &Controller,
     tol: f64,

@@ -47,8 +47,8 @@ pub use full_order::{
 };
 pub use gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, closed_loop_hinf_grad_near,
-    closed_loop_hinf_grad_near_interruptible, closed_loop_hinf_grad_sharing, closed_loop_hinf_grad_unless,
-    controller_abscissa_grad, controller_hinf_grad, ControllerGradient,
+    closed_loop_hinf_grad_near_interruptible, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
+    controller_hinf_grad, ControllerGradient,
 };
 pub(crate) use hinf::hinf_norm_with_poles_interruptible;
 pub use hinf::{
