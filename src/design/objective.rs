@@ -422,7 +422,9 @@ impl Objective for DesignObjective<'_> {
     /// In the performance phase, a trial point whose cheap lower bound
     /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and up the last peak, ε‖K‖∞) already
     /// reaches `threshold` is rejected
-    /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13).
+    /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13); one that
+    /// passes is evaluated by `eval_unless`, whose norm still stops once it reaches
+    /// `threshold`.
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
         if self.phase == ObjectivePhase::Performance && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION {
             let lb = self.performance_lower_bound(&self.controller(x), threshold);
