@@ -343,14 +343,14 @@ fn hinf_norm_from(
     // the imaginary-axis test can miss (AC4 in `tests/hinf_regression.rs`: 6.6e-4 low).
     mode_frequencies(poles, fr, &mut best, &mut scan, stop)?;
     if best.gamma >= enough {
-        return Ok(HinfNorm { value: best.gamma, peak_freq: best.freq });
+        return Ok(best.norm());
     }
     stop.poll()?;
     let tested: Vec<f64> = std::iter::once(0.0).chain(scan.iter().map(|&(w, _)| w)).collect();
     let peaks = refined_peaks(sys.order());
     refine_best_peaks(fr, &mut best, &tested, &scan, peaks);
     if !best.gamma.is_finite() || best.gamma >= enough {
-        return Ok(HinfNorm { value: best.gamma, peak_freq: best.freq });
+        return Ok(best.norm());
     }
 
     let ham = Hamiltonian::new(sys, sigma_d, poles);
@@ -365,6 +365,9 @@ fn hinf_norm_from(
             break;
         }
         let before = best.gamma;
+        // γ_L rose by more than rounding (AB13DD's safeguard: otherwise the crossings or probes
+        // were spurious).
+        let raised = |best: &Best| best.gamma >= before * (1.0 + 0.1 * tol);
         let mut mids: Vec<f64> = Vec::with_capacity(ws.len() + 2);
         // σ(∞) = σmax(D) < γ, so an odd count means a crossing was lost, and it may lie in any
         // interval: also look in [0, w₁] (NN5 in `tests/hinf_regression.rs`: the crossing just
@@ -408,8 +411,8 @@ fn hinf_norm_from(
         }
         if ws.is_empty() {
             count(Step::Probe);
-            if !(best.gamma >= before * (1.0 + 0.1 * tol)) {
-                break; // the probes were off any peak above γ_L (as the progress test below)
+            if !raised(&best) {
+                break; // the probes were off any peak above γ_L
             }
             count(Step::ProbeFound);
         } else {
@@ -420,11 +423,11 @@ fn hinf_norm_from(
         all.sort_by(f64::total_cmp);
         stop.poll()?;
         refine_best_peaks(fr, &mut best, &all, &scan, peaks);
-        if !(best.gamma >= before * (1.0 + 0.1 * tol)) || best.gamma >= enough {
+        if !raised(&best) || best.gamma >= enough {
             break; // no progress: the crossings were spurious (or the level is reached)
         }
     }
-    Ok(HinfNorm { value: best.gamma, peak_freq: best.freq })
+    Ok(best.norm())
 }
 
 /// Ratio of consecutive frequencies of [`high_frequency_ladder`].
@@ -520,6 +523,11 @@ impl Best {
             self.gamma = if s.is_nan() { f64::INFINITY } else { s };
             self.freq = w;
         }
+    }
+
+    /// The best point as the norm's value and peak frequency.
+    fn norm(&self) -> HinfNorm {
+        HinfNorm { value: self.gamma, peak_freq: self.freq }
     }
 }
 
@@ -774,8 +782,9 @@ impl<'s> Hamiltonian<'s> {
     }
 
     /// The sorted nonnegative frequencies ω with iω an (numerically) imaginary eigenvalue of H(γ),
-    /// and on the explicit path the probes ([`LevelSet`]); `None` if the eigensolver failed. `peak_freq`: where σmax(G(iω)) attains γ_L, the local
-    /// peak just below γ ([`squared_crossings`]).
+    /// and on the explicit path the probes ([`LevelSet`]); `None` if the eigensolver failed.
+    /// `peak_freq`: where σmax(G(iω)) attains γ_L, the local peak just below γ
+    /// ([`squared_crossings`]).
     fn crossings(&self, gamma: f64, peak_freq: f64) -> Option<LevelSet> {
         let kappa = gamma * gamma / ((gamma - self.sigma_d) * (gamma + self.sigma_d));
         // Below order HESSENBERG_QR_FROM always the pencil (unsquared, so crossings close to
