@@ -106,7 +106,8 @@ pub struct DesignArgs {
     #[arg(long)]
     pub no_open_loop_start: bool,
     /// Coordinates of the local searches: "off" (the controller's parameters), "alternate"
-    /// (HIFOO's first starts unscaled; then three hop cycles in four in the coordinates that
+    /// (HIFOO's first starts and the open-loop start unscaled, each central start unscaled and
+    /// then scaled; then three hop cycles in four in the coordinates that
     /// found the best controller so far and one in the others: the parameters, or variables
     /// scaled by the plant's control and measurement channel sizes) or "always" (scaled only; a
     /// bare --variable-scaling). No change for a plant whose

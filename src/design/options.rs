@@ -239,7 +239,8 @@ pub struct DesignOptions {
     #[serde(default, skip_serializing_if = "is_false")]
     pub open_loop_start: bool,
     /// Coordinates of the local searches ([`VariableScaling`]): `Off`, x only; `Alternate` (the
-    /// default), HIFOO's first starts in x, then the continued search's hop cycles in the
+    /// default), HIFOO's first starts and the open-loop start in x, each central start in x and
+    /// then in x̃ (on a scaled plant), then the continued search's hop cycles in the
     /// coordinates that found the incumbent, except one in four (the first included) in the
     /// others — x or the plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`: the control
     /// and measurement channels scaled to comparable sizes, powers of two); `Always`, x̃ only. A
