@@ -378,6 +378,20 @@ fn ac10_order1_is_stabilised_from_a_cold_start() {
     assert!(o.gamma.is_finite() && o.gamma < 30.0, "γ = {}", o.gamma);
 }
 
+/// AC10 n_K = 1 at ε = 1e-3, seed 1, one random start (HIFOO's `nrand`), ended by `maxevals`
+/// evaluations (deterministic) and otherwise with the default search.
+fn ac10_order1_one_random_start(maxevals: usize) -> DesignOptions {
+    DesignOptions {
+        order: 1,
+        eps: 1e-3,
+        seed: 1,
+        cpumax: 1e6,
+        maxevals: Some(maxevals),
+        nrand: 1,
+        ..Default::default()
+    }
+}
+
 /// Plant-scaled variables (`variable_scaling`, docs/ALGORITHMS.md §8.6: AC10's two measurements
 /// are 10⁵ apart) within one deterministic budget of 1500 evaluations (one random start and the
 /// open-loop start first, then the continued search): the unscaled search (`Off`) stays at
@@ -390,16 +404,7 @@ fn ac10_order1_is_stabilised_from_a_cold_start() {
 #[test]
 fn ac10_order1_default_search_with_scaled_cycles_gets_far_below_the_unscaled_one() {
     let p = plant("AC10");
-    let base = DesignOptions {
-        order: 1,
-        eps: 1e-3,
-        seed: 1,
-        cpumax: 1e6,
-        maxevals: Some(1500),
-        nrand: 1,
-        central_gammas: Vec::new(),
-        ..Default::default()
-    };
+    let base = DesignOptions { central_gammas: Vec::new(), ..ac10_order1_one_random_start(1500) };
     assert_eq!(base.variable_scaling, VariableScaling::Alternate, "the default");
     let gamma = |mode| {
         let o =
@@ -477,17 +482,8 @@ fn bounded_run_spends_its_budget_and_the_stall_rule_ends_unbounded_runs() {
 #[test]
 fn ac10_central_start_in_scaled_variables_beats_the_paper() {
     let p = plant("AC10");
-    let opts = DesignOptions {
-        order: 1,
-        eps: 1e-3,
-        seed: 1,
-        cpumax: 1e6,
-        maxevals: Some(5000),
-        nrand: 1,
-        open_loop_start: false,
-        central_gammas: vec![2.0],
-        ..Default::default()
-    };
+    let opts =
+        DesignOptions { open_loop_start: false, central_gammas: vec![2.0], ..ac10_order1_one_random_start(5000) };
     let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
     check_recomputed(&p, &o);
     let s = &o.search;

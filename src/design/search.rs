@@ -683,9 +683,9 @@ impl Search<'_, '_, '_> {
             full_ctl.maxevals().map_or(usize::MAX, |m| m - search_ctl.maxevals().unwrap_or(m)),
         );
         let mut rounds = GsRounds { first: first_reserve, ..Default::default() };
+        let plan = self.first_plan(opts.variable_scaling, first_kinds, first.len());
         // HIFOO's own first starts (random or init): the extra open-loop and central starts are
         // like the continued search, a budget may end the run before them without truncating it.
-        let plan = self.first_plan(opts.variable_scaling, first_kinds, first.len());
         let hifoo_starts = first_kinds
             .iter()
             .take(first.len())
