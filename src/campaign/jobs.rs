@@ -124,20 +124,34 @@ pub fn job_id(plant_fingerprint: &str, options: &DesignOptions, warm_from: Optio
     JobId(digest.iter().map(|b| format!("{b:02x}")).collect())
 }
 
-/// Expands a campaign into its jobs (see the module docs for the order).
+/// Expands a campaign into its jobs (see the module docs for the order and the chains).
 pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
     let mut jobs = Vec::new();
     for (pi, p) in c.problems.iter().enumerate() {
-        // predecessor of each (ε, seed) chain, by position in p.eps × p.seeds
-        let mut prev: Vec<Option<JobId>> = vec![None; p.eps.len() * p.seeds.len()];
+        let ns = p.seeds.len();
+        // the job of the previous order at each (ε, seed), by position in p.eps × p.seeds
+        let mut prev_order: Vec<Option<JobId>> = vec![None; p.eps.len() * ns];
         for &order in &p.orders {
+            // the jobs of this order so far, by the same position
+            let mut this_order: Vec<Option<JobId>> = vec![None; p.eps.len() * ns];
             for (ei, &eps) in p.eps.iter().enumerate() {
                 for (si, &seed) in p.seeds.iter().enumerate() {
-                    let options = DesignOptions { order, eps, seed, ..p.base.clone() };
-                    let chain = ei * p.seeds.len() + si;
-                    let warm_from = if p.warm_start { prev[chain].clone() } else { None };
+                    let chain = ei * ns + si;
+                    let continued = p.eps_continuation && ei > 0;
+                    let warm_from = if continued {
+                        this_order[chain - ns].clone()
+                    } else if p.warm_start {
+                        // with ε-continuation only the first ε of an order chains orders
+                        prev_order[if p.eps_continuation { si } else { chain }].clone()
+                    } else {
+                        None
+                    };
+                    let mut options = DesignOptions { order, eps, seed, ..p.base.clone() };
+                    if continued {
+                        continuation_options(&mut options, p.continued_cpumax);
+                    }
                     let id = job_id(&p.fingerprint, &options, warm_from.as_ref(), runner);
-                    prev[chain] = Some(id.clone());
+                    this_order[chain] = Some(id.clone());
                     jobs.push(Job {
                         id,
                         index: jobs.len(),
@@ -151,9 +165,22 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
                     });
                 }
             }
+            prev_order = this_order;
         }
     }
     jobs
+}
+
+/// The options of an ε-continued job: its CPU budget `continued_cpumax` (if given), and as first
+/// starts only its predecessor's controller and HIFOO's `nrand` perturbations of it — no
+/// open-loop and central-controller starts, which do not depend on ε and were made by the head
+/// of the chain.
+fn continuation_options(options: &mut DesignOptions, continued_cpumax: Option<f64>) {
+    options.open_loop_start = false;
+    options.central_gammas.clear();
+    if let Some(c) = continued_cpumax {
+        options.cpumax = c;
+    }
 }
 
 #[cfg(test)]
@@ -212,6 +239,44 @@ orders = [1]
                 other => panic!("unexpected chain {other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn eps_continuation_chains_eps_within_order_and_seed() {
+        let text = TEXT.replace(
+            "eps = [1e-2, 1e-3]",
+            "eps = [1e-2, 1e-3, 1e-4]\neps_continuation = true\ncpumax = 300.0\ncontinued_cpumax = 30.0",
+        );
+        let jobs = expand(&campaign(&text), RunnerTag::Design);
+        let by_id = |id: &JobId| jobs.iter().find(|k| &k.id == id).unwrap();
+        let key = |j: &Job| (j.problem, j.options.order, j.options.eps, j.options.seed);
+        for j in &jobs {
+            let first_eps = j.options.eps == 1e-2;
+            match (&j.warm_from, first_eps, j.problem, j.options.order) {
+                // heads: no predecessor, or (HE1 warm-started) the first ε of the order below
+                (None, true, 1, _) | (None, true, 0, 1) => {}
+                (Some(prev), true, 0, 2) => assert_eq!(key(by_id(prev)), (0, 1, 1e-2, j.options.seed)),
+                // continued: the previous ε of the same order and seed, before it in the expansion
+                (Some(prev), false, _, _) => {
+                    let p = by_id(prev);
+                    assert!(p.index < j.index);
+                    assert_eq!(
+                        (p.problem, p.options.order, p.options.seed),
+                        (j.problem, j.options.order, j.options.seed)
+                    );
+                    assert_eq!(p.options.eps, if j.options.eps == 1e-3 { 1e-2 } else { 1e-3 });
+                }
+                other => panic!("unexpected chain {other:?} for {}", j.label()),
+            }
+            // a continued job's first starts are its predecessor's controller and perturbations
+            // of it; the head made the open-loop and central starts
+            assert_eq!(j.options.open_loop_start, first_eps, "{}", j.label());
+            assert_eq!(j.options.central_gammas.is_empty(), !first_eps, "{}", j.label());
+            assert_eq!(j.options.cpumax, if first_eps { 300.0 } else { 30.0 }, "{}", j.label());
+        }
+        // without the key, the same file keeps today's jobs
+        let plain = expand(&campaign(&text.replace("eps_continuation = true", "")), RunnerTag::Design);
+        assert!(plain.iter().filter(|j| j.problem == 1).all(|j| j.warm_from.is_none()));
     }
 
     #[test]

@@ -73,6 +73,11 @@ pub struct Problem {
     /// Chain orders: order k of a (plant, ε, seed) chain starts from the controller of the next
     /// lower order of the same chain.
     pub warm_start: bool,
+    /// Continuation in ε: the job at the i-th ε of an (order, seed) starts from the controller of
+    /// the (i−1)-th ε of the same order and seed (module docs of `campaign::jobs`).
+    pub eps_continuation: bool,
+    /// CPU budget of an ε-continued job (None: `base.cpumax`, as every other job).
+    pub continued_cpumax: Option<f64>,
     /// Options common to all this problem's jobs (`order`, `eps`, `seed` are set per job).
     pub base: DesignOptions,
     /// Where the problem's `plant` key is (for messages about the problem).

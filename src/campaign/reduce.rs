@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::record::JobRecord;
-use crate::lti::{closed_loop, hinf_norm, is_stable, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
+use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
 /// them.
@@ -50,6 +50,8 @@ pub enum Verdict {
         alpha_cl: f64,
         /// α(Ak) (None for order 0).
         alpha_k: Option<f64>,
+        /// Recomputed ‖K‖∞.
+        k_hinf: f64,
     },
     /// Not counted, with the reason.
     Rejected(String),
@@ -79,8 +81,13 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
     if !gamma.is_finite() {
         return Verdict::Rejected(format!("γ not finite ({gamma})"));
     }
-    Verdict::Verified { gamma, alpha_cl, alpha_k }
+    let k_hinf = controller_hinf_grad(k, DEFAULT_HINF_TOL).0.value;
+    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf }
 }
+
+/// Relative distance to the best γ within which a replicate counts as reaching it
+/// ([`BestRow::near_best`]).
+pub const NEAR_BEST_RTOL: f64 = 1e-3;
 
 /// Best result of one (plant, order).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -101,10 +108,24 @@ pub struct BestRow {
     pub eps: Option<f64>,
     /// Its seed.
     pub seed: Option<u64>,
+    /// ‖K‖∞ of that controller (recomputed).
+    #[serde(default, with = "crate::design::serde_opt_f64_or_string")]
+    pub k_hinf: Option<f64>,
+    /// α(A_K) of that controller (recomputed; none for n_K = 0).
+    #[serde(default, with = "crate::design::serde_opt_f64_or_string")]
+    pub alpha_k: Option<f64>,
+    /// CPU seconds that job took to first reach its final objective (the journal's
+    /// `search.cpu_to_best_s`; a continued or warm-started job counts from its own start).
+    #[serde(default, with = "crate::design::serde_opt_f64_or_string")]
+    pub cpu_to_best_s: Option<f64>,
     /// Journaled jobs of this (plant, order) (a job journaled twice counts once).
     pub runs: usize,
     /// Jobs whose controller re-verified stable and stabilising.
     pub verified: usize,
+    /// Verified jobs whose γ is within a relative [`NEAR_BEST_RTOL`] (0.1 %) of the best, the
+    /// best job included: how many replicates (ε × seeds) reached the reported value.
+    #[serde(default)]
+    pub near_best: usize,
     /// Jobs that failed (status `failed`: no trustworthy result), the same count as `campaign
     /// status` and the run's exit code use.
     pub failed: usize,
@@ -121,59 +142,81 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
         let name = plants.get(&r.plant_fingerprint).map_or(r.plant.as_str(), |p| p.name.as_str());
         (r.plant_fingerprint.as_str(), name)
     }));
-    // job id → (record, verified γ) of its best record
-    let mut per_job: BTreeMap<&str, (&JobRecord, Option<f64>)> = BTreeMap::new();
+    // job id → (record, verified figures) of its best record
+    let mut per_job: BTreeMap<&str, (&JobRecord, Option<Verdict>)> = BTreeMap::new();
     for r in records {
-        let gamma = match plants.get(&r.plant_fingerprint).map(|p| verify(r, p)) {
-            Some(Verdict::Verified { gamma, .. }) => Some(gamma),
-            _ => None,
-        };
-        let better = |old: Option<f64>| match (gamma, old) {
-            (Some(g), Some(o)) => g < o,
+        let verdict = plants.get(&r.plant_fingerprint).map(|p| verify(r, p)).filter(|v| v.gamma().is_some());
+        let better = |old: &Option<Verdict>| match (verdict.as_ref().and_then(Verdict::gamma), old) {
+            (Some(g), Some(o)) => o.gamma().is_some_and(|o| g < o),
             (Some(_), None) => true,
             (None, _) => false,
         };
-        per_job
-            .entry(r.job_id.0.as_str())
-            .and_modify(|e| {
-                if better(e.1) {
-                    *e = (r, gamma);
-                }
-            })
-            .or_insert((r, gamma));
+        match per_job.get_mut(r.job_id.0.as_str()) {
+            Some(e) if better(&e.1) => *e = (r, verdict),
+            Some(_) => {}
+            None => {
+                per_job.insert(r.job_id.0.as_str(), (r, verdict));
+            }
+        }
     }
-    let mut rows: BTreeMap<(String, usize), BestRow> = BTreeMap::new();
-    for (r, gamma) in per_job.into_values() {
+    let mut rows: BTreeMap<(String, usize), (BestRow, Vec<f64>)> = BTreeMap::new();
+    for (r, verdict) in per_job.into_values() {
         let label = labels[&r.plant_fingerprint].clone();
-        let row = rows.entry((label.clone(), r.order)).or_insert_with(|| BestRow {
-            plant: label,
-            plant_fingerprint: r.plant_fingerprint.clone(),
-            order: r.order,
-            gamma: f64::NAN,
-            job_id: None,
-            eps: None,
-            seed: None,
-            runs: 0,
-            verified: 0,
-            failed: 0,
-            unverified: 0,
+        let (row, gammas) = rows.entry((label.clone(), r.order)).or_insert_with(|| {
+            let row = BestRow {
+                plant: label,
+                plant_fingerprint: r.plant_fingerprint.clone(),
+                order: r.order,
+                gamma: f64::NAN,
+                job_id: None,
+                eps: None,
+                seed: None,
+                k_hinf: None,
+                alpha_k: None,
+                cpu_to_best_s: None,
+                runs: 0,
+                verified: 0,
+                near_best: 0,
+                failed: 0,
+                unverified: 0,
+            };
+            (row, Vec::new())
         });
         row.runs += 1;
-        match gamma {
-            Some(gamma) => {
+        match verdict {
+            Some(Verdict::Verified { gamma, alpha_k, k_hinf, .. }) => {
                 row.verified += 1;
+                gammas.push(gamma);
                 if !(gamma >= row.gamma) {
                     row.gamma = gamma;
                     row.job_id = Some(r.job_id.0.clone());
                     row.eps = Some(r.eps);
                     row.seed = Some(r.seed);
+                    row.k_hinf = Some(k_hinf);
+                    row.alpha_k = alpha_k;
+                    row.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
                 }
             }
-            None if r.failed() => row.failed += 1,
-            None => row.unverified += 1,
+            _ if r.failed() => row.failed += 1,
+            _ => row.unverified += 1,
         }
     }
-    rows.into_values().collect()
+    rows.into_values()
+        .map(|(mut row, gammas)| {
+            row.near_best = gammas.iter().filter(|&&g| g <= row.gamma * (1.0 + NEAR_BEST_RTOL)).count();
+            row
+        })
+        .collect()
+}
+
+impl Verdict {
+    /// The recomputed γ of a verified record.
+    pub fn gamma(&self) -> Option<f64> {
+        match self {
+            Verdict::Verified { gamma, .. } => Some(*gamma),
+            Verdict::Rejected(_) => None,
+        }
+    }
 }
 
 #[cfg(test)]

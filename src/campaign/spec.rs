@@ -91,6 +91,8 @@ macro_rules! with_design_settings {
             continued_maxit: Option<Spanned<usize>>,
             return_gs_reserve: Option<bool>,
             refine_rtol: Option<Spanned<f64>>,
+            eps_continuation: Option<bool>,
+            continued_cpumax: Option<Spanned<f64>>,
             $($tail)*
         }
     };
@@ -367,6 +369,8 @@ fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Sourc
         eps,
         seeds,
         warm_start: p.warm_start,
+        eps_continuation: settings.eps_continuation.unwrap_or(false),
+        continued_cpumax: settings.continued_cpumax.as_ref().map(|(x, _)| *x),
         base,
         location: Location::of_offset(src.text, p.plant.span().start),
     })
@@ -408,6 +412,8 @@ struct Layered {
     continued_maxit: Setting<usize>,
     return_gs_reserve: Option<bool>,
     refine_rtol: Setting<f64>,
+    eps_continuation: Option<bool>,
+    continued_cpumax: Setting<f64>,
 }
 
 impl Layered {
@@ -437,6 +443,8 @@ impl Layered {
             continued_maxit: layer(&p.continued_maxit, &d.continued_maxit),
             return_gs_reserve: p.return_gs_reserve.or(d.return_gs_reserve),
             refine_rtol: layer(&p.refine_rtol, &d.refine_rtol),
+            eps_continuation: p.eps_continuation.or(d.eps_continuation),
+            continued_cpumax: layer(&p.continued_cpumax, &d.continued_cpumax),
         }
     }
 
@@ -588,15 +596,22 @@ fn check_options(
     src: &Source,
 ) -> Result<(), SpecError> {
     let max_order = *orders.last().expect("orders is not empty");
-    for &e in eps {
-        let opts = DesignOptions { order: max_order, eps: e, ..base.clone() };
-        if let Err(err) = crate::design::validate(plant, &opts, None) {
-            let span = match &err {
-                crate::design::DesignError::Options { field: "order", .. } => Some(p.orders.span()),
-                crate::design::DesignError::Options { field, .. } => settings.span_of(field),
-                _ => None,
-            };
-            return Err(src.error(span.unwrap_or(p.plant.span()), err.to_string()));
+    // every job's cpumax: the problem's, and that of its ε-continued jobs (with its own span)
+    let continued = settings.continued_cpumax.as_ref().map(|(c, span)| (*c, Some(span.clone())));
+    for (cpumax, cpumax_span) in std::iter::once((base.cpumax, None)).chain(continued) {
+        for &e in eps {
+            let opts = DesignOptions { order: max_order, eps: e, cpumax, ..base.clone() };
+            if let Err(err) = crate::design::validate(plant, &opts, None) {
+                let span = match &err {
+                    crate::design::DesignError::Options { field: "order", .. } => Some(p.orders.span()),
+                    crate::design::DesignError::Options { field: "cpumax", .. } if cpumax_span.is_some() => {
+                        cpumax_span.clone()
+                    }
+                    crate::design::DesignError::Options { field, .. } => settings.span_of(field),
+                    _ => None,
+                };
+                return Err(src.error(span.unwrap_or(p.plant.span()), err.to_string()));
+            }
         }
     }
     Ok(())
@@ -781,6 +796,23 @@ objective = "plain"
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nspend_budget = 1\n");
         assert_eq!(e.location.line, 5, "{e}");
         assert!(e.message.contains("bool"), "{e}");
+    }
+
+    #[test]
+    fn eps_continuation_keys_layer_and_a_bad_continued_cpumax_is_located() {
+        let c = parse(
+            "name = \"t\"\n[defaults]\neps_continuation = true\ncontinued_cpumax = 30.0\n[[problem]]\nplant = \"HE1\"\n\
+             orders = [1]\n[[problem]]\nplant = \"REA2\"\norders = [1]\neps_continuation = false\n",
+        )
+        .unwrap();
+        let got: Vec<(bool, Option<f64>)> =
+            c.problems.iter().map(|p| (p.eps_continuation, p.continued_cpumax)).collect();
+        assert_eq!(got, [(true, Some(30.0)), (false, Some(30.0))]);
+        let d = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+        assert_eq!((d.problems[0].eps_continuation, d.problems[0].continued_cpumax), (false, None));
+        let e = err("name = \"t\"\n[defaults]\ncpumax = 5.0\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_cpumax = -1.0\n");
+        assert_eq!(e.location.line, 7, "{e}");
+        assert!(e.message.contains("cpumax"), "{e}");
     }
 
     #[test]
