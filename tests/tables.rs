@@ -23,6 +23,7 @@ fn row(plant: &str, order: usize, gamma: f64) -> BestRow {
         k_hinf: Some(10.0),
         alpha_k: Some(-1.0),
         cpu_to_best_s: Some(0.5),
+        chain_cpu_to_best_s: Some(0.5),
         runs: 2,
         verified: 1,
         near_best: 1,

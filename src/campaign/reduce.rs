@@ -118,6 +118,11 @@ pub struct BestRow {
     /// `search.cpu_to_best_s`; a continued or warm-started job counts from its own start).
     #[serde(default, with = "crate::design::serde_opt_f64_or_string")]
     pub cpu_to_best_s: Option<f64>,
+    /// The same, plus the whole CPU seconds of the jobs it was started from (its `warm_from`
+    /// predecessors, transitively: the ε-continuation and warm-start chain up to it); None if
+    /// one of them is not in the journals.
+    #[serde(default, with = "crate::design::serde_opt_f64_or_string")]
+    pub chain_cpu_to_best_s: Option<f64>,
     /// Journaled jobs of this (plant, order) (a job journaled twice counts once).
     pub runs: usize,
     /// Jobs whose controller re-verified stable and stabilising.
@@ -159,8 +164,21 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
             }
         }
     }
+    // CPU seconds of the chain before a job: its predecessors' whole jobs
+    let cpu_of: BTreeMap<&str, (f64, Option<&str>)> =
+        per_job.iter().map(|(id, (r, _))| (*id, (r.cpu_s, r.warm_from.as_ref().map(|p| p.0.as_str())))).collect();
+    let chain_cpu_before = |r: &JobRecord| {
+        let mut total = 0.0;
+        let mut next = r.warm_from.as_ref().map(|p| p.0.as_str());
+        while let Some(id) = next {
+            let (cpu, prev) = cpu_of.get(id)?;
+            total += cpu;
+            next = *prev;
+        }
+        Some(total)
+    };
     let mut rows: BTreeMap<(String, usize), (BestRow, Vec<f64>)> = BTreeMap::new();
-    for (r, verdict) in per_job.into_values() {
+    for (r, verdict) in per_job.values().map(|(r, v)| (*r, v.clone())) {
         let label = labels[&r.plant_fingerprint].clone();
         let (row, gammas) = rows.entry((label.clone(), r.order)).or_insert_with(|| {
             let row = BestRow {
@@ -174,6 +192,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
                 k_hinf: None,
                 alpha_k: None,
                 cpu_to_best_s: None,
+                chain_cpu_to_best_s: None,
                 runs: 0,
                 verified: 0,
                 near_best: 0,
@@ -195,6 +214,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
                     row.k_hinf = Some(k_hinf);
                     row.alpha_k = alpha_k;
                     row.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
+                    row.chain_cpu_to_best_s = row.cpu_to_best_s.zip(chain_cpu_before(r)).map(|(t, before)| t + before);
                 }
             }
             _ if r.failed() => row.failed += 1,
@@ -286,6 +306,39 @@ mod tests {
         let other = plant("NEW", 3.0);
         let rows = best_per_order(&[record(&other, "NEW", 0)], &map(&[&p]));
         assert_eq!((rows[0].verified, rows[0].failed, rows[0].unverified), (0, 0, 1));
+    }
+
+    /// `record` with the static gain `d` (γ = c/(1 − d)), `cpu_s` and a predecessor.
+    fn gain_record(p: &Plant, seed: u64, d: f64, cpu_s: f64, warm_from: Option<&JobRecord>) -> JobRecord {
+        let mut r = record(p, "P", seed);
+        let JobResult::Designed(o) = &mut r.result else { unreachable!("a designed record") };
+        o.controller.dk[(0, 0)] = d;
+        o.search.cpu_to_best_s = 0.25;
+        r.cpu_s = cpu_s;
+        r.warm_from = warm_from.map(|w| w.job_id.clone());
+        r.job_id = job_id(&p.fingerprint(), &r.options, r.warm_from.as_ref(), RunnerTag::Design);
+        r
+    }
+
+    #[test]
+    fn best_row_reports_the_best_controller_its_chain_cpu_and_the_replicates_near_it() {
+        let p = plant("P", 1.0);
+        // γ = 1/(1 − d): 2.0 (head), 1.0005/… and 1.01 (continued from the head), 1.0 (seed 3)
+        let head = gain_record(&p, 0, 0.5, 10.0, None);
+        let near = gain_record(&p, 1, 1.0 - 1.0 / 1.0005, 4.0, Some(&head));
+        let far = gain_record(&p, 2, 1.0 - 1.0 / 1.01, 3.0, Some(&head));
+        let best = gain_record(&p, 3, 0.0, 7.0, Some(&near));
+        let rows = best_per_order(&[head, near, far, best.clone()], &map(&[&p]));
+        let r = &rows[0];
+        assert!((r.gamma - 1.0).abs() < 1e-9, "{r:?}");
+        assert_eq!(r.job_id.as_deref(), Some(best.job_id.0.as_str()));
+        assert_eq!((r.runs, r.verified, r.near_best), (4, 4, 2), "γ 1.0 and 1.0005 are within 0.1 %");
+        assert!((r.k_hinf.unwrap() - 0.0).abs() < 1e-12 && r.alpha_k.is_none(), "static gain 0: ‖K‖∞ 0, no α_K");
+        assert_eq!(r.cpu_to_best_s, Some(0.25));
+        assert_eq!(r.chain_cpu_to_best_s, Some(10.0 + 4.0 + 0.25), "head and continued job, then its own 0.25 s");
+        // a chain whose head is not in the journals has no chain figure
+        let rows = best_per_order(&[gain_record(&p, 3, 0.0, 7.0, Some(&best))], &map(&[&p]));
+        assert_eq!(rows[0].chain_cpu_to_best_s, None);
     }
 
     #[test]
