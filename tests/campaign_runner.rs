@@ -217,7 +217,8 @@ fn sparse_trace_is_small_and_still_summarises_and_plots() {
         t.phases.iter().map(|(n, p)| (n.clone(), p.first_f.to_bits(), p.last_f.to_bits())).collect()
     };
     assert_eq!(phases(&s), phases(&f));
-    let search = |t: &hinfix::campaign::TraceSummary| t.search.clone().map(|s| (s.starts, s.best_start, s.evals_to_best));
+    let search =
+        |t: &hinfix::campaign::TraceSummary| t.search.clone().map(|s| (s.starts, s.best_start, s.evals_to_best));
     assert_eq!((&s.final_status, s.final_gamma, search(&s)), (&f.final_status, f.final_gamma, search(&f)));
 
     // The best objective of every phase kind, and the first and last point of every local
