@@ -1,6 +1,7 @@
 //! End-to-end tests of `campaign run` through the real binary: resume after `kill -9` at random
 //! moments gives exactly the journal of an uninterrupted run; a torn journal line is reported,
-//! ignored and cut off; a small real-design campaign writes its journal, traces and reports.
+//! ignored and cut off; a small real-design campaign writes its journal, traces and reports;
+//! its sparse traces are a fraction of the full ones and still summarise and plot.
 //!
 //! The kill test uses the fake runner (examples/fake_campaign.rs, see `campaign::fake`) so that
 //! it takes seconds; its jobs carry their own ids, so fake records can never pass for real ones.
@@ -11,8 +12,8 @@ use std::process::{Command, Output};
 use std::time::Duration;
 
 use hinfix::campaign::read_journal;
-use hinfix::campaign::summarise;
 use hinfix::campaign::FAKE_RUNNER_ENV;
+use hinfix::campaign::{read_iterations, summarise, TraceIteration};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -124,7 +125,8 @@ fn torn_last_line_is_reported_ignored_and_cut_off() {
 fn real_design_campaign_writes_journal_traces_and_reports() {
     let dir = scratch("real");
     let file = dir.join("c.toml");
-    std::fs::write(&file, "name = \"t\"\n[defaults]\neps = [1e-2]\nseeds = 1\ncpumax = 5.0\nmaxevals = 3000\n[[problem]]\nplant = \"REA2\"\norders = [1]\n").unwrap();
+    // Every iteration in the trace (the file's key; the default is sparse).
+    std::fs::write(&file, "name = \"t\"\n[defaults]\neps = [1e-2]\nseeds = 1\ncpumax = 5.0\nmaxevals = 3000\ntrace = \"full\"\n[[problem]]\nplant = \"REA2\"\norders = [1]\n").unwrap();
     let results = dir.join("r");
     let out = run_to_end(&file, &results, false);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -165,6 +167,101 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("c.toml:3:"), "{stderr}");
+}
+
+/// The one trace of a results folder.
+fn only_trace(results: &Path) -> PathBuf {
+    let traces: Vec<_> =
+        std::fs::read_dir(results.join("t").join("traces")).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(traces.len(), 1, "{traces:?}");
+    traces[0].clone()
+}
+
+/// One real design (evaluation budget: the same iterations every time) traced at each level
+/// through `--trace`: the same journal and job id; the sparse trace is a small fraction of the
+/// full one and summarises to the same steps, phases, best ‖Tzw‖∞ and result; `campaign trace`
+/// and the convergence figure work on it; with `off` there is no trace and `campaign plot` skips
+/// the convergence figure without an error.
+#[test]
+fn sparse_trace_is_small_and_still_summarises_and_plots() {
+    let dir = scratch("levels");
+    let file = dir.join("c.toml");
+    std::fs::write(&file, "name = \"t\"\n[defaults]\neps = [1e-2]\nseeds = 1\ncpumax = 30.0\nmaxevals = 4000\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+    let run = |level: Option<&str>| {
+        let results = dir.join(level.unwrap_or("default"));
+        let mut c = command(&file, &results, false);
+        if let Some(l) = level {
+            c.arg("--trace").arg(l);
+        }
+        let out = c.output().unwrap();
+        assert!(out.status.success(), "{level:?}: {}", String::from_utf8_lossy(&out.stderr));
+        results
+    };
+    let (sparse, full, off) = (run(None), run(Some("full")), run(Some("off")));
+    assert_eq!(journal(&sparse), journal(&full));
+    assert_eq!(journal(&off), journal(&full));
+
+    let (ts, tf) = (only_trace(&sparse), only_trace(&full));
+    assert_eq!(ts.file_name(), tf.file_name(), "same job id");
+    let (bs, bf) = (std::fs::metadata(&ts).unwrap().len(), std::fs::metadata(&tf).unwrap().len());
+    assert!(bs * 5 < bf, "sparse {bs} B, full {bf} B");
+    let (s, f) = (summarise(&ts).unwrap(), summarise(&tf).unwrap());
+    assert!(s.messages * 5 < f.messages, "{} of {} messages", s.messages, f.messages);
+    assert_eq!((s.offered, f.offered), (f.messages, f.messages));
+    let designed = read_journal(&sparse.join("t").join("runs.jsonl")).unwrap().records[0].outcome().unwrap().clone();
+    assert_eq!((s.iterations, f.iterations), (designed.iterations, designed.iterations));
+    assert_eq!((s.first_f.to_bits(), s.last_f.to_bits()), (f.first_f.to_bits(), f.last_f.to_bits()));
+    assert_eq!(s.best_gamma.to_bits(), f.best_gamma.to_bits());
+    assert_eq!(s.evaluations, f.evaluations);
+    let phases = |t: &hinfix::campaign::TraceSummary| -> Vec<(String, u64, u64)> {
+        t.phases.iter().map(|(n, p)| (n.clone(), p.first_f.to_bits(), p.last_f.to_bits())).collect()
+    };
+    assert_eq!(phases(&s), phases(&f));
+    let search =
+        |t: &hinfix::campaign::TraceSummary| t.search.clone().map(|s| (s.starts, s.best_start, s.evals_to_best));
+    assert_eq!((&s.final_status, s.final_gamma, search(&s)), (&f.final_status, f.final_gamma, search(&f)));
+
+    // The best objective of every phase kind, and the first and last point of every local
+    // search, are in the sparse trace.
+    let (is, it) = (read_iterations(&ts).unwrap(), read_iterations(&tf).unwrap());
+    let best = |v: &[TraceIteration], stab: bool| {
+        v.iter().filter(|i| (i.phase == "stabilisation") == stab).map(|i| i.f).fold(f64::INFINITY, f64::min)
+    };
+    for stab in [true, false] {
+        assert_eq!(best(&is, stab).to_bits(), best(&it, stab).to_bits());
+    }
+    let ends = |v: &[TraceIteration]| -> Vec<(String, usize, usize)> {
+        let key = |i: &TraceIteration| (i.phase.clone(), i.start, i.iteration);
+        let mut e = Vec::new();
+        for w in v.windows(2) {
+            if w[0].phase != w[1].phase || w[0].start != w[1].start || w[1].iteration <= w[0].iteration {
+                e.extend([key(&w[0]), key(&w[1])]);
+            }
+        }
+        e
+    };
+    assert!(ends(&it).len() >= 4);
+    assert_eq!(ends(&is), ends(&it));
+
+    // `campaign trace` and `campaign plot` on the sparse trace; no trace at level off.
+    let out = Command::new(BIN).arg("trace").arg(&ts).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("kept (sparse)") && text.contains("final: "), "{text}");
+    let plot = |results: &Path| {
+        let mut c = Command::new(BIN);
+        c.arg("plot").arg(&file).arg("--results").arg(results);
+        c.env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"));
+        let out = c.output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        (results.join("t").join("plots"), String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let (plots, _) = plot(&sparse);
+    assert!(plots.join("convergence_HE1_nK1.svg").is_file() && plots.join("convergence_HE1_nK1.png").is_file());
+    assert!(!off.join("t").join("traces").exists());
+    let (plots, stderr) = plot(&off);
+    assert!(!plots.join("convergence_HE1_nK1.svg").exists());
+    assert!(plots.join("sigma_HE1_nK1.svg").is_file());
+    assert!(stderr.contains("skipped: convergence of HE1_nK1: no trace"), "{stderr}");
 }
 
 /// Under an evaluation budget (CPU budget not binding) a real-design campaign journals the same

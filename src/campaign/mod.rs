@@ -28,6 +28,7 @@ pub(crate) mod scheduler;
 pub(crate) mod shard;
 mod spec;
 pub(crate) mod trace;
+mod trace_filter;
 
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
 pub use jobs::{expand, job_id, Job, JobId, RunnerTag, JOB_ID_VERSION};
@@ -54,3 +55,4 @@ pub use trace::{
     iter_message, read_iterations, summarise, trace_observers, PhaseSummary, TraceError, TraceIteration, TraceSummary,
     TraceWriter, ITER_TOPIC, RESULT_TOPIC,
 };
+pub use trace_filter::{Keep, SparseFilter, TraceLevel, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO};

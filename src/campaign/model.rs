@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use super::trace_filter::TraceLevel;
 use crate::design::DesignOptions;
 use crate::lti::Plant;
 
@@ -80,6 +81,9 @@ pub struct Problem {
     pub continued_cpumax: Option<f64>,
     /// Options common to all this problem's jobs (`order`, `eps`, `seed` are set per job).
     pub base: DesignOptions,
+    /// How much of its jobs' iterations their traces keep (`trace`). Not a design option: it is
+    /// not in `base` and never enters a job id.
+    pub trace: TraceLevel,
     /// Where the problem's `plant` key is (for messages about the problem).
     pub location: Location,
 }
@@ -88,5 +92,12 @@ impl Campaign {
     /// Worker threads: the command line's, else the file's, else [`DEFAULT_THREADS`].
     pub fn threads(&self, cli: Option<usize>) -> usize {
         cli.or(self.threads).unwrap_or(DEFAULT_THREADS).max(1)
+    }
+
+    /// Trace level of each problem's jobs (indexed like [`Campaign::problems`]): the command
+    /// line's for all, else the problem's `trace` (itself the problem's key, else the one in
+    /// `[defaults]`, else [`TraceLevel::Sparse`]).
+    pub fn trace_levels(&self, cli: Option<TraceLevel>) -> Vec<TraceLevel> {
+        self.problems.iter().map(|p| cli.unwrap_or(p.trace)).collect()
     }
 }

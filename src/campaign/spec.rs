@@ -20,6 +20,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
+use super::trace_filter::TraceLevel;
 use crate::design::{DesignOptions, ObjectiveKind, VariableScaling};
 use crate::lti::Plant;
 
@@ -93,6 +94,8 @@ macro_rules! with_design_settings {
             refine_rtol: Option<Spanned<f64>>,
             eps_continuation: Option<bool>,
             continued_cpumax: Option<Spanned<f64>>,
+            // Not a design setting (no `DesignOptions` field, not in the job id); layered alike.
+            trace: Option<TraceLevel>,
             $($tail)*
         }
     };
@@ -372,6 +375,7 @@ fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Sourc
         eps_continuation: settings.eps_continuation.unwrap_or(false),
         continued_cpumax: settings.continued_cpumax.as_ref().map(|(x, _)| *x),
         base,
+        trace: p.trace.or(d.trace).unwrap_or_default(),
         location: Location::of_offset(src.text, p.plant.span().start),
     })
 }
@@ -837,6 +841,33 @@ objective = "plain"
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_maxit = 1000000000\n");
         assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
         assert!(e.message.contains("continued_maxit"), "{e}");
+    }
+
+    #[test]
+    fn trace_level_layers_stays_out_of_the_job_ids_and_a_bad_value_is_located() {
+        let text = |defaults: &str, problem: &str| {
+            format!(
+                "name = \"t\"\n[defaults]\n{defaults}\n[[problem]]\nplant = \"HE1\"\norders = [1]\n{problem}\n\
+                 [[problem]]\nplant = \"REA2\"\norders = [1]\n"
+            )
+        };
+        let levels = |d: &str, p: &str| parse(&text(d, p)).unwrap().trace_levels(None);
+        assert_eq!(levels("", ""), [TraceLevel::Sparse, TraceLevel::Sparse]);
+        assert_eq!(levels("trace = \"off\"", ""), [TraceLevel::Off, TraceLevel::Off]);
+        assert_eq!(levels("trace = \"off\"", "trace = \"full\""), [TraceLevel::Full, TraceLevel::Off]);
+        let c = parse(&text("trace = \"off\"", "trace = \"full\"")).unwrap();
+        assert_eq!(c.trace_levels(Some(TraceLevel::Sparse)), [TraceLevel::Sparse, TraceLevel::Sparse]);
+        // Not a design option: the same jobs, with the same ids, at every level.
+        let ids = |c: &Campaign| -> Vec<_> {
+            super::super::jobs::expand(c, super::super::jobs::RunnerTag::Design).into_iter().map(|j| j.id).collect()
+        };
+        assert_eq!(ids(&c), ids(&parse(&text("", "")).unwrap()));
+        let e = err(&text("", "trace = \"verbose\""));
+        assert_eq!((e.location.line, e.location.column), (7, 9), "{e}");
+        assert!(e.message.contains("verbose") && e.message.contains("sparse"), "{e}");
+        let e = err(&text("trace = true", ""));
+        assert_eq!((e.location.line, e.location.column), (3, 9), "{e}");
+        assert!(e.to_string().starts_with("test.toml:3:9: "), "{e}");
     }
 
     #[test]

@@ -4,16 +4,21 @@
 //! `jsonschema`):
 //! * [`ITER_TOPIC`] — one message per optimiser iteration ([`iter_message`]: phase, start,
 //!   iteration, f, ‖Tzw‖∞ as `gamma`, ‖K‖∞ as `k_hinf` (older builds: `hinf_cl`, `hinf_k`),
-//!   α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds);
+//!   α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds) at trace level `full`; at level
+//!   `sparse` (the default) only the iterations [`SparseFilter`] keeps. A message's MCAP
+//!   sequence number is its index among all the iterations, so a sparse trace's gaps show what
+//!   was left out ([`TraceSummary::offered`]);
 //! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled (with its
 //!   `search` summary: starts, best start, CPU time to best, stop reason).
 //!
 //! Non-finite numbers are written as the strings `"inf"`, `"-inf"` or `"nan"` (JSON has no
 //! such numbers); the schema allows number or string for every float.
 //!
+//! Level `off` makes no writer and no file ([`trace_observers`]).
+//!
 //! The writer ([`TraceWriter`], a [`JobObserver`]) writes `<job_id>.mcap.<host>.<pid>.tmp` (a
 //! name no other process uses, even on another machine sharing the folder), flushes every
-//! [`FLUSH_EVERY`] iterations or [`FLUSH_INTERVAL`], and on `finish` renames it atomically to
+//! [`FLUSH_EVERY`] messages written or [`FLUSH_INTERVAL`], and on `finish` renames it atomically to
 //! `<job_id>.mcap`; `abandon` deletes the tmp file, so a cut-off run never leaves a
 //! complete-looking trace. The job's claim is held while it runs, so on creation the leftover
 //! tmp files of the same job (from a killed process) are deleted. An I/O error is kept and stops
@@ -31,14 +36,15 @@ use serde_json::{json, Value};
 
 use super::jobs::Job;
 use super::record::JobRecord;
-use super::scheduler::{JobObserver, ObserverError};
+use super::scheduler::{no_observers, JobObserver, ObserverError};
+use super::trace_filter::{SparseFilter, TraceLevel};
 use crate::design::{DesignIterRecord, Phase};
 
 /// Topic of the per-iteration channel.
 pub const ITER_TOPIC: &str = "/hinfix/iterations";
 /// Topic of the final-result channel.
 pub const RESULT_TOPIC: &str = "/hinfix/result";
-/// Flush after this many iterations …
+/// Flush after this many messages written …
 pub const FLUSH_EVERY: usize = 50;
 /// … or after this much wall time, whichever comes first.
 pub const FLUSH_INTERVAL: Duration = Duration::from_secs(1);
@@ -154,9 +160,19 @@ pub fn result_schema() -> Value {
     })
 }
 
+/// An iteration waiting to be written: its sequence number and time are those of its arrival.
+#[derive(Debug)]
+struct Stamped {
+    seq: u32,
+    log_time: u64,
+    rec: DesignIterRecord,
+}
+
 /// Writes one job's trace; see the module doc.
 pub struct TraceWriter {
     writer: Option<mcap::Writer<BufWriter<File>>>,
+    /// `None`: every iteration (level `full`).
+    filter: Option<SparseFilter<Stamped>>,
     tmp: PathBuf,
     target: PathBuf,
     iter_channel: u16,
@@ -171,8 +187,9 @@ pub struct TraceWriter {
 impl TraceWriter {
     /// Creates `<dir>/<job_id>.mcap.<host>.<pid>.tmp` (and `dir`), deleting other tmp files of
     /// the job (the caller runs the job, so they are leftovers), and writes the header, schemas
-    /// and channels.
-    pub fn create(dir: &Path, job_id: &str) -> Result<Self, TraceError> {
+    /// and channels. `level` [`TraceLevel::Sparse`] writes the iterations [`SparseFilter`]
+    /// keeps, any other level every iteration (`off` is the factory's: it makes no writer).
+    pub fn create(dir: &Path, job_id: &str, level: TraceLevel) -> Result<Self, TraceError> {
         let target = dir.join(format!("{job_id}.mcap"));
         let host = super::provenance::host_name();
         let tmp = dir.join(format!("{job_id}.mcap.{host}.{}.tmp", std::process::id()));
@@ -203,6 +220,7 @@ impl TraceWriter {
         let result_channel = w.add_channel(s_res, RESULT_TOPIC, "json", &meta).map_err(mc)?;
         Ok(TraceWriter {
             writer: Some(w),
+            filter: (level == TraceLevel::Sparse).then(SparseFilter::new),
             tmp,
             target,
             iter_channel,
@@ -220,12 +238,16 @@ impl TraceWriter {
         &self.tmp
     }
 
-    fn write(&mut self, channel: u16, data: &Value) -> Result<(), TraceError> {
-        let Some(w) = self.writer.as_mut() else { return Ok(()) };
-        let t = self.started.elapsed().as_nanos() as u64;
-        let header =
-            mcap::records::MessageHeader { channel_id: channel, sequence: self.seq, log_time: t, publish_time: t };
+    /// The next sequence number and the time now.
+    fn stamp(&mut self) -> (u32, u64) {
+        let seq = self.seq;
         self.seq += 1;
+        (seq, self.started.elapsed().as_nanos() as u64)
+    }
+
+    fn write(&mut self, channel: u16, (sequence, t): (u32, u64), data: &Value) -> Result<(), TraceError> {
+        let Some(w) = self.writer.as_mut() else { return Ok(()) };
+        let header = mcap::records::MessageHeader { channel_id: channel, sequence, log_time: t, publish_time: t };
         let bytes = data.to_string();
         w.write_to_known_channel(&header, bytes.as_bytes())
             .map_err(|source| TraceError::Mcap { path: self.tmp.clone(), source })
@@ -243,17 +265,31 @@ impl TraceWriter {
         Ok(())
     }
 
-    /// Writes one iteration.
-    pub fn record_iter(&mut self, rec: &DesignIterRecord) -> Result<(), TraceError> {
-        self.write(self.iter_channel, &iter_message(rec))?;
+    fn write_iter(&mut self, s: Stamped) -> Result<(), TraceError> {
+        self.write(self.iter_channel, (s.seq, s.log_time), &iter_message(&s.rec))?;
         self.flush_if_due()
     }
 
-    /// Writes the final result, finishes the file, fsyncs it and renames it into place.
+    /// Takes one iteration: writes it (level `full`), or gives it to the filter and writes what
+    /// that releases.
+    pub fn record_iter(&mut self, rec: &DesignIterRecord) -> Result<(), TraceError> {
+        let (seq, log_time) = self.stamp();
+        let s = Stamped { seq, log_time, rec: rec.clone() };
+        match self.filter.as_mut() {
+            None => self.write_iter(s),
+            Some(f) => f.push(rec, s).into_iter().try_for_each(|s| self.write_iter(s)),
+        }
+    }
+
+    /// Writes the iteration the filter still holds (the last one), the final result, finishes
+    /// the file, fsyncs it and renames it into place.
     pub fn complete(mut self, record: &JobRecord) -> Result<PathBuf, TraceError> {
         if let Some(e) = self.error.take() {
             let _ = std::fs::remove_file(&self.tmp);
             return Err(e);
+        }
+        for held in self.filter.as_mut().map(SparseFilter::finish).unwrap_or_default() {
+            self.write_iter(held)?;
         }
         let data = serde_json::to_value(record).map_err(|source| TraceError::Json {
             path: self.tmp.clone(),
@@ -261,7 +297,8 @@ impl TraceWriter {
             index: self.seq as usize,
             source,
         })?;
-        self.write(self.result_channel, &data)?;
+        let stamp = self.stamp();
+        self.write(self.result_channel, stamp, &data)?;
         let mc = |source| TraceError::Mcap { path: self.tmp.clone(), source };
         let mut w = self.writer.take().ok_or_else(|| TraceError::Io {
             path: self.tmp.clone(),
@@ -305,11 +342,20 @@ impl JobObserver for TraceWriter {
     }
 }
 
-/// The observer factory for `scheduler::execute`: one [`TraceWriter`] per job in `traces_dir`.
-pub fn trace_observers(traces_dir: &Path) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, ObserverError> + Sync {
+/// The observer factory for `scheduler::execute`: one [`TraceWriter`] per job in `traces_dir`,
+/// at the trace level of the job's problem (`levels`, indexed like the campaign's problems:
+/// [`super::Campaign::trace_levels`]; a problem beyond it gets the default); none at level
+/// `off`.
+pub fn trace_observers(
+    traces_dir: &Path,
+    levels: Vec<TraceLevel>,
+) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, ObserverError> + Sync {
     let dir = traces_dir.to_path_buf();
-    move |job: &Job| {
-        TraceWriter::create(&dir, &job.id.0).map(|w| Box::new(w) as Box<dyn JobObserver>).map_err(ObserverError::failed)
+    move |job: &Job| match levels.get(job.problem).copied().unwrap_or_default() {
+        TraceLevel::Off => no_observers(job),
+        level => TraceWriter::create(&dir, &job.id.0, level)
+            .map(|w| Box::new(w) as Box<dyn JobObserver>)
+            .map_err(ObserverError::failed),
     }
 }
 
@@ -329,10 +375,18 @@ pub struct PhaseSummary {
 pub struct TraceSummary {
     /// The file.
     pub path: PathBuf,
-    /// Iteration messages (one per optimiser step plus one for the starting point of every
-    /// optimiser run, which has `iteration` 0).
+    /// Iteration messages in the file (at level `full`: one per optimiser step plus one for the
+    /// starting point of every optimiser run, which has `iteration` 0; at level `sparse`: those
+    /// kept).
     pub messages: usize,
-    /// Optimiser steps: messages with `iteration` ≥ 1. Equals the journal's `iterations`.
+    /// Iteration messages the optimiser produced, kept or not: one more than the last message's
+    /// sequence number (the result's, else the last iteration's). Equals `messages` in a full
+    /// trace.
+    pub offered: usize,
+    /// Optimiser steps. Counted per run (the messages of one local search in one phase, as
+    /// [`SparseFilter`] delimits them) from the iteration counts of its first and last message
+    /// (both kept at every level), so a sparse trace counts what a full one does. Equals the
+    /// journal's `iterations`.
     pub iterations: usize,
     /// Per phase (by name, in first-seen order).
     pub phases: Vec<(String, PhaseSummary)>,
@@ -355,8 +409,9 @@ pub struct TraceSummary {
     pub search: Option<crate::design::SearchSummary>,
 }
 
-/// Calls `f(topic, message)` for every message of the trace at `path`, in file order.
-fn each_message(path: &Path, mut f: impl FnMut(&str, Value)) -> Result<(), TraceError> {
+/// Calls `f(topic, sequence number, message)` for every message of the trace at `path`, in file
+/// order.
+fn each_message(path: &Path, mut f: impl FnMut(&str, u32, Value)) -> Result<(), TraceError> {
     let bytes = crate::input::read_capped(path, crate::input::MAX_TRACE_BYTES, "trace file")
         .map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
     let stream =
@@ -370,7 +425,7 @@ fn each_message(path: &Path, mut f: impl FnMut(&str, Value)) -> Result<(), Trace
             index,
             source,
         })?;
-        f(&topic, v);
+        f(&topic, msg.sequence, v);
     }
     Ok(())
 }
@@ -393,7 +448,7 @@ pub struct TraceIteration {
 /// Every iteration message of a trace, in order.
 pub fn read_iterations(path: &Path) -> Result<Vec<TraceIteration>, TraceError> {
     let mut out = Vec::new();
-    each_message(path, |topic, v| {
+    each_message(path, |topic, _, v| {
         if topic == ITER_TOPIC {
             out.push(TraceIteration {
                 phase: v["phase"].as_str().unwrap_or("?").to_string(),
@@ -412,6 +467,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
     let mut s = TraceSummary {
         path: path.to_path_buf(),
         messages: 0,
+        offered: 0,
         iterations: 0,
         phases: Vec::new(),
         first_f: f64::NAN,
@@ -423,16 +479,22 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
         final_gamma: None,
         search: None,
     };
-    each_message(path, |topic, v| {
+    let mut last: Option<(String, u64, u64)> = None; // phase, start, iteration
+    each_message(path, |topic, seq, v| {
+        s.offered = seq as usize + (topic == ITER_TOPIC) as usize;
         if topic == ITER_TOPIC {
             let f = f64_from_json(&v["f"]);
             if s.messages == 0 {
                 s.first_f = f;
             }
             s.messages += 1;
-            if v["iteration"].as_u64().is_some_and(|i| i >= 1) {
-                s.iterations += 1;
-            }
+            let phase = v["phase"].as_str().unwrap_or("?").to_string();
+            let (start, iteration) = (v["start"].as_u64().unwrap_or(0), v["iteration"].as_u64().unwrap_or(0));
+            s.iterations += match &last {
+                Some((p, st, i)) if *p == phase && *st == start && iteration > *i => (iteration - i) as usize,
+                _ => (iteration >= 1) as usize,
+            };
+            last = Some((phase.clone(), start, iteration));
             s.last_f = f;
             let h = f64_from_json(iter_field(&v, "gamma"));
             if h.is_finite() && !(h >= s.best_gamma) {
@@ -440,7 +502,6 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
             }
             s.evaluations = v["evaluations"].as_u64().unwrap_or(0) as usize;
             s.elapsed_cpu_s = f64_from_json(&v["elapsed_cpu_s"]);
-            let phase = v["phase"].as_str().unwrap_or("?").to_string();
             let idx = match s.phases.iter().position(|(p, _)| *p == phase) {
                 Some(i) => i,
                 None => {
@@ -463,10 +524,15 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
 impl fmt::Display for TraceSummary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "trace {}", self.path.display())?;
+        let kept = if self.offered > self.messages {
+            format!("{} of {} iteration messages kept (sparse)", self.messages, self.offered)
+        } else {
+            format!("{} messages with the starting points", self.messages)
+        };
         writeln!(
             f,
-            "  iterations {} ({} messages with the starting points)  evaluations {}  cpu {:.2} s",
-            self.iterations, self.messages, self.evaluations, self.elapsed_cpu_s
+            "  iterations {} ({kept})  evaluations {}  cpu {:.2} s",
+            self.iterations, self.evaluations, self.elapsed_cpu_s
         )?;
         writeln!(f, "  f: first {:.6e}  last {:.6e}  best ‖Tzw‖∞ {:.6}", self.first_f, self.last_f, self.best_gamma)?;
         for (name, p) in &self.phases {

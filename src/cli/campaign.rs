@@ -16,6 +16,7 @@ use crate::campaign::scheduler::{DesignRunner, ExecuteOptions, JobRunner};
 use crate::campaign::shard::{self, Shard};
 use crate::campaign::{
     expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
+    TraceLevel,
 };
 use anyhow::Context;
 
@@ -53,6 +54,11 @@ pub struct RunArgs {
     /// not) may share one results folder.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
+    /// How much of each job's iterations its trace keeps: `sparse` (what `campaign trace` and the
+    /// convergence figure need), `full` (every iteration) or `off` (no trace file). Overrides the
+    /// file's `trace` keys; default: those, else sparse. Job ids and results do not depend on it.
+    #[arg(long, value_name = "LEVEL", value_enum)]
+    pub trace: Option<TraceLevel>,
 }
 
 /// Extra journals merged into `status` and `report`.
@@ -168,7 +174,7 @@ pub fn run(a: RunArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
         Some(f) => f.as_ref(),
         None => &DesignRunner,
     };
-    let observers = trace_observers(&l.dir.join("traces"));
+    let observers = trace_observers(&l.dir.join("traces"), l.campaign.trace_levels(a.trace));
     let mut reporter = Reporter::new(&jobs, Display::choose(a.no_progress));
     let (name, dir) = (for_terminal(&l.campaign.name), for_terminal(&l.dir.display().to_string()));
     match a.shard {
