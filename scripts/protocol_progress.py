@@ -7,8 +7,12 @@ CPU hours (sum of the jobs' thread CPU seconds) and the wall-clock span of the s
 plant the jobs, CPU hours and how the jobs stopped. The tables themselves come from
 `campaign report`; this only says where and at what cost the journals were made.
 
-    python3 scripts/protocol_progress.py results/strong-stab [--expected 2850]
+    python3 scripts/protocol_progress.py results/strong-stab [--expected 2850] [--compare]
+
+With --compare it also prints the folder's compare.csv (written by `campaign report`) as a
+Markdown table: per plant and order, ours, the paper's HIFOO value and their ratio.
 """
+import csv
 import argparse
 import collections
 import glob
@@ -40,6 +44,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folder")
     ap.add_argument("--expected", type=int, help="jobs the campaign expands to")
+    ap.add_argument("--compare", action="store_true", help="also print compare.csv as Markdown")
     a = ap.parse_args()
     recs = list(records(a.folder))
     by_id = {}
@@ -74,6 +79,19 @@ def main():
         stops = collections.Counter((r.get("search") or {}).get("stop", r["status"]["kind"]) for r in rs)
         s = ", ".join(f"{k} {v}" for k, v in sorted(stops.items()))
         print(f"| {plant} | {len(rs)} | {c / 3600:.2f} | {c / len(rs):.1f} | {s} |")
+    if a.compare:
+        print()
+        print("| plant | n_K | ours | paper (HIFOO) | ours/paper |")
+        print("|---|---:|---:|---:|---:|")
+        with open(os.path.join(a.folder, "compare.csv"), encoding="utf-8") as f:
+            for row in csv.DictReader(f):
+                def num(key, fmt):
+                    try:
+                        return fmt.format(float(row[key]))
+                    except ValueError:
+                        return "–"
+                ours, paper, ratio = num("ours", "{:.4g}"), num("paper", "{:.4g}"), num("ratio", "{:.4f}")
+                print(f"| {row['plant']} | {row['order']} | {ours} | {paper} | {ratio} |")
 
 
 if __name__ == "__main__":
