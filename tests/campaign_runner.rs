@@ -221,8 +221,9 @@ fn sparse_trace_is_small_and_still_summarises_and_plots() {
         |t: &hinfix::campaign::TraceSummary| t.search.clone().map(|s| (s.starts, s.best_start, s.evals_to_best));
     assert_eq!((&s.final_status, s.final_gamma, search(&s)), (&f.final_status, f.final_gamma, search(&f)));
 
-    // The best objective of every phase kind, and the first and last point of every local
-    // search, are in the sparse trace.
+    // The best objective of every phase kind, and the last point of every local search (so
+    // every run boundary), are in the sparse trace; of the first points, those of the job and of
+    // every phase's first run.
     let (is, it) = (read_iterations(&ts).unwrap(), read_iterations(&tf).unwrap());
     let best = |v: &[TraceIteration], stab: bool| {
         v.iter().filter(|i| (i.phase == "stabilisation") == stab).map(|i| i.f).fold(f64::INFINITY, f64::min)
@@ -230,18 +231,30 @@ fn sparse_trace_is_small_and_still_summarises_and_plots() {
     for stab in [true, false] {
         assert_eq!(best(&is, stab).to_bits(), best(&it, stab).to_bits());
     }
-    let ends = |v: &[TraceIteration]| -> Vec<(String, usize, usize)> {
-        let key = |i: &TraceIteration| (i.phase.clone(), i.start, i.iteration);
-        let mut e = Vec::new();
-        for w in v.windows(2) {
-            if w[0].phase != w[1].phase || w[0].start != w[1].start || w[1].iteration <= w[0].iteration {
-                e.extend([key(&w[0]), key(&w[1])]);
-            }
-        }
+    let key = |i: &TraceIteration| (i.phase.clone(), i.start, i.iteration);
+    let lasts = |v: &[TraceIteration]| -> Vec<(String, usize, usize)> {
+        let mut e: Vec<_> = v
+            .windows(2)
+            .filter(|w| w[0].phase != w[1].phase || w[0].start != w[1].start || w[1].iteration <= w[0].iteration)
+            .map(|w| key(&w[0]))
+            .collect();
+        e.extend(v.last().map(key));
         e
     };
-    assert!(ends(&it).len() >= 4);
-    assert_eq!(ends(&is), ends(&it));
+    assert!(lasts(&it).len() >= 4);
+    assert_eq!(lasts(&is), lasts(&it));
+    let phase_firsts = |v: &[TraceIteration]| -> Vec<(String, usize, usize)> {
+        let mut firsts: Vec<(String, usize, usize)> = Vec::new();
+        for i in v {
+            if !firsts.iter().any(|f| f.0 == i.phase) {
+                firsts.push(key(i));
+            }
+        }
+        firsts
+    };
+    assert_eq!(phase_firsts(&is), phase_firsts(&it));
+    let starting_points = |v: &[TraceIteration]| v.iter().filter(|i| i.iteration == 0).count();
+    assert!(starting_points(&is) < starting_points(&it), "the other runs' first messages are left out");
 
     // `campaign trace` and `campaign plot` on the sparse trace; no trace at level off.
     let out = Command::new(BIN).arg("trace").arg(&ts).output().unwrap();

@@ -102,10 +102,11 @@ fn convergence_marks_phases_and_restarts_and_renders() {
     its.extend((0..5).map(|i| it("gradient_sampling", 0, i, 0.39 - 0.001 * i as f64, 0.6 + 0.01 * i as f64)));
     let fig = ConvergenceFigure { title: "synthetic".into(), iterations: its };
     assert!(fig.x_is_cpu());
+    // Each marker at the last message before the change (the end of a run, in every trace).
     let phases: Vec<(f64, String)> = fig.phase_markers().into_iter().map(|m| (m.x, m.label)).collect();
-    assert_eq!(phases, vec![(0.03, "BFGS".to_string()), (0.6, "gradient sampling".to_string())]);
+    assert_eq!(phases, vec![(0.02, "BFGS".to_string()), (0.3 + 0.01 * 19.0, "gradient sampling".to_string())]);
     let restarts: Vec<(f64, String)> = fig.restart_markers().into_iter().map(|m| (m.x, m.label)).collect();
-    assert_eq!(restarts, vec![(0.3, "start 2".to_string())]);
+    assert_eq!(restarts, vec![(0.03 + 0.01 * 19.0, "start 2".to_string())]);
     let p = Path::new("synthetic.png");
     check_png(&png_bytes(&fig, p).unwrap(), "convergence");
     check_svg(&svg_text(&fig, p).unwrap(), "convergence");

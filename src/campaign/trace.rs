@@ -16,10 +16,16 @@
 //!
 //! Level `off` makes no writer and no file ([`trace_observers`]).
 //!
+//! Messages are written in zstd-compressed chunks. A chunk is readable only once it is finished,
+//! so the writer ends the chunk and flushes the file when the messages written since the last
+//! flush reach [`CHUNK_BYTES`] (uncompressed) or [`FLUSH_INTERVAL`] has passed: a killed job's
+//! tmp file is a readable trace up to at most that much before the kill. Large chunks compress
+//! well: a short job's sparse trace is one chunk, and the smoke campaign's sparse chunks shrink to
+//! about 27 % of their JSON (campaigns/FORMAT.md, "Traces").
+//!
 //! The writer ([`TraceWriter`], a [`JobObserver`]) writes `<job_id>.mcap.<host>.<pid>.tmp` (a
-//! name no other process uses, even on another machine sharing the folder), flushes every
-//! [`FLUSH_EVERY`] messages written or [`FLUSH_INTERVAL`], and on `finish` renames it atomically to
-//! `<job_id>.mcap`; `abandon` deletes the tmp file, so a cut-off run never leaves a
+//! name no other process uses, even on another machine sharing the folder), and on `finish`
+//! renames it atomically to `<job_id>.mcap`; `abandon` deletes the tmp file, so a cut-off run never leaves a
 //! complete-looking trace. The job's claim is held while it runs, so on creation the leftover
 //! tmp files of the same job (from a killed process) are deleted. An I/O error is kept and stops
 //! the job's tracing (never the job).
@@ -44,10 +50,11 @@ use crate::design::{DesignIterRecord, Phase};
 pub const ITER_TOPIC: &str = "/hinfix/iterations";
 /// Topic of the final-result channel.
 pub const RESULT_TOPIC: &str = "/hinfix/result";
-/// Flush after this many messages written …
-pub const FLUSH_EVERY: usize = 50;
+/// End the chunk and flush when the messages written since the last flush reach this many bytes
+/// (uncompressed JSON) …
+pub const CHUNK_BYTES: usize = 64 * 1024;
 /// … or after this much wall time, whichever comes first.
-pub const FLUSH_INTERVAL: Duration = Duration::from_secs(1);
+pub const FLUSH_INTERVAL: Duration = Duration::from_secs(10);
 
 /// Errors of the trace writer and reader, naming the file.
 #[derive(Debug, thiserror::Error)]
@@ -178,6 +185,7 @@ pub struct TraceWriter {
     iter_channel: u16,
     result_channel: u16,
     seq: u32,
+    /// Message bytes written since the last flush.
     since_flush: usize,
     last_flush: Instant,
     started: Instant,
@@ -206,7 +214,11 @@ impl TraceWriter {
         let file = File::create(&tmp).map_err(io)?;
         let mc = |source| TraceError::Mcap { path: tmp.clone(), source };
         let mut w = mcap::WriteOptions::new()
-            .compression(None)
+            .compression(Some(mcap::Compression::Zstd))
+            // On the writing thread: no zstd worker threads beside the campaign's own.
+            .compression_threads(0)
+            // Chunks end where the writer flushes (module doc), not at mcap's 1 MiB default.
+            .chunk_size(None)
             .profile("")
             .library(concat!("hinfix ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::new(file))
@@ -249,13 +261,13 @@ impl TraceWriter {
         let Some(w) = self.writer.as_mut() else { return Ok(()) };
         let header = mcap::records::MessageHeader { channel_id: channel, sequence, log_time: t, publish_time: t };
         let bytes = data.to_string();
+        self.since_flush += bytes.len();
         w.write_to_known_channel(&header, bytes.as_bytes())
             .map_err(|source| TraceError::Mcap { path: self.tmp.clone(), source })
     }
 
     fn flush_if_due(&mut self) -> Result<(), TraceError> {
-        self.since_flush += 1;
-        if self.since_flush >= FLUSH_EVERY || self.last_flush.elapsed() >= FLUSH_INTERVAL {
+        if self.since_flush >= CHUNK_BYTES || self.last_flush.elapsed() >= FLUSH_INTERVAL {
             if let Some(w) = self.writer.as_mut() {
                 w.flush().map_err(|source| TraceError::Mcap { path: self.tmp.clone(), source })?;
             }
@@ -384,9 +396,10 @@ pub struct TraceSummary {
     /// trace.
     pub offered: usize,
     /// Optimiser steps. Counted per run (the messages of one local search in one phase, as
-    /// [`SparseFilter`] delimits them) from the iteration counts of its first and last message
-    /// (both kept at every level), so a sparse trace counts what a full one does. Equals the
-    /// journal's `iterations`.
+    /// [`SparseFilter`] delimits them) as the iteration count of its last message, kept at every
+    /// level (a run counts from iteration 0, its starting point, or from 1 where the starting
+    /// point is not reported), so a sparse trace, which keeps few runs' first messages, counts
+    /// what a full one does. Equals the journal's `iterations`.
     pub iterations: usize,
     /// Per phase (by name, in first-seen order).
     pub phases: Vec<(String, PhaseSummary)>,
@@ -492,7 +505,8 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
             let (start, iteration) = (v["start"].as_u64().unwrap_or(0), v["iteration"].as_u64().unwrap_or(0));
             s.iterations += match &last {
                 Some((p, st, i)) if *p == phase && *st == start && iteration > *i => (iteration - i) as usize,
-                _ => (iteration >= 1) as usize,
+                // A new run: the steps up to this message (its earlier messages may be left out).
+                _ => iteration as usize,
             };
             last = Some((phase.clone(), start, iteration));
             s.last_f = f;

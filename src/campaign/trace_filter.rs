@@ -5,21 +5,30 @@
 //! The level is not a design option: it is carried by the campaign model to the trace observer
 //! factory ([`super::trace::trace_observers`]), never enters a job id and changes no result.
 //!
-//! A sparse trace keeps, of the [`super::trace::ITER_TOPIC`] messages (campaigns/FORMAT.md, "Trace
-//! levels"):
-//! * the first and the last message of every *run* — the consecutive messages of one local search
-//!   in one phase (a run ends where the phase or the start index changes, or where the iteration
-//!   count does not increase), so every phase change and every restart is kept;
+//! A sparse trace keeps, of the [`super::trace::ITER_TOPIC`] messages (campaigns/FORMAT.md,
+//! "Traces"):
+//! * the last message of every *run* — the consecutive messages of one local search in one phase
+//!   (a run ends where the phase or the start index changes, or where the iteration count does
+//!   not increase) — so every phase change and every restart is seen, at the end point of the
+//!   run before it, and the step count of every run is known (runs count from iteration 0);
+//! * the first message of a run only where something needs it: the job's first message and the
+//!   first of every phase not seen before (`campaign trace`'s first f, overall and per phase);
+//!   the first of every gradient-sampling run (the best point it refines: the phase's gain is
+//!   measured from it); and the first of a run that goes on in the same phase and start (the
+//!   iteration count starts again), without which its boundary would not show. The other runs —
+//!   a restart, or the change from stabilisation to optimisation of one start — begin in the
+//!   trace at their first message kept for another reason (or their last);
 //! * every message whose objective value f is below the best f of the trace so far, the
 //!   stabilisation objective (phase `stabilisation`) and the performance objective (the other
 //!   phases) tracked separately — the same improvements the search records for its time to best;
 //! * every message whose ‖Tzw‖∞ (`gamma`) is below the smallest one so far, so that
 //!   `campaign trace`'s best ‖Tzw‖∞ is that of the full trace;
 //! * a thinned sample of the rest: a message is a sample if its iteration count has reached the
-//!   run's next point of a geometric grid (iterations 1, 2, 3, 4, 6, 9, 14, …: each point
-//!   [`SAMPLE_RATIO`] times the previous kept one) *and* at least [`SAMPLE_CPU_S`] CPU seconds
-//!   have passed since the last message kept for any reason. Samples are therefore at most one
-//!   per [`SAMPLE_CPU_S`] of the job's CPU time, and at most logarithmically many per run.
+//!   run's next point of a geometric grid (iterations 1, 2, 3, 5, 8, 12, 18, … when every point
+//!   is sampled: each point [`SAMPLE_RATIO`] times the previous sample, rounded up) *and* at
+//!   least [`SAMPLE_CPU_S`] CPU seconds have passed since the last message kept for any reason.
+//!   Samples are therefore at most one per [`SAMPLE_CPU_S`] of the job's CPU time, and at most
+//!   logarithmically many per run.
 //!
 //! Everything depends only on the messages offered (their phase, start, iteration, f, ‖Tzw‖∞ and
 //! CPU seconds), so the same messages give the same trace. The last message of a run is only
@@ -78,6 +87,21 @@ impl RunPos {
     /// Whether `rec` starts a new run after this one.
     fn ends_before(&self, rec: &DesignIterRecord) -> bool {
         self.phase != rec.phase || self.start != rec.start || rec.iter <= self.iter
+    }
+
+    /// Whether `rec` goes on in this run's phase and start (so, if it starts a new run, only
+    /// its iteration count shows it).
+    fn same_search(&self, rec: &DesignIterRecord) -> bool {
+        self.phase == rec.phase && self.start == rec.start
+    }
+}
+
+/// Index of a phase among the three (for the phases seen).
+fn phase_index(p: Phase) -> usize {
+    match p {
+        Phase::Stabilisation => 0,
+        Phase::Optimisation => 1,
+        Phase::GradientSampling => 2,
     }
 }
 
@@ -145,6 +169,8 @@ pub struct SparseFilter<T> {
     next_sample_iter: usize,
     /// CPU seconds of the last message kept.
     last_kept_cpu_s: f64,
+    /// Phases of the messages offered so far (by [`phase_index`]).
+    seen: [bool; 3],
 }
 
 impl<T> Default for SparseFilter<T> {
@@ -155,6 +181,7 @@ impl<T> Default for SparseFilter<T> {
             records: [Record::NONE; 3],
             next_sample_iter: 1,
             last_kept_cpu_s: f64::NEG_INFINITY,
+            seen: [false; 3],
         }
     }
 }
@@ -162,7 +189,9 @@ impl<T> Default for SparseFilter<T> {
 /// Why the filter writes a message.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Keep {
-    /// First message of a run.
+    /// First message of a run, where it is kept (module doc): the job's first, the first of a
+    /// phase, of a gradient-sampling run, or of a run in the same phase and start as the one
+    /// before.
     RunStart,
     /// Lowers the best objective of its kind, or the smallest ‖Tzw‖∞, by at least
     /// [`IMPROVE_RTOL`] since the last one kept.
@@ -180,17 +209,21 @@ impl<T> SparseFilter<T> {
         Self::default()
     }
 
-    /// Why `rec` is written now, if it is, and the roles it holds if it is not. Updates the
+    /// Why `rec` is written now, if it is, and the roles it holds if it is not. `new_run`: it
+    /// is the first message of a run; `start_kept`: one whose first message is kept. Updates the
     /// records and the sample clock.
-    fn judge(&mut self, rec: &DesignIterRecord, new_run: bool) -> Result<Keep, u8> {
+    fn judge(&mut self, rec: &DesignIterRecord, new_run: bool, start_kept: bool) -> Result<Keep, u8> {
         let (slot, f_role) = match rec.phase {
             Phase::Stabilisation => (0, role::STAB_RECORD),
             Phase::Optimisation | Phase::GradientSampling => (1, role::PERF_RECORD),
         };
         let f = self.records[slot].offer(rec.f);
         let gamma = self.records[2].offer(rec.gamma);
+        if new_run {
+            self.next_sample_iter = 1;
+        }
         let due = rec.iter >= self.next_sample_iter && rec.cpu_s >= self.last_kept_cpu_s + SAMPLE_CPU_S;
-        let keep = if new_run {
+        let keep = if start_kept {
             Some(Keep::RunStart)
         } else if f == Lowers::Clearly || gamma == Lowers::Clearly {
             Some(Keep::Improvement)
@@ -199,7 +232,7 @@ impl<T> SparseFilter<T> {
         } else {
             None
         };
-        if new_run || keep == Some(Keep::Sample) {
+        if keep == Some(Keep::Sample) {
             let grown = (rec.iter.max(1) as f64 * SAMPLE_RATIO).ceil() as usize;
             self.next_sample_iter = grown.max(rec.iter + 1);
         }
@@ -239,12 +272,16 @@ impl<T> SparseFilter<T> {
     /// [`Self::push`], with the reason each message is written.
     pub fn push_why(&mut self, rec: &DesignIterRecord, item: T) -> Vec<(T, Keep)> {
         let new_run = self.last.is_none_or(|l| l.ends_before(rec));
+        let seen = &mut self.seen[phase_index(rec.phase)];
+        let start_kept = new_run
+            && (!*seen || rec.phase == Phase::GradientSampling || self.last.is_some_and(|l| l.same_search(rec)));
+        *seen = true;
         self.last = Some(RunPos::of(rec));
         let mut out = Vec::new();
         if new_run {
             self.release(&mut out);
         }
-        match self.judge(rec, new_run) {
+        match self.judge(rec, new_run, start_kept) {
             Ok(why) => {
                 self.release(&mut out);
                 out.push((item, why));
@@ -323,9 +360,10 @@ mod tests {
                 assert!(out.contains(&i), "improvement {i} ({r:?}) dropped: {out:?}");
             }
         }
-        // No CPU time passes, so no samples: start 1's first iterations, above the best, go.
+        // No CPU time passes, so no samples: start 1's first iterations, above the best, go, its
+        // first message too (the change from stabilisation to optimisation of a later start).
         let n = recs.len();
-        assert_eq!(out.iter().filter(|&&i| i >= n - 13).count(), 1 + 4, "{out:?}");
+        assert_eq!(out.iter().filter(|&&i| i >= n - 13).count(), 4, "{out:?}");
     }
 
     #[test]
@@ -340,8 +378,9 @@ mod tests {
         let improvements = out.iter().filter(|(_, k)| *k == Keep::Improvement).count();
         assert!((5..=7).contains(&improvements), "{out:?}");
         assert!(out.contains(&(500, Keep::Held)), "the lowest value: {out:?}");
-        assert!(out.contains(&(800, Keep::Held)) && out.contains(&(801, Keep::RunStart)), "{out:?}");
-        assert_eq!(out.len(), 1 + improvements + 2 + 2, "{out:?}");
+        // The restart's first message (801) is not kept, its last is.
+        assert!(out.contains(&(800, Keep::Held)) && out.contains(&(804, Keep::Held)), "{out:?}");
+        assert_eq!(out.len(), 1 + improvements + 2 + 1, "{out:?}");
     }
 
     #[test]
@@ -354,7 +393,7 @@ mod tests {
     }
 
     #[test]
-    fn first_and_last_of_every_run_and_phase_changes_are_kept() {
+    fn last_of_every_run_and_only_the_needed_firsts_are_kept() {
         let flat = |_: usize| 5.0;
         let mut recs = run(Phase::Stabilisation, 0, 20, 0.0, 0.0, |_| 1.0);
         recs.extend(run(Phase::Optimisation, 0, 30, 0.0, 0.0, flat));
@@ -362,18 +401,30 @@ mod tests {
         recs.extend(run(Phase::Optimisation, 1, 30, 0.0, 0.0, flat)); // same start, iterations restart
         recs.extend(run(Phase::GradientSampling, 1, 7, 0.0, 0.0, flat));
         recs.push(rec(Phase::GradientSampling, 1, 9, 5.0, 0.0)); // one more, a gap in the count
-        let out = kept(&recs);
-        let firsts = [0, 21, 52, 83, 114];
-        let lasts = [20, 51, 82, 113, 122];
-        // The first message of each objective is also its first improvement; nothing else.
+        recs.extend(run(Phase::Stabilisation, 2, 4, 0.0, 0.0, |_| 2.0)); // out of gradient sampling
+        recs.extend(run(Phase::Optimisation, 2, 6, 0.0, 0.0, flat)); // a later start's optimisation
+        recs.extend(run(Phase::GradientSampling, 0, 3, 0.0, 0.0, flat)); // a second gradient sampling
+        let out = written(&recs);
+        let lasts = [20, 51, 82, 113, 122, 127, 134, 138];
+        // The job's first message, the first of the optimisation and gradient-sampling phases
+        // and of every gradient-sampling run, and the first of the run that goes on in start 1
+        // after its iteration count restarted; not those of the restart (52), of the run out of
+        // gradient sampling (123) or of start 2's optimisation (128).
+        let firsts = [0, 21, 83, 114, 135];
         let mut expected: Vec<usize> = firsts.iter().chain(&lasts).copied().collect();
         expected.sort_unstable();
-        assert_eq!(out, expected);
-        for (i, pair) in recs.windows(2).enumerate() {
-            if pair[0].phase != pair[1].phase {
-                assert!(out.contains(&i) && out.contains(&(i + 1)), "phase change at {i}");
-            }
+        assert_eq!(out.iter().map(|(i, _)| *i).collect::<Vec<_>>(), expected, "{out:?}");
+        for i in firsts {
+            assert!(out.contains(&(i, Keep::RunStart)), "{i}: {out:?}");
         }
+        for i in lasts {
+            assert!(out.contains(&(i, Keep::Held)), "{i}: {out:?}");
+        }
+        // Every run boundary shows in what is kept: the last message before it and the first one
+        // kept after it differ in phase or start, or the iteration count does not increase.
+        let kept: Vec<&DesignIterRecord> = expected.iter().map(|&i| &recs[i]).collect();
+        let boundaries = kept.windows(2).filter(|w| RunPos::of(w[0]).ends_before(w[1])).count();
+        assert_eq!(boundaries, lasts.len() - 1);
     }
 
     #[test]

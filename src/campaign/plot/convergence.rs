@@ -57,21 +57,24 @@ impl ConvergenceFigure {
             .collect()
     }
 
-    /// Phase boundaries: where the phase changes.
+    /// Phase boundaries: where the phase changes, drawn at the last message before the change.
+    /// That message ends a run, which every trace level keeps; the new run's first message may
+    /// not be in a sparse trace (its first kept one can come much later).
     pub fn phase_markers(&self) -> Vec<Marker> {
         let it = &self.iterations;
         (1..it.len())
             .filter(|&i| it[i].phase != it[i - 1].phase)
-            .map(|i| Marker { x: self.x_of(i), label: phase_label(&it[i].phase).to_string() })
+            .map(|i| Marker { x: self.x_of(i - 1), label: phase_label(&it[i].phase).to_string() })
             .collect()
     }
 
-    /// Restarts: where the start index changes within a phase.
+    /// Restarts: where the start index changes within a phase, drawn like
+    /// [`Self::phase_markers`] at the last message before the change.
     pub fn restart_markers(&self) -> Vec<Marker> {
         let it = &self.iterations;
         (1..it.len())
             .filter(|&i| it[i].phase == it[i - 1].phase && it[i].start != it[i - 1].start)
-            .map(|i| Marker { x: self.x_of(i), label: format!("start {}", it[i].start + 1) })
+            .map(|i| Marker { x: self.x_of(i - 1), label: format!("start {}", it[i].start + 1) })
             .collect()
     }
 
