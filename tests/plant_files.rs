@@ -230,3 +230,24 @@ fn unknown_name_lists_the_library() {
     assert!(s.contains("NoSuchPlant") && s.contains("HE1"), "{s}");
     assert!(hinfix::lti::resolve_plant("HE1").unwrap().ends_with("plants/HE1.json"));
 }
+
+#[test]
+fn unknown_top_level_key_is_rejected_by_name() {
+    // issue 34 item 12: a misspelt matrix (`d12`) or a key this version does not know was ignored.
+    for key in ["d12", "Ts", "comment"] {
+        let text = with(|o| {
+            o.insert(key.into(), json!(1));
+        });
+        let e = Plant::from_json_str(&text, "p.json").unwrap_err();
+        assert!(matches!(&e.kind, PlantErrorKind::UnknownKey { key: k } if k == key), "{key}: {e}");
+        assert!(e.to_string().contains(&format!("unknown key `{key}`")), "{e}");
+    }
+    // the optional provenance keys stay accepted
+    let text = with(|o| {
+        o.insert("notes".into(), json!("n"));
+        o.insert("check".into(), json!({"gamma": 1.0}));
+        o.insert("order".into(), json!(2));
+        o.insert("description".into(), json!("d"));
+    });
+    Plant::from_json_str(&text, "p.json").unwrap();
+}

@@ -5,11 +5,14 @@
 //!   is either entirely there or (after a kill -9 or a power cut in the middle) a torn tail.
 //! * Reading ([`read_journal`]): every complete (newline-terminated) line must parse; a corrupt
 //!   complete line is an error naming the file and line (something other than a crash damaged
-//!   the file) and is never deleted, wherever it is. Only a last line without its newline — what
-//!   a cut-off append leaves — is torn: it is reported in [`JournalRead::torn`] and ignored, and
-//!   that job simply runs again.
-//! * Repair ([`JournalWriter::open`]): before appending, a torn tail is truncated away so the file
-//!   stays valid JSONL.
+//!   the file) and is never deleted, wherever it is. A last line without its newline that parses
+//!   as a whole record (a copy or an editor dropped the final newline; a cut-off append cannot
+//!   leave one, since a record is one JSON object and no proper prefix of it parses) is kept and
+//!   counted in [`JournalRead::unterminated`]. A last line without its newline that does not
+//!   parse — what a cut-off append leaves — is torn: it is reported in [`JournalRead::torn`] and
+//!   ignored, and that job simply runs again.
+//! * Repair ([`JournalWriter::open`]): before appending, a torn tail is truncated away and a kept
+//!   unterminated last record gets its newline, so the file stays valid JSONL.
 //!
 //! Blank lines are skipped. Records with a newer `schema_version` than this program knows are
 //! refused (an error naming the line) rather than misread.
@@ -99,6 +102,8 @@ pub struct JournalRead {
     pub records: Vec<JobRecord>,
     /// The torn last line, if any (ignored).
     pub torn: Option<TornTail>,
+    /// Whether the last record (kept, in `records`) lacks its final newline.
+    pub unterminated: bool,
 }
 
 fn io_err(path: &Path) -> impl FnOnce(io::Error) -> JournalError + '_ {
@@ -144,7 +149,19 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
         let torn =
             |reason: String| TornTail { line: line_no, offset: offset as u64, len: bytes.len() - offset, reason };
         if !complete {
-            out.torn = Some(torn("no trailing newline (the write was cut short)".into()));
+            // A whole record lacking only its newline is kept; anything else is a cut-off write.
+            match std::str::from_utf8(raw).map(|t| parse_line(t.trim())) {
+                Ok(Ok(r)) => {
+                    out.records.push(r);
+                    out.unterminated = true;
+                }
+                Ok(Err(Err(found))) => {
+                    return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found })
+                }
+                _ => {
+                    out.torn = Some(torn("no trailing newline and not a whole record (the write was cut short)".into()))
+                }
+            }
             break;
         }
         let text = match std::str::from_utf8(raw) {
@@ -221,6 +238,10 @@ impl JournalWriter {
             file.set_len(t.offset).map_err(io_err(path))?;
             file.sync_all().map_err(io_err(path))?;
         }
+        if read.unterminated {
+            file.write_all(b"\n").map_err(io_err(path))?;
+            file.sync_data().map_err(io_err(path))?;
+        }
         Ok(Some((JournalWriter { path: path.to_path_buf(), file }, read)))
     }
 
@@ -274,7 +295,8 @@ struct Tail {
 
 /// Reads the journals of a folder (and extra journal files) incrementally: each
 /// [`poll`](Follower::poll) returns the complete records appended since the last one, including
-/// those of journals that appeared meanwhile. An incomplete last line is left for the next poll
+/// those of journals that appeared meanwhile. An incomplete last line (one that does not parse
+/// as a whole record) is left for the next poll
 /// (its writer may still be writing it); if its writer died it stays, and is reported by
 /// [`torn`](Follower::torn).
 #[derive(Debug, Clone)]

@@ -1,5 +1,7 @@
 //! Reduction of journal records to "best γ per (plant, order)", counting only controllers that
-//! are re-verified by recomputation: the closed loop is formed again (`lti::closed_loop`), both
+//! are re-verified by recomputation: the controller's shape is checked against the job's order
+//! and the plant's channels (the journal's `order` and `options.order` must agree too), the
+//! closed loop is formed again (`lti::closed_loop`), both
 //! α(A_cl) < 0 and α(Ak) < 0 are checked, and γ = ‖Tzw‖∞ is recomputed. The reported γ is
 //! always the recomputed one, never the journal's.
 //!
@@ -58,8 +60,14 @@ pub enum Verdict {
 /// Re-verifies one record's controller against `plant`.
 pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
     let Some(k) = record.controller() else { return Verdict::Rejected("job failed".into()) };
-    if let Err(e) = k.check_fits(plant) {
-        return Verdict::Rejected(format!("controller does not fit the plant: {e}"));
+    if record.options.order != record.order {
+        return Verdict::Rejected(format!(
+            "the record's order {} differs from its options' order {}",
+            record.order, record.options.order
+        ));
+    }
+    if let Err(e) = k.check_fits_order(plant, record.order) {
+        return Verdict::Rejected(format!("controller does not fit the job: {e}"));
     }
     let cl = match closed_loop(plant, k) {
         Ok(cl) => cl,
@@ -255,5 +263,30 @@ mod tests {
         let rows = best_per_order(&[bad.clone(), good.clone(), bad], &map(&[&p]));
         assert_eq!((rows[0].runs, rows[0].verified, rows[0].failed), (1, 1, 0));
         assert_eq!(rows[0].job_id.as_deref(), Some(good.job_id.0.as_str()));
+    }
+
+    #[test]
+    fn a_controller_of_another_order_than_its_job_is_rejected() {
+        // issue 34 item 4: an order-0 job's record carrying a stable order-2 controller was
+        // re-verified and reported.
+        let p = plant("P", 1.0);
+        let mut rec = record(&p, "P", 0);
+        let JobResult::Designed(o) = &mut rec.result else { unreachable!("a designed record") };
+        o.controller = crate::lti::Controller::zeros(2, 1, 1);
+        o.controller.ak[(0, 0)] = -1.0;
+        o.controller.ak[(1, 1)] = -1.0;
+        let Verdict::Rejected(why) = verify(&rec, &p) else { panic!("accepted an order-2 controller for order 0") };
+        assert!(why.contains("order 2") && why.contains("order is 0"), "{why}");
+        // blocks that disagree with each other (Bk of the wrong height)
+        let mut rec = record(&p, "P", 0);
+        let JobResult::Designed(o) = &mut rec.result else { unreachable!("a designed record") };
+        o.controller.bk = faer::Mat::zeros(1, 1);
+        let Verdict::Rejected(why) = verify(&rec, &p) else { panic!("accepted inconsistent blocks") };
+        assert!(why.contains("BK is 1×1"), "{why}");
+        // the journal's order and its options' order must agree
+        let mut rec = record(&p, "P", 0);
+        rec.order = 2;
+        assert!(matches!(verify(&rec, &p), Verdict::Rejected(_)));
+        assert!(matches!(verify(&record(&p, "P", 0), &p), Verdict::Verified { .. }));
     }
 }
