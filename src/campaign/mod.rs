@@ -51,6 +51,6 @@ pub use spec::{
     MAX_THREADS,
 };
 pub use trace::{
-    iter_message, read_iterations, summarise, trace_observers, PhaseSummary, TraceError, TraceIteration, TraceSummary,
-    TraceWriter, ITER_TOPIC, RESULT_TOPIC,
+    iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,
+    TraceIteration, TraceSummary, TraceWriter, ITER_TOPIC, RESULT_TOPIC,
 };

@@ -384,6 +384,13 @@ pub fn plot(a: PlotArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
     for why in &s.skipped {
         eprintln!("skipped: {why}");
     }
+    for why in &s.failed {
+        eprintln!("error: {why}");
+    }
+    if !s.failed.is_empty() {
+        eprintln!("error: {} figure(s) could not be made; the others were written", s.failed.len());
+        return Ok(ExitCode::FAILURE);
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -9,7 +9,8 @@
 //! Every outcome writes the returned controller. Exit codes: 0 for a stabilising controller
 //! (converged, stopped by a limit, budget exhausted, stabilised only), 4 when it is NOT
 //! STABILISED, 130/143/129 after Ctrl-C/SIGTERM/SIGHUP (the run is cancelled; the best
-//! controller so far is still written). `--out` is checked (not a directory, writable) before
+//! controller so far is still written). `--out` is checked (not a directory, writable, with a
+//! probe file of a unique name, so that concurrent runs writing one file do not trip) before
 //! the design starts.
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -205,22 +206,12 @@ fn parse_scales(text: &str, flag: &str) -> anyhow::Result<Vec<f64>> {
         .collect()
 }
 
-/// `path` can receive the controller: not a directory, and its `.tmp` sibling can be created
-/// (it is removed again).
+/// `path` can receive the controller (`fs_atomic::check_writable`); a directory gets a hint.
 fn check_writable(path: &Path) -> anyhow::Result<()> {
     if path.is_dir() {
         anyhow::bail!("is a directory; give a file name such as {}", path.join("K.json").display());
     }
-    let tmp = tmp_path(path);
-    std::fs::OpenOptions::new().write(true).create(true).truncate(true).open(&tmp)?;
-    std::fs::remove_file(&tmp)?;
-    Ok(())
-}
-
-fn tmp_path(path: &Path) -> PathBuf {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    PathBuf::from(tmp)
+    Ok(crate::fs_atomic::check_writable(path)?)
 }
 
 fn status_text(s: &DesignStatus) -> String {

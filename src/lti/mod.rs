@@ -22,6 +22,7 @@ pub mod kernel_bench;
 mod level_set_pencil;
 mod lyapunov;
 mod mat_file;
+mod mat_inflate;
 mod matrix_json;
 mod plant;
 mod plant_library;
