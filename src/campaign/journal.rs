@@ -14,6 +14,15 @@
 //! * Repair ([`JournalWriter::open`]): before appending, a torn tail is truncated away and a kept
 //!   unterminated last record gets its newline, so the file stays valid JSONL.
 //!
+//! * Identity ([`JournalWriter::append`]): before each append the writer compares the open
+//!   file's (device, inode) with what the path names now. If the journal was deleted (or its
+//!   folder) or replaced by another file, appending would write into a file nobody can read:
+//!   instead the writer saves everything the open file holds plus the new record to a new
+//!   journal `runs.rescued-<pid>.jsonl` in the same folder (re-creating the folder if it is
+//!   gone), goes on appending there, and returns [`JournalError::Gone`] naming it, which stops
+//!   the run with an error. The rescued file is a journal like any other: a resume skips its
+//!   jobs.
+//!
 //! Blank lines are skipped. Records with a newer `schema_version` than this program knows are
 //! refused (an error naming the line) rather than misread.
 //!
@@ -71,6 +80,19 @@ pub enum JournalError {
     Busy {
         /// The journal.
         path: PathBuf,
+    },
+    /// The journal file was deleted or replaced while this writer appended to it.
+    #[error(
+        "{}: the journal was {what} while the run was writing it; {rescue}",
+        path.display()
+    )]
+    Gone {
+        /// The journal.
+        path: PathBuf,
+        /// `deleted` or `replaced by another file`.
+        what: &'static str,
+        /// Where this writer's records went, or why they could not be saved.
+        rescue: String,
     },
     /// A record could not be serialised (cannot happen for well-formed records).
     #[error("cannot serialise the record of job {job}: {message}")]
@@ -195,6 +217,14 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
 pub struct JournalWriter {
     path: PathBuf,
     file: File,
+    /// (device, inode) of `file`: the path must still name it at each append.
+    id: (u64, u64),
+}
+
+/// (device, inode) of a file's metadata.
+fn file_id(m: &std::fs::Metadata) -> (u64, u64) {
+    use std::os::unix::fs::MetadataExt;
+    (m.dev(), m.ino())
 }
 
 impl JournalWriter {
@@ -242,7 +272,8 @@ impl JournalWriter {
             file.write_all(b"\n").map_err(io_err(path))?;
             file.sync_data().map_err(io_err(path))?;
         }
-        Ok(Some((JournalWriter { path: path.to_path_buf(), file }, read)))
+        let id = file_id(&file.metadata().map_err(io_err(path))?);
+        Ok(Some((JournalWriter { path: path.to_path_buf(), file, id }, read)))
     }
 
     /// The journal's path.
@@ -250,15 +281,58 @@ impl JournalWriter {
         &self.path
     }
 
-    /// Appends one record as one line: a single write of line + newline, flush, fsync.
+    /// Appends one record as one line: a single write of line + newline, flush, fsync. If the
+    /// path no longer names the open file, the records are rescued first and the result is
+    /// [`JournalError::Gone`] (see the module docs).
     pub fn append(&mut self, record: &JobRecord) -> Result<(), JournalError> {
         let mut line = serde_json::to_vec(record)
             .map_err(|e| JournalError::Serialise { job: record.job_id.to_string(), message: e.to_string() })?;
         line.push(b'\n');
+        let gone = match std::fs::metadata(&self.path) {
+            Ok(m) if file_id(&m) == self.id => None,
+            Ok(_) => Some("replaced by another file"),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => Some("deleted"),
+            Err(e) => return Err(io_err(&self.path)(e)),
+        };
+        if let Some(what) = gone {
+            let path = self.path.clone();
+            let rescue = match self.rescue(&line) {
+                Ok((to, n)) => format!(
+                    "its {n} records (this one included) are saved in {}, which a resume reads; the run stops",
+                    to.display()
+                ),
+                Err(e) => format!("its records could not be saved ({e}); the run stops"),
+            };
+            return Err(JournalError::Gone { path, what, rescue });
+        }
         let path = &self.path;
         self.file.write_all(&line).map_err(io_err(path))?;
         self.file.flush().map_err(io_err(path))?;
         self.file.sync_data().map_err(io_err(path))
+    }
+
+    /// Writes what the open (unlinked or replaced) file holds plus `line` to a new journal
+    /// `runs.rescued-<pid>.jsonl` of the folder, atomically, and moves this writer there.
+    /// Returns the new path and the number of lines it holds.
+    fn rescue(&mut self, line: &[u8]) -> io::Result<(PathBuf, usize)> {
+        let mut bytes = Vec::new();
+        self.file.seek(SeekFrom::Start(0))?;
+        self.file.read_to_end(&mut bytes)?;
+        if !bytes.is_empty() && !bytes.ends_with(b"\n") {
+            bytes.push(b'\n'); // a torn tail cannot be left in the middle of the file
+        }
+        bytes.extend_from_slice(line);
+        let dir = self.path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir)?;
+        let to = dir.join(format!("runs.rescued-{}.jsonl", std::process::id()));
+        crate::fs_atomic::write_atomic(&to, &bytes)?;
+        let file = OpenOptions::new().read(true).append(true).open(&to)?;
+        // Our own new file: the lock can only fail on a file system without locks.
+        let _ = file.try_lock();
+        self.id = file_id(&file.metadata()?);
+        self.file = file;
+        self.path = to.clone();
+        Ok((to, bytes.iter().filter(|&&b| b == b'\n').count()))
     }
 }
 

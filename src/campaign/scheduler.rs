@@ -168,6 +168,16 @@ pub enum CancelReason {
     Interrupt,
 }
 
+impl CancelReason {
+    /// Why the run stops, in words for the user (the error itself follows from the caller).
+    pub fn describe(self) -> &'static str {
+        match self {
+            CancelReason::CallbackError => "after an error, shown at the end",
+            CancelReason::Interrupt => "interrupted",
+        }
+    }
+}
+
 /// Counts of one `execute` call.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct RunStats {

@@ -32,7 +32,7 @@ use serde_json::{json, Value};
 use super::jobs::Job;
 use super::record::JobRecord;
 use super::scheduler::{JobObserver, ObserverError};
-use crate::design::{DesignIterRecord, Phase};
+use crate::design::DesignIterRecord;
 
 /// Topic of the per-iteration channel.
 pub const ITER_TOPIC: &str = "/hinfix/iterations";
@@ -90,13 +90,6 @@ pub enum TraceError {
 
 pub use crate::design::{f64_from_json, f64_to_json as json_f64};
 
-fn phase_name(p: Phase) -> String {
-    match serde_json::to_value(p) {
-        Ok(Value::String(s)) => s,
-        _ => format!("{p:?}"),
-    }
-}
-
 /// Keys of [`ITER_TOPIC`] messages renamed since older builds: (current, old). ‖Tzw‖∞ and ‖K‖∞
 /// have one name each across the crate (docs/ARCHITECTURE.md §5); traces written before the
 /// rename stay readable through [`iter_field`].
@@ -114,7 +107,7 @@ pub fn iter_field<'a>(v: &'a Value, key: &str) -> &'a Value {
 /// One iteration as written on [`ITER_TOPIC`].
 pub fn iter_message(rec: &DesignIterRecord) -> Value {
     json!({
-        "phase": phase_name(rec.phase),
+        "phase": rec.phase.name(),
         "start": rec.start,
         "iteration": rec.iter,
         "f": json_f64(rec.f),
