@@ -82,7 +82,20 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
-    Ok(CheckReport { alpha_cl, alpha_k, gamma: h.value, peak_freq: h.peak_freq, k_hinf: hk.value })
+    let r = CheckReport { alpha_cl, alpha_k, gamma: h.value, peak_freq: h.peak_freq, k_hinf: hk.value };
+    // A stable system has a finite norm: NaN or ∞ here is a computation out of f64's range (a
+    // controller with huge entries; plants are bounded on load), never a result to print.
+    for (what, value, stable) in
+        [("‖Tzw‖∞", r.gamma, r.closed_loop_stable()), ("‖K‖∞", r.k_hinf, r.controller_stable())]
+    {
+        if stable && !value.is_finite() {
+            anyhow::bail!(
+                "{what} of a stable system came out {value}: the plant's and the controller's numbers are out of \
+                 the range the norm can be computed in (see the magnitude limits in campaigns/FORMAT.md)"
+            );
+        }
+    }
+    Ok(r)
 }
 
 use crate::design::f64_to_json as num;

@@ -175,6 +175,18 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
+    // A stabilising result has a finite γ; NaN or ∞ would be a failed computation called success.
+    let stabilising = !matches!(outcome.status, DesignStatus::NotStabilised { .. } | DesignStatus::Interrupted);
+    if stabilising && !(outcome.gamma.is_finite() && outcome.objective.is_finite()) {
+        anyhow::bail!(
+            "designing an order-{} controller for {}: the result's ‖Tzw‖∞ = {} (objective {}) is not finite for a \
+             stable closed loop; the numbers are out of the range the norm can be computed in, no controller written",
+            a.order,
+            for_terminal(&plant.name),
+            outcome.gamma,
+            outcome.objective
+        );
+    }
     if crate::lti::is_mat_path(&a.out) {
         outcome.controller.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
     } else {

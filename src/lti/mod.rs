@@ -60,7 +60,7 @@ pub use hinf::{
 pub use interrupt::{Interrupt, Interrupted};
 pub use lyapunov::{lyapunov_residual, solve_lyapunov, stable_antistable_basis, LyapunovError, LYAPUNOV_RESIDUAL_TOL};
 pub use mat_file::{is_mat_path, read_mat_vars, write_mat, MatReadError, MatVar};
-pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
+pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError, MAX_PLANT_MAGNITUDE, MIN_PLANT_MAGNITUDE};
 pub use plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub(crate) use riccati::balance_scaling;

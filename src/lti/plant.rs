@@ -10,8 +10,10 @@
 //! A plant file is a JSON object with `name`, optional `description`, `source` (a citation string
 //! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices
 //! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows; optional `notes` and `check` are
-//! kept as provenance, and an optional `order` must equal `dims.n`. Any other top-level key is an
-//! error naming it ([`PlantErrorKind::UnknownKey`]): a misspelt `D12` or a key this version does
+//! kept as provenance, and an optional `order` must equal `dims.n`. No entry may exceed 1e50
+//! in absolute value, and a non-zero matrix needs an entry of 1e-50 or more
+//! (`matrix_json::check_magnitudes`). Any other top-level
+//! key is an error naming it ([`PlantErrorKind::UnknownKey`]): a misspelt `D12` or a key this version does
 //! not know must not be silently ignored. [`Plant::from_json_str`] validates everything and names
 //! the file, the field and the row/column of the first thing wrong.
 
@@ -24,7 +26,7 @@ use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
 use super::mat_file::{json_number, read_char_var, read_mat_vars, var_to_json, write_mat, MatReadError, MatVar};
-use super::matrix_json::{json_shape, matrix_from_json, MatrixJsonError};
+use super::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
 
 /// Sizes of a generalised plant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -269,6 +271,11 @@ impl Plant {
                     _ => String::new(),
                 };
                 PlantErrorKind::Matrix { matrix: key, problem, hint }
+            })?;
+            check_magnitudes(m.as_ref()).map_err(|problem| PlantErrorKind::Matrix {
+                matrix: key,
+                problem,
+                hint: String::new(),
             })?;
             mats.push(m);
         }
