@@ -1,4 +1,6 @@
-//! Issue 34, item 6: numbers out of the range the norm can be computed in are a clear error with
+//! Issue 34, items 6 and 7: numbers at the edges of what can be computed. Item 7: a closed loop
+//! is stable only with a margin (α < −1e-12 · max(1, ‖A_cl‖_F)). Item 6: numbers out of the
+//! range the norm can be computed in are a clear error with
 //! a non-zero exit, never a NaN or ∞ result called success. Plant entries are bounded on load
 //! (at most `MAX_PLANT_MAGNITUDE`; a non-zero matrix needs an entry of `MIN_PLANT_MAGNITUDE` or
 //! more; the error names the file and the matrix); a
@@ -93,4 +95,23 @@ fn design_and_check_never_call_a_nan_result_success() {
     assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
     assert!(!stdout.contains("NaN") && !stdout.contains("= inf"), "{stdout}");
     assert!(stderr.contains("out of the range"), "{stderr}");
+}
+
+#[test]
+fn check_calls_a_loop_within_the_margin_unstable() {
+    // issue 34 item 7: α = −4.4e-16 was called stable.
+    let dir = tempfile::tempdir().unwrap();
+    let plant = dir.path().join("edge.json");
+    let doc = serde_json::json!({
+        "name": "edge", "dims": {"n": 1, "m1": 1, "m2": 1, "p1": 1, "p2": 1},
+        "A": [[-4.4e-16]], "B1": [[1.0]], "B2": [[1.0]], "C1": [[1.0]], "C2": [[1.0]],
+        "D11": [[0.0]], "D12": [[0.0]], "D21": [[0.0]], "D22": [[0.0]]
+    });
+    std::fs::write(&plant, doc.to_string()).unwrap();
+    let k = dir.path().join("K0.json");
+    std::fs::write(&k, r#"{"AK": [], "BK": [], "CK": [[]], "DK": [[0.0]]}"#).unwrap();
+    let out = Command::new(BIN).args(["check", "--plant"]).arg(&plant).arg("--controller").arg(&k).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(4), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("UNSTABLE (stable means α < −1.0e-12)"), "{stdout}");
 }

@@ -39,7 +39,7 @@ impl Summary {
         Summary { name: plant.name.clone(), plant, alpha }
     }
     fn stable(&self) -> bool {
-        lti::is_stable(self.alpha)
+        lti::is_stable_with_margin(self.alpha, self.plant.a.as_ref())
     }
     fn json(&self) -> Value {
         let d = self.plant.dims;

@@ -67,5 +67,8 @@ pub(crate) use riccati::balance_scaling;
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::abscissa_of;
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
-pub use spectral::{is_stable, spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
+pub use spectral::{
+    is_stable, is_stable_with_margin, spectral_abscissa, spectral_abscissa_grad, stability_margin, MIN_EIGVEC_COSINE,
+    STABILITY_MARGIN_RTOL,
+};
 pub use state_space::StateSpace;
