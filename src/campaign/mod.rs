@@ -39,7 +39,10 @@ pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
 pub use provenance::Provenance;
 pub use record::{JobRecord, JobResult, JobStatus, SCHEMA_VERSION};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
-pub use reference::{load_default_reference, load_reference, RefMethod, ReferenceError, ReferenceRow, REFERENCE_CSV};
+pub use reference::{
+    load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow,
+    PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
+};
 pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_MAX_N};
 pub use run::{campaign_dir, journal_path, run_jobs, RunError, RunOutcome};
 pub use scheduler::{

@@ -18,8 +18,6 @@ pub(crate) mod sigma;
 
 use std::path::{Path, PathBuf};
 
-use sha2::Digest;
-
 use super::compare::full_order_rows;
 use super::record::JobRecord;
 use super::reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
@@ -85,33 +83,26 @@ pub struct PlotSummary {
 pub const MAX_FILE_PART: usize = 64;
 
 /// A plant name as a file-name part: letters, digits, `-`, `_`, `.` are kept and anything else
-/// becomes `_`. When that changed the name, or it is longer than [`MAX_FILE_PART`], the part is
-/// cut to that length and `-` plus the first 8 hex digits of the name's SHA-256 is appended, so
-/// different names never share figure files (`X+1` and `X_1` once did) and every name fits.
+/// becomes `_`; when that changed the name, or it is longer than [`MAX_FILE_PART`], a short hash
+/// is appended ([`super::sanitise::as_key`]), so different names never share figure files (`X+1`
+/// and `X_1` once did) and every name fits.
 pub fn file_part(name: &str) -> String {
-    let clean: String =
-        name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
-    if clean == name && clean.len() <= MAX_FILE_PART {
-        return clean;
-    }
-    let hash: String = sha2::Sha256::digest(name.as_bytes())[..4].iter().map(|b| format!("{b:02x}")).collect();
-    // `clean` is ASCII: any byte length is a character boundary.
-    format!("{}-{hash}", &clean[..clean.len().min(MAX_FILE_PART - 9)])
+    super::sanitise::as_key(name, |c| c.is_ascii_alphanumeric() || "-_.".contains(c), '_', MAX_FILE_PART)
 }
 
 /// The γ-vs-order figure of each plant in `best`.
 pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<GammaOrderFigure> {
     let full = full_order_rows(best, plants, reference);
-    let mut names: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
+    let mut names: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
     names.dedup();
     names
         .into_iter()
-        .map(|p| {
+        .map(|(p, fp)| {
             let ours =
                 best.iter().filter(|r| r.plant == p && r.gamma.is_finite()).map(|r| (r.order, r.gamma)).collect();
             let mut paper: Vec<(usize, f64)> = reference
                 .iter()
-                .filter(|r| r.plant == p && r.method == RefMethod::Hifoo)
+                .filter(|r| r.is_for(fp) && r.method == RefMethod::Hifoo)
                 .map(|r| (r.order, r.gamma))
                 .collect();
             paper.sort_by_key(|x| x.0);
