@@ -1,4 +1,6 @@
-//! Issue 34, item 2: the journal (or the whole results folder) removed or replaced while
+//! Faults of the results folder during `campaign run` (issue 34, items 2 and 11). Item 11: traces
+//! that cannot be written (a full disk) fail the run (exit 1, saying so) though the results are
+//! journaled. Item 2: the journal (or the whole results folder) removed or replaced while
 //! `campaign run` appends to it. The run must notice before its next append, stop with an error
 //! (non-zero exit) naming what happened, and lose no finished record: everything the journal
 //! held and the record that found it gone are in a rescued journal of the folder, which a resume
@@ -108,4 +110,27 @@ fn results_folder_deleted_during_a_run_stops_it_and_loses_nothing() {
         }
         panic!("could not remove {}", folder.display());
     });
+}
+
+#[test]
+fn traces_that_cannot_be_written_fail_the_run_and_say_so() {
+    // issue 34 item 11: a full disk while writing traces exited 0 and the traces were lost. A
+    // file where the traces folder should be fails every trace the same way.
+    let dir = scratch("traces");
+    let folder = dir.join("r").join("t");
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::write(folder.join("traces"), b"not a folder").unwrap();
+    let f = dir.join("c.toml");
+    std::fs::write(&f, "name = \"t\"\n[defaults]\nseeds = 2\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+    let out = std::process::Command::new(common::fake_campaign_bin())
+        .args(["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
+        .env("HINFIX_PLANTS", PLANTS)
+        .env(FAKE_RUNNER_ENV, "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("warning(s) above") && stderr.contains("traces"), "{stderr}");
+    assert_eq!(ids_in(&folder.join("runs.jsonl")).len(), 2, "the results are journaled");
+    let _ = std::fs::remove_dir_all(&dir);
 }

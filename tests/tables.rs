@@ -84,8 +84,7 @@ fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_us
     ];
     let tex = tables_tex(&best, &full, &reference);
     let block = |p: &str| {
-        let start =
-            tex.find(&format!("\\label{{tab:hinfix-{p}")).unwrap_or_else(|| panic!("no label for {p}:\n{tex}"));
+        let start = tex.find(&format!("\\label{{tab:hinfix-{p}")).unwrap_or_else(|| panic!("no label for {p}:\n{tex}"));
         let end = start + tex[start..].find("\\end{table}").unwrap();
         tex[start..end].to_string()
     };
