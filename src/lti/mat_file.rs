@@ -79,7 +79,8 @@ pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadEr
     if bytes.get(512..).is_some_and(|b| b.starts_with(b"\x89HDF")) {
         return Err(MatReadError::Format("an HDF5-based v7.3 file".into()));
     }
-    let plain = super::mat_inflate::inflate_elements(bytes, super::mat_inflate::MAX_MAT_INFLATED_BYTES)?;
+    let plain = super::mat_inflate::inflate_elements(bytes, super::mat_inflate::MAX_MAT_INFLATED_BYTES)
+        .map_err(MatReadError::Format)?;
     // The last resort for a parser we do not own: a panic on damaged data is a format error.
     let file = crate::panic_guard::catch_quietly(|| matfile::MatFile::parse(plain.as_slice()))
         .map_err(|panic| MatReadError::Format(format!("damaged file: {panic}")))?

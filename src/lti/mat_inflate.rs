@@ -10,8 +10,6 @@
 
 use std::io::Read;
 
-use super::mat_file::MatReadError;
-
 /// Largest total size of a MAT-file's elements after decompression: 64 MiB, 8 Mi doubles (a dense
 /// n = 2 500 plant's A is 6.25 Mi). A plant or controller file holds nothing else worth reading.
 pub(crate) const MAX_MAT_INFLATED_BYTES: u64 = 64 << 20;
@@ -21,9 +19,9 @@ const MI_COMPRESSED: u32 = 15;
 
 /// The file `bytes` (at least its 128-byte header) with every `miCOMPRESSED` element replaced by
 /// the elements it holds, or an error when the elements would exceed `limit` bytes or a
-/// compressed stream is damaged. Elements whose tags run past the end are copied as they are
-/// (the parser reports them).
-pub(crate) fn inflate_elements(bytes: &[u8], limit: u64) -> Result<Vec<u8>, MatReadError> {
+/// compressed stream is damaged (the message; `mat_file` makes it a format error). Elements whose
+/// tags run past the end are copied as they are (the parser reports them).
+pub(crate) fn inflate_elements(bytes: &[u8], limit: u64) -> Result<Vec<u8>, String> {
     let big_endian = bytes.get(126..128) == Some(b"MI");
     let u32_at = |i: usize| {
         bytes.get(i..i + 4).map(|b| {
@@ -35,12 +33,8 @@ pub(crate) fn inflate_elements(bytes: &[u8], limit: u64) -> Result<Vec<u8>, MatR
             }
         })
     };
-    let too_large = || {
-        MatReadError::Format(format!(
-            "its variables hold more than {} MiB once decompressed, the limit for a .mat file",
-            limit >> 20
-        ))
-    };
+    let too_large =
+        || format!("its variables hold more than {} MiB once decompressed, the limit for a .mat file", limit >> 20);
     let mut out = bytes[..128.min(bytes.len())].to_vec();
     let mut pos = 128;
     while pos < bytes.len() {
@@ -52,7 +46,7 @@ pub(crate) fn inflate_elements(bytes: &[u8], limit: u64) -> Result<Vec<u8>, MatR
             let mut inflated = Vec::new();
             libflate::zlib::Decoder::new(body)
                 .and_then(|d| d.take(budget.saturating_add(1)).read_to_end(&mut inflated))
-                .map_err(|e| MatReadError::Format(format!("a compressed variable is damaged: {e}")))?;
+                .map_err(|e| format!("a compressed variable is damaged: {e}"))?;
             if inflated.len() as u64 > budget {
                 return Err(too_large());
             }
@@ -106,6 +100,6 @@ mod tests {
         let n = f.len();
         f[n - 6] ^= 0xff;
         f[136] ^= 0xff; // the zlib header
-        assert!(matches!(inflate_elements(&f, 1 << 20), Err(MatReadError::Format(_))));
+        assert!(inflate_elements(&f, 1 << 20).unwrap_err().contains("damaged"));
     }
 }

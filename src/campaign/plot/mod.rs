@@ -84,7 +84,7 @@ pub const MAX_FILE_PART: usize = 64;
 
 /// A plant name as a file-name part: letters, digits, `-`, `_`, `.` are kept and anything else
 /// becomes `_`; when that changed the name, or it is longer than [`MAX_FILE_PART`], a short hash
-/// is appended ([`super::sanitise::as_key`]), so different names never share figure files (`X+1`
+/// is appended (`sanitise::as_key`), so different names never share figure files (`X+1`
 /// and `X_1` once did) and every name fits.
 pub fn file_part(name: &str) -> String {
     super::sanitise::as_key(name, |c| c.is_ascii_alphanumeric() || "-_.".contains(c), '_', MAX_FILE_PART)
