@@ -33,6 +33,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     sync_dir(path)
 }
 
+/// Whether `path` can be written by [`write_atomic`]: a tmp file of the same unique name scheme
+/// is created next to it (`create_new`, so never another writer's) and removed again. A
+/// directory at `path` is an error saying so. Used to refuse an unusable output before long
+/// work; sharing one fixed probe name (`<path>.tmp`) let concurrent writers of one file delete
+/// each other's probe and fail.
+pub fn check_writable(path: &Path) -> io::Result<()> {
+    if path.is_dir() {
+        return Err(io::Error::new(io::ErrorKind::IsADirectory, "is a directory, not a file"));
+    }
+    let tmp = tmp_path(path)?;
+    std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp)?;
+    std::fs::remove_file(&tmp)
+}
+
 /// `<dir>/.<name>.<host>.<pid>.<seq>.tmp` next to `path`.
 fn tmp_path(path: &Path) -> io::Result<PathBuf> {
     static SEQ: AtomicUsize = AtomicUsize::new(0);
@@ -111,6 +125,31 @@ mod tests {
         assert_eq!(names, vec![std::ffi::OsString::from("out")]);
         // A path that names no file at all.
         assert_eq!(write_atomic(Path::new("/"), b"x").unwrap_err().kind(), io::ErrorKind::InvalidInput);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn concurrent_writers_of_one_file_all_succeed() {
+        // issue 34 item 10: `design --out` probed `<out>.tmp`, one name for every writer; two
+        // runs at once deleted each other's probe and one failed (about 1 in 8).
+        let d = scratch("concurrent");
+        let p = d.join("K.json");
+        std::thread::scope(|s| {
+            for t in 0..8 {
+                let p = &p;
+                s.spawn(move || {
+                    for i in 0..50 {
+                        check_writable(p).unwrap();
+                        write_atomic(p, format!("{t} {i}\n").as_bytes()).unwrap();
+                    }
+                });
+            }
+        });
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.ends_with(" 49\n"), "{text}");
+        let names: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("K.json")]);
+        assert_eq!(check_writable(&d).unwrap_err().kind(), io::ErrorKind::IsADirectory);
         let _ = std::fs::remove_dir_all(&d);
     }
 }

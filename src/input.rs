@@ -35,16 +35,59 @@ pub fn read_capped(path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> {
     let mut buf = Vec::new();
     file.take(limit.saturating_add(1)).read_to_end(&mut buf)?;
     if buf.len() as u64 > limit {
-        return Err(too_large(limit, what));
+        return Err(match meta.is_file() {
+            true => too_large(limit, what),
+            // say what it is: `/dev/zero` is a character device, not a huge file
+            false => io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("is {}, not a regular file, and gave more than the limit for a {what}", kind_of(&meta)),
+            ),
+        });
     }
     Ok(buf)
 }
 
-/// As [`read_capped`], as UTF-8 text.
+/// What kind of file system object `meta` describes, for messages: "a directory", "a character
+/// device", …
+pub fn kind_of(meta: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = meta.file_type();
+    match () {
+        _ if t.is_dir() => "a directory",
+        _ if t.is_file() => "a regular file",
+        _ if t.is_char_device() => "a character device",
+        _ if t.is_block_device() => "a block device",
+        _ if t.is_fifo() => "a FIFO (named pipe)",
+        _ if t.is_socket() => "a socket",
+        _ => "not a regular file",
+    }
+}
+
+/// Why `path` cannot be an input file: `None` for a regular file (or a symlink to one), else
+/// "does not exist", "is a directory, not a file", "is a character device, not a file", ….
+pub fn not_a_file(path: &Path) -> Option<String> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => None,
+        Ok(m) => Some(format!("is {}, not a file", kind_of(&m))),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Some("does not exist".into()),
+        Err(e) => Some(format!("cannot be read: {e}")),
+    }
+}
+
+/// As [`read_capped`], as UTF-8 text. A leading UTF-8 byte-order mark (which some Windows
+/// editors write) is accepted and dropped: JSON and TOML parsers would refuse it with a message
+/// that does not name it.
 pub fn read_capped_string(path: &Path, limit: u64, what: &str) -> io::Result<String> {
-    String::from_utf8(read_capped(path, limit, what)?)
+    let mut bytes = read_capped(path, limit, what)?;
+    if bytes.starts_with(UTF8_BOM) {
+        bytes.drain(..UTF8_BOM.len());
+    }
+    String::from_utf8(bytes)
         .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not UTF-8 text ({})", e.utf8_error())))
 }
+
+/// The UTF-8 byte-order mark.
+const UTF8_BOM: &[u8] = b"\xef\xbb\xbf";
 
 fn too_large(limit: u64, what: &str) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidData, format!("larger than {} MiB, the limit for a {what}", limit / MIB))
@@ -68,5 +111,23 @@ mod tests {
         assert!(read_capped(dir.path(), MIB, "x").unwrap_err().to_string().contains("directory"));
         std::fs::write(&p, [0xff, 0xfe]).unwrap();
         assert!(read_capped_string(&p, MIB, "x").unwrap_err().to_string().contains("UTF-8"));
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_dropped_and_non_files_are_named() {
+        // issue 34 item 11: a BOM made the JSON error unclear; a directory or /dev/zero as a plant
+        // was said not to exist.
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.json");
+        std::fs::write(&p, b"\xef\xbb\xbf{\"a\": 1}").unwrap();
+        assert_eq!(read_capped_string(&p, MIB, "x").unwrap(), "{\"a\": 1}");
+        assert_eq!(not_a_file(&p), None);
+        assert_eq!(not_a_file(dir.path()).unwrap(), "is a directory, not a file");
+        assert_eq!(not_a_file(&dir.path().join("nope")).unwrap(), "does not exist");
+        if Path::new("/dev/zero").exists() {
+            assert_eq!(not_a_file(Path::new("/dev/zero")).unwrap(), "is a character device, not a file");
+            let e = read_capped(Path::new("/dev/zero"), 1000, "plant file").unwrap_err().to_string();
+            assert!(e.contains("is a character device") && e.contains("limit for a plant file"), "{e}");
+        }
     }
 }

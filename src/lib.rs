@@ -12,7 +12,8 @@
 //!
 //! Under all of them, used by any and using none: `numeric` (a few shared numeric helpers,
 //! crate-private), [`fs_atomic`] (atomic, durable file writes) and [`input`] (bounded reading of
-//! every input file, with documented size limits), and [`malloc_tuning`] (the C allocator's reuse of
+//! every input file, with documented size limits), [`panic_guard`] (a third-party parser's panic on
+//! damaged input turned into an error), and [`malloc_tuning`] (the C allocator's reuse of
 //! freed memory, set by the binary). The layers, a job's path through them and the
 //! journal's guarantees are described in docs/ARCHITECTURE.md; the methods, with their
 //! references, in docs/ALGORITHMS.md.
@@ -30,3 +31,4 @@ pub mod lti;
 pub mod malloc_tuning;
 pub(crate) mod numeric;
 pub mod optim;
+pub mod panic_guard;

@@ -122,6 +122,28 @@ fn torn_last_line_is_reported_ignored_and_cut_off() {
 }
 
 #[test]
+fn whole_last_record_without_newline_is_kept_not_cut() {
+    // issue 34 item 3: a valid last record lacking only its newline was taken for torn and cut.
+    let dir = scratch("nonl");
+    let file = campaign_file(&dir, 5.0, 1);
+    let results = dir.join("r");
+    run_to_end(&file, &results, true);
+    let path = results.join("t").join("runs.jsonl");
+    let complete = std::fs::read(&path).unwrap();
+    let n = complete.iter().filter(|&&b| b == b'\n').count();
+    std::fs::write(&path, &complete[..complete.len() - 1]).unwrap();
+    let read = read_journal(&path).unwrap();
+    assert!(read.torn.is_none() && read.unterminated);
+    assert_eq!(read.records.len(), n);
+
+    let out = run_to_end(&file, &results, true);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("torn"), "{stderr}");
+    // nothing ran again: the file is the original, newline restored
+    assert_eq!(std::fs::read(&path).unwrap(), complete);
+}
+
+#[test]
 fn real_design_campaign_writes_journal_traces_and_reports() {
     let dir = scratch("real");
     let file = dir.join("c.toml");

@@ -1,15 +1,17 @@
-//! Property-based fuzzing of every reader of outside input (issue 15, item 10): the plant and
-//! controller JSON readers, the campaign-file reader, the journal reader, and
-//! `design::validate`. The property is always the same: any input gives `Ok` or a clear `Err`,
+//! Property-based fuzzing of every reader of outside input (issue 15, item 10; issue 34, item 1):
+//! the plant and controller JSON readers, the campaign-file reader, the journal reader, the MCAP
+//! trace reader (mutations of a real trace), the MAT-file reader (mutations of real plant files,
+//! plain and compressed), and `design::validate`. The property is always the same: any input gives `Ok` or a clear `Err`,
 //! never a panic (proptest turns a panic into a failing case and shrinks it).
 //!
 //! Inputs are partly free (arbitrary JSON, TOML-ish text, bytes) and partly mutations of valid
 //! files (one field replaced by an arbitrary value, bytes flipped, the text cut short), so that
 //! the deep paths (shapes, dims, option ranges, record fields) are reached too.
 //!
-//! `cargo test --test fuzz_readers` runs a fast subset ([`FAST_CASES`] per target). The full run,
-//! `cargo test --release --test fuzz_readers -- --ignored --nocapture`, runs
-//! [`FULL_CASES`] per target (≥ 100 000 in all) and prints the counts.
+//! `cargo test --release --test fuzz_readers` runs a fast subset ([`FAST_CASES`] per target). The
+//! full run, `cargo test --release --test fuzz_readers -- --ignored --nocapture`, runs
+//! [`FULL_CASES`] (100 000) inputs per target and prints the counts; `HINFIX_FUZZ_CASES=N` sets
+//! another count per target for the full run.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -18,16 +20,17 @@ use std::sync::OnceLock;
 use hinfix::campaign::parse_journal;
 use hinfix::campaign::JobRecord;
 use hinfix::campaign::{expand, Campaign, RunnerTag};
+use hinfix::campaign::{summarise_bytes, TraceError, TraceWriter};
 use hinfix::design::{validate, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats};
-use hinfix::lti::{Controller, Plant};
+use hinfix::lti::{read_mat_vars, Controller, Plant};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use serde_json::{json, Value};
 
 /// Cases per target in `cargo test`.
 const FAST_CASES: u32 = 300;
-/// Cases per target in the ignored full run (5 targets → 250 000 inputs).
-const FULL_CASES: u32 = 50_000;
+/// Cases per target in the ignored full run, unless `HINFIX_FUZZ_CASES` says otherwise.
+const FULL_CASES: u32 = 100_000;
 
 fn manifest(p: &str) -> String {
     format!("{}/{p}", env!("CARGO_MANIFEST_DIR"))
@@ -191,7 +194,11 @@ fn arb_edits() -> impl Strategy<Value = Vec<Edit>> {
 }
 
 fn apply(text: &str, edits: &[Edit]) -> Vec<u8> {
-    let mut b = text.as_bytes().to_vec();
+    apply_bytes(text.as_bytes(), edits)
+}
+
+fn apply_bytes(bytes: &[u8], edits: &[Edit]) -> Vec<u8> {
+    let mut b = bytes.to_vec();
     for e in edits {
         let n = b.len().max(1);
         match e {
@@ -376,6 +383,94 @@ fn journal_target(cases: u32) -> Counts {
     })
 }
 
+/// The bytes of a real trace: a [`TraceWriter`] file of 30 iterations in two phases and the
+/// final record of [`record_line`].
+fn trace_bytes() -> &'static [u8] {
+    static T: OnceLock<Vec<u8>> = OnceLock::new();
+    T.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = TraceWriter::create(dir.path(), "job").unwrap();
+        for i in 0..30 {
+            let x = i as f64;
+            w.record_iter(&hinfix::design::DesignIterRecord {
+                phase: if i < 10 { Phase::Stabilisation } else { Phase::Optimisation },
+                start: i / 20,
+                iter: i % 20,
+                f: 1.0 / (1.0 + x),
+                gamma: if i < 10 { f64::INFINITY } else { 2.0 - x / 100.0 },
+                k_hinf: f64::NAN,
+                alpha_cl: -x,
+                alpha_k: f64::NAN,
+                dnorm: 1e-3,
+                step: 1.0,
+                evals: 2 * i,
+                cpu_s: x / 10.0,
+            })
+            .unwrap();
+        }
+        let record: JobRecord = serde_json::from_str(record_line()).unwrap();
+        std::fs::read(w.complete(&record).unwrap()).unwrap()
+    })
+}
+
+/// Byte-level mutations of `valid`: the text edits of [`arb_edits`], or 1–16 bytes overwritten
+/// at a random place with random bytes or with one repeated byte (lengths, offsets and counts
+/// in binary formats are what such overwrites hit).
+fn arb_bytes(valid: &'static [u8]) -> impl Strategy<Value = Vec<u8>> {
+    let overwrite =
+        (
+            any::<usize>(),
+            prop_oneof![
+                prop::collection::vec(any::<u8>(), 1..16),
+                (any::<u8>(), 1usize..16).prop_map(|(b, n)| vec![b; n]),
+            ],
+        )
+            .prop_map(move |(at, with)| {
+                let mut b = valid.to_vec();
+                let k = at % b.len();
+                for (i, x) in with.into_iter().enumerate() {
+                    if let Some(slot) = b.get_mut(k + i) {
+                        *slot = x;
+                    }
+                }
+                b
+            });
+    prop_oneof![
+        2 => overwrite,
+        1 => arb_edits().prop_map(move |e| apply_bytes(valid, &e)),
+    ]
+}
+
+fn trace_target(cases: u32) -> Counts {
+    fuzz("trace reader", cases, arb_bytes(trace_bytes()), |bytes| {
+        summarise_bytes(&bytes, Path::new("fuzz.mcap")).is_ok()
+    })
+}
+
+fn mat_bytes(name: &str) -> &'static [u8] {
+    static FILES: OnceLock<std::collections::BTreeMap<String, Vec<u8>>> = OnceLock::new();
+    let files = FILES.get_or_init(|| {
+        ["HE1.mat", "HE1_compressed.mat", "K2.mat"]
+            .into_iter()
+            .map(|f| (f.to_string(), std::fs::read(manifest(&format!("tests/fixtures/mat/{f}"))).unwrap()))
+            .collect()
+    });
+    &files[name]
+}
+
+fn mat_target(cases: u32) -> Counts {
+    let files = prop_oneof![
+        arb_bytes(mat_bytes("HE1.mat")),
+        arb_bytes(mat_bytes("HE1_compressed.mat")),
+        arb_bytes(mat_bytes("K2.mat"))
+    ];
+    fuzz("MAT-file reader", cases, files, |bytes| {
+        let vars = read_mat_vars(&bytes).is_ok();
+        let plant = Plant::from_mat_bytes(&bytes, Path::new("fuzz.mat")).is_ok();
+        vars || plant
+    })
+}
+
 #[allow(clippy::needless_update)]
 fn validate_target(cases: u32) -> Counts {
     // Mostly valid values, so that every check is reached, and every kind of invalid one.
@@ -426,8 +521,33 @@ fn all(cases: u32) -> Vec<(&'static str, Counts)> {
         ("controller reader", controller_target(cases)),
         ("campaign reader", campaign_target(cases)),
         ("journal reader", journal_target(cases)),
+        ("trace reader", trace_target(cases)),
+        ("MAT-file reader", mat_target(cases)),
         ("design::validate", validate_target(cases)),
     ]
+}
+
+#[test]
+fn trace_with_eight_bytes_overwritten_anywhere_is_an_error_not_a_panic() {
+    // issue 34 item 1: a real trace with 8 bytes overwritten made the mcap reader panic (slice
+    // index out of range), and `campaign trace` exit 101. Every offset, three fillers.
+    let good = trace_bytes();
+    assert!(summarise_bytes(good, Path::new("t.mcap")).unwrap().iterations > 0);
+    let mut damaged = 0;
+    for filler in [0x00u8, 0xff, 0x7f] {
+        for at in 0..good.len() {
+            let mut b = good.to_vec();
+            for slot in b.iter_mut().skip(at).take(8) {
+                *slot = filler;
+            }
+            if let Err(TraceError::Damaged { message, .. }) = summarise_bytes(&b, Path::new("t.mcap")) {
+                assert!(!message.is_empty());
+                damaged += 1;
+            }
+        }
+    }
+    // the reader's panic is reached (and caught) at some offsets
+    assert!(damaged > 0);
 }
 
 #[test]
@@ -440,10 +560,11 @@ fn readers_never_panic_fast_subset() {
 }
 
 #[test]
-#[ignore = "about a minute in release: cargo test --release --test fuzz_readers -- --ignored --nocapture"]
+#[ignore = "minutes in release: cargo test --release --test fuzz_readers -- --ignored --nocapture"]
 fn readers_never_panic_full() {
     let t = std::time::Instant::now();
-    let counts = all(FULL_CASES);
+    let cases = std::env::var("HINFIX_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(FULL_CASES);
+    let counts = all(cases);
     let total: usize = counts.iter().map(|c| c.1.tried).sum();
     for (name, c) in &counts {
         eprintln!(
@@ -454,5 +575,5 @@ fn readers_never_panic_full() {
         );
     }
     eprintln!("fuzz total {total} inputs, 0 panics, {:.1} s", t.elapsed().as_secs_f64());
-    assert!(total >= 100_000, "{total}");
+    assert!(counts.iter().all(|c| c.1.tried as u32 >= cases), "{counts:?}");
 }

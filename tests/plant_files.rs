@@ -230,3 +230,67 @@ fn unknown_name_lists_the_library() {
     assert!(s.contains("NoSuchPlant") && s.contains("HE1"), "{s}");
     assert!(hinfix::lti::resolve_plant("HE1").unwrap().ends_with("plants/HE1.json"));
 }
+
+#[test]
+fn unknown_top_level_key_is_rejected_by_name() {
+    // issue 34 item 12: a misspelt matrix (`d12`) or a key this version does not know was ignored.
+    for key in ["d12", "Ts", "comment"] {
+        let text = with(|o| {
+            o.insert(key.into(), json!(1));
+        });
+        let e = Plant::from_json_str(&text, "p.json").unwrap_err();
+        assert!(matches!(&e.kind, PlantErrorKind::UnknownKey { key: k } if k == key), "{key}: {e}");
+        assert!(e.to_string().contains(&format!("unknown key `{key}`")), "{e}");
+    }
+    // the optional provenance keys stay accepted
+    let text = with(|o| {
+        o.insert("notes".into(), json!("n"));
+        o.insert("check".into(), json!({"gamma": 1.0}));
+        o.insert("order".into(), json!(2));
+        o.insert("description".into(), json!("d"));
+    });
+    Plant::from_json_str(&text, "p.json").unwrap();
+}
+
+#[test]
+fn each_shipped_plant_has_its_fingerprint_in_the_reference_table() {
+    // issue 34 item 5: the paper's values are matched by content fingerprint, not by name.
+    let table = hinfix::campaign::PAPER_PLANT_FINGERPRINTS;
+    let shipped = hinfix::lti::shipped_plants().unwrap();
+    assert_eq!(table.len(), shipped.len());
+    for name in shipped {
+        let p = Plant::load(plants_dir().join(format!("{name}.json"))).unwrap();
+        let entry = table.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name} has no entry"));
+        assert_eq!(entry.1, p.fingerprint(), "{name}: the table's fingerprint is not the shipped file's");
+        assert_eq!(hinfix::campaign::paper_plant_name(&p.fingerprint()), Some(name.as_str()));
+    }
+}
+
+#[test]
+fn a_changed_plant_named_like_a_paper_plant_is_not_compared_with_the_paper() {
+    use hinfix::campaign::{compare_rows, load_default_reference, BestRow};
+    let he1 = Plant::load(plants_dir().join("HE1.json")).unwrap();
+    let mut changed = he1.clone();
+    changed.a[(0, 0)] += 1e-3;
+    let reference = load_default_reference().unwrap();
+    let row = |p: &Plant| BestRow {
+        plant: "HE1".into(),
+        plant_fingerprint: p.fingerprint(),
+        order: 1,
+        gamma: 0.2,
+        job_id: None,
+        eps: None,
+        seed: None,
+        runs: 1,
+        verified: 1,
+        failed: 0,
+        unverified: 0,
+    };
+    let rows = compare_rows(&[row(&he1), row(&changed)], &[], &reference);
+    assert_eq!(rows[0].paper, 0.1235, "the shipped HE1 is compared with the paper's");
+    assert!(rows[1].paper.is_nan() && rows[1].literature.is_empty(), "{:?}", rows[1]);
+    // and a renamed copy of the shipped plant still is
+    let mut renamed = row(&he1);
+    renamed.plant = "MyHelicopter".into();
+    assert_eq!(compare_rows(&[renamed], &[], &reference)[0].paper, 0.1235);
+}

@@ -88,6 +88,93 @@ fn every_figure_kind_is_rendered_for_a_small_real_campaign() {
     assert!(svg.contains("paper (HIFOO, 2008)") && svg.contains("full-order bound"), "γ-vs-order legend");
     let svg = std::fs::read_to_string(plots.join("convergence_REA2_nK1.svg")).unwrap();
     assert!(svg.contains("CPU time (s)"), "convergence x axis");
+
+    // issue 34 item 1: a trace with 8 bytes overwritten made the MCAP reader panic, so `campaign
+    // trace` exited 101 and `campaign plot` died. Damage the order-1 trace where the reader
+    // panics (found with the library, so the test keeps hitting that path).
+    let traces: Vec<PathBuf> =
+        std::fs::read_dir(results.join("p").join("traces")).unwrap().map(|e| e.unwrap().path()).collect();
+    let title = |t: &Path| hinfix::campaign::summarise(t).unwrap().final_status;
+    assert_eq!(traces.len(), 2, "{traces:?}");
+    let good = std::fs::read(&traces[0]).unwrap();
+    let damaged = (0..good.len())
+        .map(|at| {
+            let mut b = good.clone();
+            b[at..(at + 8).min(good.len())].fill(0xff);
+            b
+        })
+        .find(|b| {
+            matches!(
+                hinfix::campaign::summarise_bytes(b, Path::new("t")),
+                Err(hinfix::campaign::TraceError::Damaged { .. })
+            )
+        })
+        .expect("some 8-byte overwrite makes the reader panic");
+    assert!(title(&traces[1]).is_some());
+    std::fs::write(&traces[0], damaged).unwrap();
+    let out = Command::new(BIN).arg("trace").arg(&traces[0]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("damaged trace") && !stderr.contains("panicked"), "{stderr}");
+    for f in &expected {
+        std::fs::remove_file(f).unwrap();
+    }
+    let out = run(&["plot"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("skipped: convergence of") && stderr.contains("damaged trace"), "{stderr}");
+    let missing: Vec<&PathBuf> = expected.iter().filter(|f| !f.is_file()).collect();
+    assert_eq!(missing.len(), 2, "only the damaged trace's figure is missing: {missing:?}");
+    assert!(missing.iter().all(|f| f.to_string_lossy().contains("convergence_")), "{missing:?}");
+}
+
+/// A plant file for [`plant_names_never_share_or_overflow_figure_files`]: ẋ = −x + w + u,
+/// z = c x, y = x.
+fn tiny_plant(dir: &Path, file: &str, name: &str, c: f64) -> PathBuf {
+    let p = dir.join(file);
+    let doc = serde_json::json!({
+        "name": name, "dims": {"n": 1, "m1": 1, "m2": 1, "p1": 1, "p2": 1},
+        "A": [[-1.0]], "B1": [[1.0]], "B2": [[1.0]], "C1": [[c]], "C2": [[1.0]],
+        "D11": [[0.0]], "D12": [[0.0]], "D21": [[0.0]], "D22": [[0.0]]
+    });
+    std::fs::write(&p, doc.to_string()).unwrap();
+    p
+}
+
+#[test]
+fn plant_names_never_share_or_overflow_figure_files() {
+    // issue 34 item 9: plants "X+1" and "X_1" wrote the same figure files, and a 300-character
+    // name failed with "File name too long" and stopped the later figures.
+    let dir = tempfile::tempdir().unwrap();
+    let long = "Y".repeat(300);
+    let names = ["X+1", "X_1", long.as_str()];
+    let mut toml = "name = \"n\"\n[defaults]\neps = [1e-3]\nseeds = 1\ncpumax = 1.0\nnrand = 1\nspend_budget = false\n"
+        .to_string();
+    for (i, name) in names.iter().enumerate() {
+        let p = tiny_plant(dir.path(), &format!("p{i}.json"), name, 1.0 + i as f64);
+        toml += &format!("[[problem]]\nplant = {:?}\norders = [0]\n", p.to_str().unwrap());
+    }
+    let file = dir.path().join("c.toml");
+    std::fs::write(&file, toml).unwrap();
+    let results = dir.path().join("r");
+    for cmd in ["run", "plot"] {
+        let mut c = Command::new(BIN);
+        c.arg(cmd).arg(&file).arg("--results").arg(&results);
+        if cmd == "run" {
+            c.arg("--no-progress");
+        }
+        let out = c.output().unwrap();
+        assert!(out.status.success(), "{cmd}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    let files: Vec<String> = std::fs::read_dir(results.join("n").join("plots"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    for kind in ["gamma-vs-order_", "sigma_"] {
+        let n = files.iter().filter(|f| f.starts_with(kind) && f.ends_with(".png")).count();
+        assert_eq!(n, 3, "{kind}: {files:?}");
+    }
+    assert!(files.iter().all(|f| f.len() < 100), "{files:?}");
+    assert!(files.contains(&"gamma-vs-order_X_1.png".to_string()), "{files:?}");
 }
 
 fn it(phase: &str, start: usize, iteration: usize, f: f64, t: f64) -> TraceIteration {

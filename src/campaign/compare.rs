@@ -50,7 +50,7 @@ pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[Referen
     seen.dedup();
     seen.into_iter()
         .map(|(name, fp)| {
-            let paper = reference.iter().find(|r| r.plant == name && r.method == RefMethod::FullOrder).map(|r| r.gamma);
+            let paper = reference.iter().find(|r| r.is_for(fp) && r.method == RefMethod::FullOrder).map(|r| r.gamma);
             let computed = plants
                 .get(fp)
                 .filter(|p| p.dims.n <= FULL_ORDER_MAX_N)
@@ -71,7 +71,7 @@ pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[Refere
     best.iter()
         .map(|b| {
             let at = |m: RefMethod| {
-                reference.iter().filter(move |r| r.plant == b.plant && r.order == b.order && r.method == m)
+                reference.iter().filter(move |r| r.is_for(&b.plant_fingerprint) && r.order == b.order && r.method == m)
             };
             let paper = at(RefMethod::Hifoo).map(|r| r.gamma).fold(f64::NAN, f64::min);
             let literature = at(RefMethod::Literature).map(|r| (r.source.clone(), r.gamma)).collect();

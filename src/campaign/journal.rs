@@ -5,11 +5,23 @@
 //!   is either entirely there or (after a kill -9 or a power cut in the middle) a torn tail.
 //! * Reading ([`read_journal`]): every complete (newline-terminated) line must parse; a corrupt
 //!   complete line is an error naming the file and line (something other than a crash damaged
-//!   the file) and is never deleted, wherever it is. Only a last line without its newline — what
-//!   a cut-off append leaves — is torn: it is reported in [`JournalRead::torn`] and ignored, and
-//!   that job simply runs again.
-//! * Repair ([`JournalWriter::open`]): before appending, a torn tail is truncated away so the file
-//!   stays valid JSONL.
+//!   the file) and is never deleted, wherever it is. A last line without its newline that parses
+//!   as a whole record (a copy or an editor dropped the final newline; a cut-off append cannot
+//!   leave one, since a record is one JSON object and no proper prefix of it parses) is kept and
+//!   counted in [`JournalRead::unterminated`]. A last line without its newline that does not
+//!   parse — what a cut-off append leaves — is torn: it is reported in [`JournalRead::torn`] and
+//!   ignored, and that job simply runs again.
+//! * Repair ([`JournalWriter::open`]): before appending, a torn tail is truncated away and a kept
+//!   unterminated last record gets its newline, so the file stays valid JSONL.
+//!
+//! * Identity ([`JournalWriter::append`]): before each append the writer compares the open
+//!   file's (device, inode) with what the path names now. If the journal was deleted (or its
+//!   folder) or replaced by another file, appending would write into a file nobody can read:
+//!   instead the writer saves everything the open file holds plus the new record to a new
+//!   journal `runs.rescued-<pid>.jsonl` in the same folder (re-creating the folder if it is
+//!   gone), goes on appending there, and returns [`JournalError::Gone`] naming it, which stops
+//!   the run with an error. The rescued file is a journal like any other: a resume skips its
+//!   jobs.
 //!
 //! Blank lines are skipped. Records with a newer `schema_version` than this program knows are
 //! refused (an error naming the line) rather than misread.
@@ -69,6 +81,19 @@ pub enum JournalError {
         /// The journal.
         path: PathBuf,
     },
+    /// The journal file was deleted or replaced while this writer appended to it.
+    #[error(
+        "{}: the journal was {what} while the run was writing it; {rescue}",
+        path.display()
+    )]
+    Gone {
+        /// The journal.
+        path: PathBuf,
+        /// `deleted` or `replaced by another file`.
+        what: &'static str,
+        /// Where this writer's records went, or why they could not be saved.
+        rescue: String,
+    },
     /// A record could not be serialised (cannot happen for well-formed records).
     #[error("cannot serialise the record of job {job}: {message}")]
     Serialise {
@@ -99,6 +124,8 @@ pub struct JournalRead {
     pub records: Vec<JobRecord>,
     /// The torn last line, if any (ignored).
     pub torn: Option<TornTail>,
+    /// Whether the last record (kept, in `records`) lacks its final newline.
+    pub unterminated: bool,
 }
 
 fn io_err(path: &Path) -> impl FnOnce(io::Error) -> JournalError + '_ {
@@ -144,7 +171,19 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
         let torn =
             |reason: String| TornTail { line: line_no, offset: offset as u64, len: bytes.len() - offset, reason };
         if !complete {
-            out.torn = Some(torn("no trailing newline (the write was cut short)".into()));
+            // A whole record lacking only its newline is kept; anything else is a cut-off write.
+            match std::str::from_utf8(raw).map(|t| parse_line(t.trim())) {
+                Ok(Ok(r)) => {
+                    out.records.push(r);
+                    out.unterminated = true;
+                }
+                Ok(Err(Err(found))) => {
+                    return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found })
+                }
+                _ => {
+                    out.torn = Some(torn("no trailing newline and not a whole record (the write was cut short)".into()))
+                }
+            }
             break;
         }
         let text = match std::str::from_utf8(raw) {
@@ -178,6 +217,14 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
 pub struct JournalWriter {
     path: PathBuf,
     file: File,
+    /// (device, inode) of `file`: the path must still name it at each append.
+    id: (u64, u64),
+}
+
+/// (device, inode) of a file's metadata.
+fn file_id(m: &std::fs::Metadata) -> (u64, u64) {
+    use std::os::unix::fs::MetadataExt;
+    (m.dev(), m.ino())
 }
 
 impl JournalWriter {
@@ -221,7 +268,12 @@ impl JournalWriter {
             file.set_len(t.offset).map_err(io_err(path))?;
             file.sync_all().map_err(io_err(path))?;
         }
-        Ok(Some((JournalWriter { path: path.to_path_buf(), file }, read)))
+        if read.unterminated {
+            file.write_all(b"\n").map_err(io_err(path))?;
+            file.sync_data().map_err(io_err(path))?;
+        }
+        let id = file_id(&file.metadata().map_err(io_err(path))?);
+        Ok(Some((JournalWriter { path: path.to_path_buf(), file, id }, read)))
     }
 
     /// The journal's path.
@@ -229,15 +281,58 @@ impl JournalWriter {
         &self.path
     }
 
-    /// Appends one record as one line: a single write of line + newline, flush, fsync.
+    /// Appends one record as one line: a single write of line + newline, flush, fsync. If the
+    /// path no longer names the open file, the records are rescued first and the result is
+    /// [`JournalError::Gone`] (see the module docs).
     pub fn append(&mut self, record: &JobRecord) -> Result<(), JournalError> {
         let mut line = serde_json::to_vec(record)
             .map_err(|e| JournalError::Serialise { job: record.job_id.to_string(), message: e.to_string() })?;
         line.push(b'\n');
+        let gone = match std::fs::metadata(&self.path) {
+            Ok(m) if file_id(&m) == self.id => None,
+            Ok(_) => Some("replaced by another file"),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => Some("deleted"),
+            Err(e) => return Err(io_err(&self.path)(e)),
+        };
+        if let Some(what) = gone {
+            let path = self.path.clone();
+            let rescue = match self.rescue(&line) {
+                Ok((to, n)) => format!(
+                    "its {n} records (this one included) are saved in {}, which a resume reads; the run stops",
+                    to.display()
+                ),
+                Err(e) => format!("its records could not be saved ({e}); the run stops"),
+            };
+            return Err(JournalError::Gone { path, what, rescue });
+        }
         let path = &self.path;
         self.file.write_all(&line).map_err(io_err(path))?;
         self.file.flush().map_err(io_err(path))?;
         self.file.sync_data().map_err(io_err(path))
+    }
+
+    /// Writes what the open (unlinked or replaced) file holds plus `line` to a new journal
+    /// `runs.rescued-<pid>.jsonl` of the folder, atomically, and moves this writer there.
+    /// Returns the new path and the number of lines it holds.
+    fn rescue(&mut self, line: &[u8]) -> io::Result<(PathBuf, usize)> {
+        let mut bytes = Vec::new();
+        self.file.seek(SeekFrom::Start(0))?;
+        self.file.read_to_end(&mut bytes)?;
+        if !bytes.is_empty() && !bytes.ends_with(b"\n") {
+            bytes.push(b'\n'); // a torn tail cannot be left in the middle of the file
+        }
+        bytes.extend_from_slice(line);
+        let dir = self.path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir)?;
+        let to = dir.join(format!("runs.rescued-{}.jsonl", std::process::id()));
+        crate::fs_atomic::write_atomic(&to, &bytes)?;
+        let file = OpenOptions::new().read(true).append(true).open(&to)?;
+        // Our own new file: the lock can only fail on a file system without locks.
+        let _ = file.try_lock();
+        self.id = file_id(&file.metadata()?);
+        self.file = file;
+        self.path = to.clone();
+        Ok((to, bytes.iter().filter(|&&b| b == b'\n').count()))
     }
 }
 
@@ -274,7 +369,8 @@ struct Tail {
 
 /// Reads the journals of a folder (and extra journal files) incrementally: each
 /// [`poll`](Follower::poll) returns the complete records appended since the last one, including
-/// those of journals that appeared meanwhile. An incomplete last line is left for the next poll
+/// those of journals that appeared meanwhile. An incomplete last line (one that does not parse
+/// as a whole record) is left for the next poll
 /// (its writer may still be writing it); if its writer died it stays, and is reported by
 /// [`torn`](Follower::torn).
 #[derive(Debug, Clone)]

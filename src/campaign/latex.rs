@@ -48,9 +48,10 @@ pub fn sig4(x: f64) -> String {
     format!("${mant}\\times10^{{{exp}}}$")
 }
 
-/// A LaTeX `\label` key part: ASCII letters and digits kept, everything else `-`.
+/// A LaTeX `\label` key part: ASCII letters and digits kept, everything else `-`, with a short
+/// hash when that changed the name (`sanitise::as_key`), so two plants never share a label.
 fn label_key(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect()
+    super::sanitise::as_key(name, |c| c.is_ascii_alphanumeric(), '-', 64)
 }
 
 /// `tables.tex`, in the layout of the paper's tables: one `table` per plant with a caption and a
@@ -61,10 +62,10 @@ fn label_key(name: &str) -> String {
 /// appear as rows of their own when we have no result there). 4 significant figures throughout.
 pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[ReferenceRow]) -> String {
     let mut s = String::from("% hinfix: best γ per controller order (re-verified) in the layout of\n% Gumussoy, Millstone & Overton (2008); needs \\usepackage{booktabs}\n");
-    let mut plants: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
+    let mut plants: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
     plants.dedup();
-    for p in plants {
-        let refs = |m: RefMethod| reference.iter().filter(move |r| r.plant == p && r.method == m);
+    for (p, fp) in plants {
+        let refs = |m: RefMethod| reference.iter().filter(move |r| r.is_for(fp) && r.method == m);
         let literature: Vec<&ReferenceRow> = refs(RefMethod::Literature).collect();
         let has_lit = !literature.is_empty();
         let paper_at =

@@ -40,7 +40,10 @@ pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
 pub use provenance::Provenance;
 pub use record::{JobRecord, JobResult, JobStatus, SCHEMA_VERSION};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
-pub use reference::{load_default_reference, load_reference, RefMethod, ReferenceError, ReferenceRow, REFERENCE_CSV};
+pub use reference::{
+    load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow,
+    PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
+};
 pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_MAX_N};
 pub use run::{campaign_dir, journal_path, run_jobs, RunError, RunOutcome};
 pub use scheduler::{
@@ -52,7 +55,7 @@ pub use spec::{
     MAX_THREADS,
 };
 pub use trace::{
-    iter_message, read_iterations, summarise, trace_observers, PhaseSummary, TraceError, TraceIteration, TraceSummary,
-    TraceWriter, ITER_TOPIC, RESULT_TOPIC,
+    iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,
+    TraceIteration, TraceSummary, TraceWriter, ITER_TOPIC, RESULT_TOPIC,
 };
 pub use trace_filter::{Keep, SparseFilter, TraceLevel, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO};

@@ -100,7 +100,7 @@ impl<'a> Reporter<'a> {
             CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma } => {
                 if let Some(b) = self.workers.get(*worker) {
                     let g = if gamma.is_finite() { format!("γ = {gamma:.6}") } else { format!("f = {f:.4e}") };
-                    b.set_message(format!("worker {worker}: {}  {phase:?} it {iter}  {g}", self.label(*index)));
+                    b.set_message(format!("worker {worker}: {}  {} it {iter}  {g}", self.label(*index), phase.name()));
                 }
             }
             CampaignEvent::JobFinished { index, worker, record } => {
@@ -133,7 +133,7 @@ impl<'a> Reporter<'a> {
                 None => self.line(format!("warning: {message}")),
             },
             CampaignEvent::CancelRequested { reason } => {
-                self.line(format!("stopping ({reason:?}): no new jobs; in-flight jobs are dropped"))
+                self.line(format!("stopping ({}): no new jobs; in-flight jobs are dropped", reason.describe()))
             }
             CampaignEvent::Finished { .. } => {
                 for b in &self.workers {

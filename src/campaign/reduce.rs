@@ -1,7 +1,9 @@
 //! Reduction of journal records to "best γ per (plant, order)", counting only controllers that
-//! are re-verified by recomputation: the closed loop is formed again (`lti::closed_loop`), both
-//! α(A_cl) < 0 and α(Ak) < 0 are checked, and γ = ‖Tzw‖∞ is recomputed. The reported γ is
-//! always the recomputed one, never the journal's.
+//! are re-verified by recomputation: the controller's shape is checked against the job's order
+//! and the plant's channels (the journal's `order` and `options.order` must agree too), the
+//! closed loop is formed again (`lti::closed_loop`), both α(A_cl) and α(Ak) are checked to be
+//! below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F)), and
+//! γ = ‖Tzw‖∞ is recomputed. The reported γ is always the recomputed one, never the journal's.
 //!
 //! A plant is identified by its content fingerprint, never by its name: records are verified
 //! against the plant with their `plant_fingerprint` and grouped by it, so two different plants
@@ -15,7 +17,10 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::record::JobRecord;
-use crate::lti::{closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
+use crate::lti::{
+    closed_loop, controller_hinf_grad, hinf_norm, is_stable_with_margin, spectral_abscissa, stability_margin, Plant,
+    DEFAULT_HINF_TOL,
+};
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
 /// them.
@@ -60,21 +65,29 @@ pub enum Verdict {
 /// Re-verifies one record's controller against `plant`.
 pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
     let Some(k) = record.controller() else { return Verdict::Rejected("job failed".into()) };
-    if let Err(e) = k.check_fits(plant) {
-        return Verdict::Rejected(format!("controller does not fit the plant: {e}"));
+    if record.options.order != record.order {
+        return Verdict::Rejected(format!(
+            "the record's order {} differs from its options' order {}",
+            record.order, record.options.order
+        ));
+    }
+    if let Err(e) = k.check_fits_order(plant, record.order) {
+        return Verdict::Rejected(format!("controller does not fit the job: {e}"));
     }
     let cl = match closed_loop(plant, k) {
         Ok(cl) => cl,
         Err(e) => return Verdict::Rejected(format!("closed loop: {e}")),
     };
     let alpha_cl = spectral_abscissa(cl.a.as_ref());
-    if !is_stable(alpha_cl) {
-        return Verdict::Rejected(format!("closed loop not stable (α = {alpha_cl})"));
+    if !is_stable_with_margin(alpha_cl, cl.a.as_ref()) {
+        let margin = stability_margin(cl.a.as_ref());
+        return Verdict::Rejected(format!("closed loop not stable (α = {alpha_cl}, must be below −{margin:.1e})"));
     }
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     if let Some(a) = alpha_k {
-        if !is_stable(a) {
-            return Verdict::Rejected(format!("controller not stable (α_K = {a})"));
+        if !is_stable_with_margin(a, k.ak.as_ref()) {
+            let margin = stability_margin(k.ak.as_ref());
+            return Verdict::Rejected(format!("controller not stable (α_K = {a}, must be below −{margin:.1e})"));
         }
     }
     let gamma = hinf_norm(&cl, DEFAULT_HINF_TOL).value;
@@ -248,9 +261,14 @@ mod tests {
 
     /// ẋ = −x + w + u, z = c·x, y = x: with K = 0, ‖Tzw‖∞ = c.
     fn plant(name: &str, c: f64) -> Arc<Plant> {
+        plant_with_pole(name, -1.0, c)
+    }
+
+    /// ẋ = a·x + w + u, z = c·x, y = x.
+    fn plant_with_pole(name: &str, a: f64, c: f64) -> Arc<Plant> {
         let text = format!(
             r#"{{"name":"{name}","dims":{{"n":1,"m1":1,"m2":1,"p1":1,"p2":1}},
-            "A":[[-1]],"B1":[[1]],"B2":[[1]],"C1":[[{c}]],"C2":[[1]],
+            "A":[[{a:e}]],"B1":[[1]],"B2":[[1]],"C1":[[{c}]],"C2":[[1]],
             "D11":[[0]],"D12":[[0]],"D21":[[0]],"D22":[[0]]}}"#
         );
         Arc::new(Plant::from_json_str(&text, "test.json").unwrap())
@@ -351,5 +369,40 @@ mod tests {
         let rows = best_per_order(&[bad.clone(), good.clone(), bad], &map(&[&p]));
         assert_eq!((rows[0].runs, rows[0].verified, rows[0].failed), (1, 1, 0));
         assert_eq!(rows[0].job_id.as_deref(), Some(good.job_id.0.as_str()));
+    }
+
+    #[test]
+    fn a_closed_loop_inside_the_stability_margin_is_not_verified() {
+        // issue 34 item 7: a closed loop with α = −4.4e-16 was called stable.
+        let p = plant_with_pole("P", -4.4e-16, 1.0);
+        let Verdict::Rejected(why) = verify(&record(&p, "P", 0), &p) else { panic!("α = −4.4e-16 verified") };
+        assert!(why.contains("must be below −1.0e-12"), "{why}");
+        let p = plant_with_pole("P", -1e-9, 1.0);
+        assert!(matches!(verify(&record(&p, "P", 0), &p), Verdict::Verified { .. }));
+    }
+
+    #[test]
+    fn a_controller_of_another_order_than_its_job_is_rejected() {
+        // issue 34 item 4: an order-0 job's record carrying a stable order-2 controller was
+        // re-verified and reported.
+        let p = plant("P", 1.0);
+        let mut rec = record(&p, "P", 0);
+        let JobResult::Designed(o) = &mut rec.result else { unreachable!("a designed record") };
+        o.controller = crate::lti::Controller::zeros(2, 1, 1);
+        o.controller.ak[(0, 0)] = -1.0;
+        o.controller.ak[(1, 1)] = -1.0;
+        let Verdict::Rejected(why) = verify(&rec, &p) else { panic!("accepted an order-2 controller for order 0") };
+        assert!(why.contains("order 2") && why.contains("order is 0"), "{why}");
+        // blocks that disagree with each other (Bk of the wrong height)
+        let mut rec = record(&p, "P", 0);
+        let JobResult::Designed(o) = &mut rec.result else { unreachable!("a designed record") };
+        o.controller.bk = faer::Mat::zeros(1, 1);
+        let Verdict::Rejected(why) = verify(&rec, &p) else { panic!("accepted inconsistent blocks") };
+        assert!(why.contains("BK is 1×1"), "{why}");
+        // the journal's order and its options' order must agree
+        let mut rec = record(&p, "P", 0);
+        rec.order = 2;
+        assert!(matches!(verify(&rec, &p), Verdict::Rejected(_)));
+        assert!(matches!(verify(&record(&p, "P", 0), &p), Verdict::Verified { .. }));
     }
 }

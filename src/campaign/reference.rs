@@ -4,7 +4,8 @@
 //! Columns: `table, plant, method, source, order, gamma, controller`, where `method` is
 //! `literature` (a value the paper quotes from earlier work), `full-order` (the optimal
 //! full-order γ, `hinfsyn`) or `hifoo` (the paper's own result), and `controller` is `stable` or
-//! `unstable` (whether that controller is itself stable).
+//! `unstable` (whether that controller is itself stable). Rows are matched to plants by content
+//! fingerprint, not by name ([`PAPER_PLANT_FINGERPRINTS`]).
 
 use std::path::{Path, PathBuf};
 
@@ -43,6 +44,38 @@ pub struct ReferenceRow {
     /// Whether the reported controller is stable.
     #[serde(rename = "controller", with = "stable_word")]
     pub controller_stable: bool,
+}
+
+/// Content fingerprints ([`crate::lti::Plant::fingerprint`]) of the plants the paper's values
+/// belong to: the shipped files `plants/<name>.json`. A reference row applies to a plant only when
+/// the plant's fingerprint is the entry of the row's name ([`ReferenceRow::is_for`]): a changed
+/// plant that keeps the name `HE1` is not compared with the paper's HE1, and a renamed copy of HE1
+/// still is. Plants the project does not ship (the paper's other problems, `plants/MISSING.md`)
+/// have no entry, so their rows match no plant: their content is unknown.
+/// `tests/plant_files.rs` checks each entry against its shipped file.
+pub const PAPER_PLANT_FINGERPRINTS: [(&str, &str); 8] = [
+    ("AC8", "bbc66d267d01e31e99e260248159cec5f5d27db3d6f6854d533d8602ee0f8fad"),
+    ("HE1", "4822dac1ddd3cc168d3a06071f6a15109a4f86177544dc0261c1f3c897035423"),
+    ("REA2", "c6c6f4f68da5fc1c92ed13067e88e2425565a584b3882076844434b0dfc3ea52"),
+    ("AC10", "e12e880ce104f5ea2933b97d1a98b321d773fc46057a0f73accf5fb8dfe1879d"),
+    ("BDT2", "30fe9cf380550c2a76a4fb087f836388aafff567e640266c271bf23fc97a66a6"),
+    ("HF1", "e81f6aaf6436b9564181dacf1f8cc3a30d5f9cd433985384bf27193e077b9fc7"),
+    ("CM4", "6dc50d37ef732824264d51a8d331ef9b7ac0eb9a14f71f10b99033b1db3fb324"),
+    ("Enns", "675edb773de947baea16efe8dad3ec569d0b0355068e0112318de0b0eaf39240"),
+];
+
+/// The paper's name of the plant with content fingerprint `fingerprint`, if the paper's values
+/// belong to it ([`PAPER_PLANT_FINGERPRINTS`]).
+pub fn paper_plant_name(fingerprint: &str) -> Option<&'static str> {
+    PAPER_PLANT_FINGERPRINTS.iter().find(|(_, fp)| *fp == fingerprint).map(|(name, _)| *name)
+}
+
+impl ReferenceRow {
+    /// Whether this row is a value of the plant with content fingerprint `fingerprint` (never
+    /// decided by the plant's name: see [`PAPER_PLANT_FINGERPRINTS`]).
+    pub fn is_for(&self, fingerprint: &str) -> bool {
+        paper_plant_name(fingerprint) == Some(self.plant.as_str())
+    }
 }
 
 /// The reference table could not be read.

@@ -6,7 +6,25 @@
 //!   would take for a formula (it starts with `=`, `+`, `-`, `@`, tab or carriage return) gets a
 //!   leading `'` (OWASP's advice against CSV injection); quoting is left to the CSV writer;
 //! * [`for_latex`]: control characters are dropped and the LaTeX specials are escaped (every
-//!   LaTeX table goes through it, also as `latex::escape`).
+//!   LaTeX table goes through it, also as `latex::escape`);
+//! * [`as_key`]: a name as an identifier part (a file name, a LaTeX label) of allowed characters
+//!   only, bounded in length, and unique: when the name had to change, a short hash of it is
+//!   appended, so two names never share a key (`X+1` and `X_1` once shared figure files).
+
+/// `name` with every character that `keep` refuses replaced by `replacement` (an allowed ASCII
+/// character). When that changed the name, or it is longer than `max_len` bytes (≥ 9), the result
+/// is cut to `max_len − 9` bytes and `-` plus the first 8 hex digits of the name's SHA-256 is
+/// appended.
+pub fn as_key(name: &str, keep: impl Fn(char) -> bool, replacement: char, max_len: usize) -> String {
+    use sha2::Digest;
+    let clean: String = name.chars().map(|c| if c.is_ascii() && keep(c) { c } else { replacement }).collect();
+    if clean == name && clean.len() <= max_len {
+        return clean;
+    }
+    let hash: String = sha2::Sha256::digest(name.as_bytes())[..4].iter().map(|b| format!("{b:02x}")).collect();
+    // `clean` is ASCII: any byte length is a character boundary.
+    format!("{}-{hash}", &clean[..clean.len().min(max_len.saturating_sub(9))])
+}
 
 /// Whether `c` must not reach an output raw.
 fn is_control(c: char) -> bool {

@@ -168,6 +168,16 @@ pub enum CancelReason {
     Interrupt,
 }
 
+impl CancelReason {
+    /// Why the run stops, in words for the user (the error itself follows from the caller).
+    pub fn describe(self) -> &'static str {
+        match self {
+            CancelReason::CallbackError => "after an error, shown at the end",
+            CancelReason::Interrupt => "interrupted",
+        }
+    }
+}
+
 /// Counts of one `execute` call.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct RunStats {
@@ -187,6 +197,9 @@ pub struct RunStats {
     pub not_started: usize,
     /// Why scheduling stopped early, if it did.
     pub cancel: Option<CancelReason>,
+    /// Warnings of jobs (an observer that failed, e.g. a trace that could not be written on a
+    /// full disk): the job's result is journaled, what the observer wrote is lost.
+    pub warnings: usize,
 }
 
 /// What the scheduler reports. Jobs are named by their index in the `jobs` slice.
@@ -475,6 +488,7 @@ pub fn execute<E>(
                 &mut stats,
             ),
             WorkerMsg::Warning { index, message } => {
+                stats.warnings += 1;
                 emit(Ok(CampaignEvent::Warning { index: Some(index), message }), &mut first_err, &mut stats)
             }
             WorkerMsg::Finished { index, worker, record } => {

@@ -679,8 +679,8 @@ fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, String> {
     if is_path {
         let p = Path::new(arg);
         let p = if p.is_absolute() { p.to_path_buf() } else { base_dir.join(p) };
-        if !p.is_file() {
-            return Err(format!("plant file {} does not exist", p.display()));
+        if let Some(why) = crate::input::not_a_file(&p) {
+            return Err(format!("plant file {} {why}", p.display()));
         }
         Ok(p)
     } else {

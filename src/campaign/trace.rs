@@ -44,7 +44,7 @@ use super::jobs::Job;
 use super::record::JobRecord;
 use super::scheduler::{no_observers, JobObserver, ObserverError};
 use super::trace_filter::{SparseFilter, TraceLevel};
-use crate::design::{DesignIterRecord, Phase};
+use crate::design::DesignIterRecord;
 
 /// Topic of the per-iteration channel.
 pub const ITER_TOPIC: &str = "/hinfix/iterations";
@@ -78,6 +78,14 @@ pub enum TraceError {
         #[source]
         source: mcap::McapError,
     },
+    /// The MCAP reader failed on damaged data (it panicked; the panic was caught).
+    #[error("{}: damaged trace, not readable as MCAP ({message})", path.display())]
+    Damaged {
+        /// The file.
+        path: PathBuf,
+        /// What the reader's panic said.
+        message: String,
+    },
     /// A message is not the JSON this module writes.
     #[error("{}: message {index} on {topic}: {source}", path.display())]
     Json {
@@ -94,13 +102,6 @@ pub enum TraceError {
 }
 
 pub use crate::design::{f64_from_json, f64_to_json as json_f64};
-
-fn phase_name(p: Phase) -> String {
-    match serde_json::to_value(p) {
-        Ok(Value::String(s)) => s,
-        _ => format!("{p:?}"),
-    }
-}
 
 /// Keys of [`ITER_TOPIC`] messages renamed since older builds: (current, old). ‖Tzw‖∞ and ‖K‖∞
 /// have one name each across the crate (docs/ARCHITECTURE.md §5); traces written before the
@@ -119,7 +120,7 @@ pub fn iter_field<'a>(v: &'a Value, key: &str) -> &'a Value {
 /// One iteration as written on [`ITER_TOPIC`].
 pub fn iter_message(rec: &DesignIterRecord) -> Value {
     json!({
-        "phase": phase_name(rec.phase),
+        "phase": rec.phase.name(),
         "start": rec.start,
         "iteration": rec.iter,
         "f": json_f64(rec.f),
@@ -424,21 +425,34 @@ pub struct TraceSummary {
 
 /// Calls `f(topic, sequence number, message)` for every message of the trace at `path`, in file
 /// order.
-fn each_message(path: &Path, mut f: impl FnMut(&str, u32, Value)) -> Result<(), TraceError> {
+fn each_message(path: &Path, f: impl FnMut(&str, u32, Value)) -> Result<(), TraceError> {
     let bytes = crate::input::read_capped(path, crate::input::MAX_TRACE_BYTES, "trace file")
         .map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
-    let stream =
-        mcap::MessageStream::new(&bytes).map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
-    for (index, msg) in stream.enumerate() {
-        let msg = msg.map_err(|source| TraceError::Mcap { path: path.to_path_buf(), source })?;
-        let topic = msg.channel.topic.clone();
-        let v: Value = serde_json::from_slice(&msg.data).map_err(|source| TraceError::Json {
+    each_message_in(&bytes, path, f)
+}
+
+/// [`each_message`] on the bytes of a trace (`path` names it in errors). The `mcap` reader takes
+/// lengths from the file and indexes with them unchecked in places (a trace with 8 bytes
+/// overwritten made it panic), so the parse runs under [`crate::panic_guard::catch_quietly`]:
+/// a panic is [`TraceError::Damaged`], never a crash. The messages are collected first, so `f`
+/// sees none of a file that turns out damaged.
+fn each_message_in(bytes: &[u8], path: &Path, mut f: impl FnMut(&str, u32, Value)) -> Result<(), TraceError> {
+    let mcap_err = |source| TraceError::Mcap { path: path.to_path_buf(), source };
+    let parsed = crate::panic_guard::catch_quietly(|| -> Result<Vec<(String, u32, Vec<u8>)>, mcap::McapError> {
+        mcap::MessageStream::new(bytes)?
+            .map(|m| m.map(|m| (m.channel.topic.clone(), m.sequence, m.data.into_owned())))
+            .collect()
+    })
+    .map_err(|message| TraceError::Damaged { path: path.to_path_buf(), message })?
+    .map_err(mcap_err)?;
+    for (index, (topic, sequence, data)) in parsed.into_iter().enumerate() {
+        let v: Value = serde_json::from_slice(&data).map_err(|source| TraceError::Json {
             path: path.to_path_buf(),
             topic: topic.clone(),
             index,
             source,
         })?;
-        f(&topic, msg.sequence, v);
+        f(&topic, sequence, v);
     }
     Ok(())
 }
@@ -477,6 +491,13 @@ pub fn read_iterations(path: &Path) -> Result<Vec<TraceIteration>, TraceError> {
 
 /// Reads a trace and summarises it.
 pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
+    let bytes = crate::input::read_capped(path, crate::input::MAX_TRACE_BYTES, "trace file")
+        .map_err(|source| TraceError::Io { path: path.to_path_buf(), source })?;
+    summarise_bytes(&bytes, path)
+}
+
+/// [`summarise`] of the bytes of a trace; `path` names it (in the summary and in errors).
+pub fn summarise_bytes(bytes: &[u8], path: &Path) -> Result<TraceSummary, TraceError> {
     let mut s = TraceSummary {
         path: path.to_path_buf(),
         messages: 0,
@@ -493,7 +514,7 @@ pub fn summarise(path: &Path) -> Result<TraceSummary, TraceError> {
         search: None,
     };
     let mut last: Option<(String, u64, u64)> = None; // phase, start, iteration
-    each_message(path, |topic, seq, v| {
+    each_message_in(bytes, path, |topic, seq, v| {
         s.offered = seq as usize + (topic == ITER_TOPIC) as usize;
         if topic == ITER_TOPIC {
             let f = f64_from_json(&v["f"]);

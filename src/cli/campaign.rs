@@ -211,6 +211,14 @@ pub fn run(a: RunArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
         eprintln!("{} job(s) failed: see `campaign status` and the journals in {}", outcome.failed(), l.dir.display());
         return Ok(ExitCode::from(EXIT_JOBS_FAILED));
     }
+    // A trace that could not be written (a full disk) is lost: the run must not look clean.
+    if outcome.stats.warnings > 0 {
+        eprintln!(
+            "error: {} warning(s) above (e.g. traces that could not be written); the jobs' results are journaled",
+            outcome.stats.warnings
+        );
+        return Ok(ExitCode::FAILURE);
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -347,14 +355,21 @@ fn print_shards(l: &Loaded, n: usize, threads: usize) {
         worst = worst.max(wall);
         println!("{:>8} {:>6} {:>10.0} s {:>12.0} s", format!("{}/{n}", k + 1), mine.len(), cpu, wall);
     }
-    let limit = (worst * 1.25 + 600.0).ceil() as u64;
-    println!(
-        "slurm time per task: {}-{:02}:{:02}:{:02}",
-        limit / 86400,
-        limit % 86400 / 3600,
-        limit % 3600 / 60,
-        limit % 60
-    );
+    println!("slurm time per task: {}", slurm_time(worst * 1.25 + 600.0));
+}
+
+/// Longest time limit `status --shards` spells out: 365 days. Beyond it (or with an infinite
+/// `cpumax`) the plan has no meaningful bound, and Slurm's own word for that is used.
+const MAX_SLURM_SECONDS: f64 = 365.0 * 86400.0;
+
+/// A Slurm `--time` value (`D-HH:MM:SS`) for `seconds`, or `UNLIMITED` with the reason when it
+/// is not finite or above [`MAX_SLURM_SECONDS`] (`cpumax = inf` printed 213503982334601 days).
+fn slurm_time(seconds: f64) -> String {
+    if !(seconds <= MAX_SLURM_SECONDS) {
+        return "UNLIMITED (no time bound: a job's cpumax is infinite or the plan exceeds a year)".into();
+    }
+    let limit = seconds.ceil() as u64;
+    format!("{}-{:02}:{:02}:{:02}", limit / 86400, limit % 86400 / 3600, limit % 3600 / 60, limit % 60)
 }
 
 /// The journaled records of this campaign's jobs ([`journaled`]); an error if there are none.
@@ -390,6 +405,13 @@ pub fn plot(a: PlotArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
     for why in &s.skipped {
         eprintln!("skipped: {why}");
     }
+    for why in &s.failed {
+        eprintln!("error: {why}");
+    }
+    if !s.failed.is_empty() {
+        eprintln!("error: {} figure(s) could not be made; the others were written", s.failed.len());
+        return Ok(ExitCode::FAILURE);
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -402,4 +424,18 @@ pub fn trace(a: TraceArgs) -> anyhow::Result<ExitCode> {
         print!("{s}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slurm_time_is_bounded() {
+        // issue 34 item 11: cpumax = inf gave a time of 213503982334601 days.
+        assert_eq!(slurm_time(90061.2), "1-01:01:02");
+        assert!(slurm_time(f64::INFINITY).starts_with("UNLIMITED"));
+        assert!(slurm_time(f64::NAN).starts_with("UNLIMITED"));
+        assert!(slurm_time(1e300).starts_with("UNLIMITED"));
+    }
 }

@@ -16,7 +16,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, is_stable, spectral_abscissa, Controller, Plant, DEFAULT_HINF_TOL,
+    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, stability_margin, Controller, Plant,
+    DEFAULT_HINF_TOL,
 };
 use anyhow::Context;
 use serde_json::{json, Value};
@@ -46,14 +47,17 @@ struct CheckReport {
     gamma: f64,
     peak_freq: f64,
     k_hinf: f64,
+    /// Stability margins (`lti::stability_margin`) of A_cl and Ak: stable means α below minus it.
+    margin_cl: f64,
+    margin_k: f64,
 }
 
 impl CheckReport {
     fn closed_loop_stable(&self) -> bool {
-        is_stable(self.alpha_cl)
+        self.alpha_cl < -self.margin_cl
     }
     fn controller_stable(&self) -> bool {
-        self.alpha_k.is_none_or(is_stable)
+        self.alpha_k.is_none_or(|a| a < -self.margin_k)
     }
 }
 
@@ -82,7 +86,29 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
-    Ok(CheckReport { alpha_cl, alpha_k, gamma: h.value, peak_freq: h.peak_freq, k_hinf: hk.value })
+    let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));
+    let r = CheckReport {
+        alpha_cl,
+        alpha_k,
+        gamma: h.value,
+        peak_freq: h.peak_freq,
+        k_hinf: hk.value,
+        margin_cl,
+        margin_k,
+    };
+    // A stable system has a finite norm: NaN or ∞ here is a computation out of f64's range (a
+    // controller with huge entries; plants are bounded on load), never a result to print.
+    for (what, value, stable) in
+        [("‖Tzw‖∞", r.gamma, r.closed_loop_stable()), ("‖K‖∞", r.k_hinf, r.controller_stable())]
+    {
+        if stable && !value.is_finite() {
+            anyhow::bail!(
+                "{what} of a stable system came out {value}: the plant's and the controller's numbers are out of \
+                 the range the norm can be computed in (see the magnitude limits in campaigns/FORMAT.md)"
+            );
+        }
+    }
+    Ok(r)
 }
 
 use crate::design::f64_to_json as num;
@@ -96,6 +122,8 @@ fn to_json(r: &CheckReport) -> Value {
         "k_hinf": num(r.k_hinf),
         "closed_loop_stable": r.closed_loop_stable(),
         "controller_stable": r.controller_stable(),
+        "closed_loop_stability_margin": num(r.margin_cl),
+        "controller_stability_margin": r.alpha_k.map(|_| num(r.margin_k)),
     })
 }
 
@@ -114,10 +142,22 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         plant.dims.n,
         k.order()
     );
-    s += &format!("closed loop: α(A_cl) = {:+.6e}   {}\n", r.alpha_cl, yes_no(r.closed_loop_stable()));
+    s += &format!(
+        "closed loop: α(A_cl) = {:+.6e}   {} (stable means α < −{:.1e})\n",
+        r.alpha_cl,
+        yes_no(r.closed_loop_stable()),
+        r.margin_cl
+    );
     s += &format!("             ‖Tzw‖∞  = {}   at {}\n", super::fmt_num(r.gamma, 10), freq);
     match r.alpha_k {
-        Some(a) => s += &format!("controller:  α(Ak)    = {:+.6e}   {}\n", a, yes_no(r.controller_stable())),
+        Some(a) => {
+            s += &format!(
+                "controller:  α(Ak)    = {:+.6e}   {} (stable means α < −{:.1e})\n",
+                a,
+                yes_no(r.controller_stable()),
+                r.margin_k
+            )
+        }
         None => s += "controller:  static gain (order 0), trivially stable\n",
     }
     s += &format!("             ‖K‖∞    = {}\n", super::fmt_num(r.k_hinf, 10));
@@ -130,7 +170,15 @@ mod tests {
 
     #[test]
     fn json_keys_and_infinities() {
-        let r = CheckReport { alpha_cl: 0.3, alpha_k: None, gamma: f64::INFINITY, peak_freq: f64::NAN, k_hinf: 1.5 };
+        let r = CheckReport {
+            alpha_cl: 0.3,
+            alpha_k: None,
+            gamma: f64::INFINITY,
+            peak_freq: f64::NAN,
+            k_hinf: 1.5,
+            margin_cl: 1e-12,
+            margin_k: 1e-12,
+        };
         let v = to_json(&r);
         assert_eq!(v["gamma"], json!("inf"));
         assert_eq!(v["k_hinf"], json!(1.5));
@@ -139,7 +187,15 @@ mod tests {
         assert_eq!(v["closed_loop_stable"], json!(false));
         assert_eq!(v["controller_stable"], json!(true));
         assert!(!serde_json::to_string(&v).unwrap().contains("Infinity"));
-        let r = CheckReport { alpha_cl: -0.3, alpha_k: Some(-1.0), gamma: 2.0, peak_freq: f64::INFINITY, k_hinf: 1.5 };
+        let r = CheckReport {
+            alpha_cl: -0.3,
+            alpha_k: Some(-1.0),
+            gamma: 2.0,
+            peak_freq: f64::INFINITY,
+            k_hinf: 1.5,
+            margin_cl: 1e-12,
+            margin_k: 1e-12,
+        };
         assert_eq!(to_json(&r)["closed_loop_peak_freq"], json!("inf"));
     }
 }

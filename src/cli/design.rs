@@ -9,7 +9,8 @@
 //! Every outcome writes the returned controller. Exit codes: 0 for a stabilising controller
 //! (converged, stopped by a limit, budget exhausted, stabilised only), 4 when it is NOT
 //! STABILISED, 130/143/129 after Ctrl-C/SIGTERM/SIGHUP (the run is cancelled; the best
-//! controller so far is still written). `--out` is checked (not a directory, writable) before
+//! controller so far is still written). `--out` is checked (not a directory, writable, with a
+//! probe file of a unique name, so that concurrent runs writing one file do not trip) before
 //! the design starts.
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -34,33 +35,33 @@ pub struct DesignArgs {
     #[arg(long)]
     pub plant: String,
     /// Controller order nk ≥ 0.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub order: usize,
     /// Weight ε of ‖K‖∞ and α(Ak) (strong stabilisation), > 0.
-    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
     pub eps: f64,
     /// Seed of the random starting points.
-    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     pub seed: u64,
     /// Budget of the whole design in CPU seconds (thread CPU time, not wall-clock time; a run
     /// it ends is not reproducible bit for bit).
-    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
     pub cpumax: f64,
     /// Evaluation budget of the whole design (deterministic: same seed, same controller).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_hyphen_values = true)]
     pub maxevals: Option<u64>,
     /// Number of first random starts (HIFOO's nrand), or of perturbations of --init, 1..=10000.
-    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 3, allow_hyphen_values = true)]
     pub nrand: usize,
     /// After the first starts, keep starting local searches (basin hops of the best point and
     /// random starts) until a budget ends the run. The stall rule — this many local searches in
     /// a row have not improved the best objective by --stall-rtol — ends runs without any budget
     /// (--cpumax inf and no --maxevals, --max-starts), or with --stop-on-stall any run once a
     /// stabilising controller is found. 0: HIFOO's search (the first starts only).
-    #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS, allow_negative_numbers = true)]
+    #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS, allow_hyphen_values = true)]
     pub stall_starts: usize,
     /// Relative improvement that resets the stall count.
-    #[arg(long, value_name = "R", default_value_t = 1e-6, allow_negative_numbers = true)]
+    #[arg(long, value_name = "R", default_value_t = 1e-6, allow_hyphen_values = true)]
     pub stall_rtol: f64,
     /// Let the stall rule end the run even when a budget (--cpumax, --maxevals, --max-starts)
     /// bounds it. By default a bounded run spends its budget: once a stabilising controller is
@@ -75,7 +76,7 @@ pub struct DesignArgs {
     /// BFGS iteration limit of the continued search's local searches on the H∞ objective
     /// (HIFOO's first starts keep its 1000); 0: the same 1000. Only local searches on many
     /// variables reach it.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_CONTINUED_MAXIT, allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_CONTINUED_MAXIT, allow_hyphen_values = true)]
     pub continued_maxit: usize,
     /// Keep the whole gradient-sampling reserve (10 % of the budget) to the end. By default
     /// gradient sampling runs on the best controller right after the --nrand first starts (as
@@ -87,19 +88,19 @@ pub struct DesignArgs {
     /// certificate at most this relative amount above the best controller gets gradient sampling
     /// from its end point, so that its basin is judged by a refined value, as the best one's is.
     /// 0: none (the default; 0.03 is the value measured in docs/ALGORITHMS.md §8.3).
-    #[arg(long, value_name = "R", default_value_t = DEFAULT_REFINE_RTOL, allow_negative_numbers = true)]
+    #[arg(long, value_name = "R", default_value_t = DEFAULT_REFINE_RTOL, allow_hyphen_values = true)]
     pub refine_rtol: f64,
     /// Largest number of local searches (first starts included; deterministic).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_hyphen_values = true)]
     pub max_starts: Option<u64>,
     /// Relative sizes of the basin-hopping perturbations of the best point, comma-separated
     /// (one hop per size, then one random start, in turn). "none": random starts only.
-    #[arg(long, value_name = "R,R,...", default_value = "0.01,0.1,1")]
+    #[arg(long, value_name = "R,R,...", default_value = "0.01,0.1,1", allow_hyphen_values = true)]
     pub hop_scales: String,
     /// Scales σ of the continued search's fresh random starts σ·N(0, I), comma-separated, used in
     /// turn (the first --nrand starts are always standard normal). Small scales reach small
     /// gains, which badly scaled plants need to be stabilised.
-    #[arg(long, value_name = "S,S,...", default_value = "1,0.1,0.01")]
+    #[arg(long, value_name = "S,S,...", default_value = "1,0.1,0.01", allow_hyphen_values = true)]
     pub random_scales: String,
     /// Do not make the open-loop start K = 0 (by default one more first start after the random
     /// ones: Bk, Ck, Dk = 0 and Ak a stable diagonal).
@@ -119,7 +120,7 @@ pub struct DesignArgs {
     /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
     /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
     /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.
-    #[arg(long, value_name = "F,F,...", default_value = "1.1,2")]
+    #[arg(long, value_name = "F,F,...", default_value = "1.1,2", allow_hyphen_values = true)]
     pub central_gammas: String,
     /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
     #[arg(long)]
@@ -174,6 +175,18 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
+    // A stabilising result has a finite γ; NaN or ∞ would be a failed computation called success.
+    let stabilising = !matches!(outcome.status, DesignStatus::NotStabilised { .. } | DesignStatus::Interrupted);
+    if stabilising && !(outcome.gamma.is_finite() && outcome.objective.is_finite()) {
+        anyhow::bail!(
+            "designing an order-{} controller for {}: the result's ‖Tzw‖∞ = {} (objective {}) is not finite for a \
+             stable closed loop; the numbers are out of the range the norm can be computed in, no controller written",
+            a.order,
+            for_terminal(&plant.name),
+            outcome.gamma,
+            outcome.objective
+        );
+    }
     if crate::lti::is_mat_path(&a.out) {
         outcome.controller.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
     } else {
@@ -205,22 +218,12 @@ fn parse_scales(text: &str, flag: &str) -> anyhow::Result<Vec<f64>> {
         .collect()
 }
 
-/// `path` can receive the controller: not a directory, and its `.tmp` sibling can be created
-/// (it is removed again).
+/// `path` can receive the controller (`fs_atomic::check_writable`); a directory gets a hint.
 fn check_writable(path: &Path) -> anyhow::Result<()> {
     if path.is_dir() {
         anyhow::bail!("is a directory; give a file name such as {}", path.join("K.json").display());
     }
-    let tmp = tmp_path(path);
-    std::fs::OpenOptions::new().write(true).create(true).truncate(true).open(&tmp)?;
-    std::fs::remove_file(&tmp)?;
-    Ok(())
-}
-
-fn tmp_path(path: &Path) -> PathBuf {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    PathBuf::from(tmp)
+    Ok(crate::fs_atomic::check_writable(path)?)
 }
 
 fn status_text(s: &DesignStatus) -> String {

@@ -39,7 +39,7 @@ impl Summary {
         Summary { name: plant.name.clone(), plant, alpha }
     }
     fn stable(&self) -> bool {
-        lti::is_stable(self.alpha)
+        lti::is_stable_with_margin(self.alpha, self.plant.a.as_ref())
     }
     fn json(&self) -> Value {
         let d = self.plant.dims;
@@ -96,7 +96,10 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
     let s = Summary::new(Plant::load(&path)?);
     let paper_full = load_default_reference()
         .ok()
-        .and_then(|rows| rows.into_iter().find(|r| r.plant == s.name && r.method == RefMethod::FullOrder))
+        .and_then(|rows| {
+            let fp = s.plant.fingerprint();
+            rows.into_iter().find(|r| r.is_for(&fp) && r.method == RefMethod::FullOrder)
+        })
         .map(|r| r.gamma);
     // Above FULL_ORDER_MAX_N the full-order γ takes minutes (and cannot be interrupted): skipped.
     let full = if s.plant.dims.n <= FULL_ORDER_MAX_N {

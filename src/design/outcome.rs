@@ -20,6 +20,17 @@ pub enum Phase {
     GradientSampling,
 }
 
+impl Phase {
+    /// The phase's name as the journal and the traces write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Stabilisation => "stabilisation",
+            Phase::Optimisation => "optimisation",
+            Phase::GradientSampling => "gradient_sampling",
+        }
+    }
+}
+
 /// How a design run ended. Failing to stabilise is an outcome, not an error.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -353,4 +364,16 @@ pub enum InitError {
     /// An entry of Ak, Bk, Ck or Dk is NaN or infinite.
     #[error("has a non-finite entry")]
     NonFinite,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn phase_names_are_the_serialised_ones() {
+        for p in [Phase::Stabilisation, Phase::Optimisation, Phase::GradientSampling] {
+            assert_eq!(serde_json::to_value(p).unwrap(), p.name());
+        }
+    }
 }

@@ -4,7 +4,8 @@
 //! xk' = Ak xk + Bk y,   u = Ck xk + Dk y        (positive feedback u = K y)
 //! ```
 //! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (docs/ALGORITHMS.md §1). The file is a JSON object with
-//! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`).
+//! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`). Any other
+//! key is an error naming it ([`ControllerErrorKind::UnknownKey`]).
 
 use std::path::{Path, PathBuf};
 
@@ -75,6 +76,12 @@ pub enum ControllerErrorKind {
     /// Not an object with AK, BK, CK, DK.
     #[error("the top level must be a JSON object with keys AK, BK, CK, DK")]
     NotObject,
+    /// A key other than AK, BK, CK, DK.
+    #[error("unknown key `{key}` (a controller file holds AK, BK, CK, DK)")]
+    UnknownKey {
+        /// The key as written in the file.
+        key: String,
+    },
     /// A matrix is wrong.
     #[error("matrix `{matrix}` {problem}")]
     Matrix {
@@ -152,6 +159,9 @@ impl Controller {
     /// Reads a controller from a parsed JSON value (`{AK, BK, CK, DK}`).
     pub fn from_json_value(doc: &Value) -> Result<Controller, ControllerErrorKind> {
         let obj = doc.as_object().ok_or(ControllerErrorKind::NotObject)?;
+        if let Some(key) = obj.keys().find(|k| !["AK", "BK", "CK", "DK"].contains(&k.as_str())) {
+            return Err(ControllerErrorKind::UnknownKey { key: key.clone() });
+        }
         let mat = |key: &'static str, r: usize, c: usize| {
             matrix_from_json(obj.get(key), r, c).map_err(|problem| ControllerErrorKind::Matrix { matrix: key, problem })
         };
@@ -182,7 +192,8 @@ impl Controller {
     }
 
     /// Writes the controller to `path`: a MATLAB `.mat` file (`AK BK CK DK`) when the extension is
-    /// `.mat`, else pretty JSON. Written to `<path>.tmp` and renamed, so no reader sees half a file.
+    /// `.mat`, else pretty JSON, atomically (`fs_atomic::write_atomic`: a uniquely named tmp file
+    /// renamed into place), so no reader sees half a file.
     pub fn save(&self, path: impl AsRef<Path>) -> std::io::Result<()> {
         let path = path.as_ref();
         let bytes = if is_mat_path(path) {
@@ -204,18 +215,32 @@ impl Controller {
     }
 
     /// Checks that the controller fits the plant: its outputs are the plant's m2 control inputs
-    /// and its inputs the plant's p2 measurements (Dk is m2 × p2).
+    /// and its inputs the plant's p2 measurements (Dk is m2 × p2), and its four blocks agree on
+    /// the order nk (Ak nk × nk, Bk nk × p2, Ck m2 × nk): the fields are public, so a controller
+    /// need not come from a checked file.
     pub fn check_fits(&self, plant: &super::Plant) -> Result<(), ControllerErrorKind> {
-        if self.outputs() != plant.dims.m2 || self.inputs() != plant.dims.p2 {
+        let (m, p, nk) = (plant.dims.m2, plant.dims.p2, self.order());
+        let blocks = [("AK", &self.ak, (nk, nk)), ("BK", &self.bk, (nk, p)), ("CK", &self.ck, (m, nk))];
+        let mismatch = |problem| Err(ControllerErrorKind::Mismatch { plant: plant.name.clone(), problem });
+        if self.outputs() != m || self.inputs() != p {
+            return mismatch(format!("DK is {}×{}, the plant needs m2×p2 = {m}×{p}", self.outputs(), self.inputs()));
+        }
+        for (name, b, (r, c)) in blocks {
+            if (b.nrows(), b.ncols()) != (r, c) {
+                return mismatch(format!("{name} is {}×{}, order {nk} needs {r}×{c}", b.nrows(), b.ncols()));
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Self::check_fits`], and the order is `order` (a journal record's controller must be of
+    /// its job's order).
+    pub fn check_fits_order(&self, plant: &super::Plant, order: usize) -> Result<(), ControllerErrorKind> {
+        self.check_fits(plant)?;
+        if self.order() != order {
             return Err(ControllerErrorKind::Mismatch {
                 plant: plant.name.clone(),
-                problem: format!(
-                    "DK is {}×{}, the plant needs m2×p2 = {}×{}",
-                    self.outputs(),
-                    self.inputs(),
-                    plant.dims.m2,
-                    plant.dims.p2
-                ),
+                problem: format!("the controller has order {}, the job's order is {order}", self.order()),
             });
         }
         Ok(())
@@ -275,6 +300,15 @@ mod tests {
         assert!(s.contains("`DK` row 1 must be an array") && s.contains("a number"), "{s}");
         let e = Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [], "DK": []}"#, "k.json").unwrap_err();
         assert!(e.to_string().contains("at least one row and one column, found 0×0"), "{e}");
+    }
+
+    #[test]
+    fn unknown_key_is_named() {
+        // issue 34 item 12: a misspelt or unknown key was ignored.
+        let text = r#"{"AK": [], "BK": [], "CK": [[]], "DK": [[1.0]], "Dk": [[2.0]]}"#;
+        let e = Controller::from_json_str(text, "k.json").unwrap_err();
+        assert!(matches!(&e.kind, ControllerErrorKind::UnknownKey { key } if key == "Dk"), "{e}");
+        assert!(e.to_string().contains("unknown key `Dk`"), "{e}");
     }
 
     #[test]

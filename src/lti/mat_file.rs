@@ -5,7 +5,8 @@
 //! designed controller go back.
 //!
 //! Reading uses the `matfile` crate (pure Rust; uncompressed and zlib-compressed variables; it
-//! returns numeric arrays and skips character, cell, struct and sparse variables). No maintained
+//! returns numeric arrays and skips character, cell, struct and sparse variables), after
+//! `mat_inflate` has decompressed the compressed variables within a size limit. No maintained
 //! Rust crate writes MAT-files, so [`write_mat`] is a minimal level-5 writer: a 128-byte header
 //! and one uncompressed `miMATRIX` element per variable (class `mxDOUBLE_CLASS`, 2-D, real),
 //! little-endian, following MathWorks' "MAT-File Format" (level 5) document. MATLAB, Octave and
@@ -78,7 +79,12 @@ pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadEr
     if bytes.get(512..).is_some_and(|b| b.starts_with(b"\x89HDF")) {
         return Err(MatReadError::Format("an HDF5-based v7.3 file".into()));
     }
-    let file = matfile::MatFile::parse(bytes).map_err(|e| MatReadError::Format(e.to_string()))?;
+    let plain = super::mat_inflate::inflate_elements(bytes, super::mat_inflate::MAX_MAT_INFLATED_BYTES)
+        .map_err(MatReadError::Format)?;
+    // The last resort for a parser we do not own: a panic on damaged data is a format error.
+    let file = crate::panic_guard::catch_quietly(|| matfile::MatFile::parse(plain.as_slice()))
+        .map_err(|panic| MatReadError::Format(format!("damaged file: {panic}")))?
+        .map_err(|e| MatReadError::Format(e.to_string()))?;
     let mut out = BTreeMap::new();
     for a in file.arrays() {
         let bad = |problem: String| MatReadError::Variable { name: a.name().to_string(), problem };

@@ -78,6 +78,29 @@ pub enum MatrixJsonError {
         /// Expected columns.
         cols: usize,
     },
+    /// A plant entry larger than [`MAX_PLANT_MAGNITUDE`] in absolute value.
+    #[error(
+        "entry ({row}, {col}) = {value:e} is larger than {MAX_PLANT_MAGNITUDE:e} in absolute value, the limit for \
+         a plant entry (products of such numbers overflow, and the H∞ norm would come out NaN or ∞); rescale the \
+         plant's inputs, outputs or states"
+    )]
+    Magnitude {
+        /// 1-based row.
+        row: usize,
+        /// 1-based column.
+        col: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A non-zero plant matrix whose entries are all below [`MIN_PLANT_MAGNITUDE`].
+    #[error(
+        "is not zero but its largest entry is {largest:e}, below {MIN_PLANT_MAGNITUDE:e} in absolute value (products \
+         of such numbers underflow, and the H∞ norm would come out 0 or ∞); write it as zeros or rescale the plant"
+    )]
+    Negligible {
+        /// Its largest entry's magnitude.
+        largest: f64,
+    },
     /// A number that is not finite.
     #[error("entry ({row}, {col}) is not finite ({value})")]
     NotFinite {
@@ -88,6 +111,38 @@ pub enum MatrixJsonError {
         /// The value.
         value: f64,
     },
+}
+
+/// Largest magnitude of a plant entry: 1e50. The closed loop, the Hamiltonian of the H∞ norm and
+/// its level set multiply entries (γ², B·Bᵀ, C1ᵀC1 and products of three or four of them), so
+/// large entries overflow to ∞ and then NaN: D11 = 1e200 gave γ = NaN, and HE1 with every
+/// matrix scaled by 1e60 (or more) gave γ = ∞ for a stable loop, while scaled by 1e50 its norm
+/// is finite. The bound keeps fourth powers of entries far below f64's 1.8e308.
+pub const MAX_PLANT_MAGNITUDE: f64 = 1e50;
+/// Smallest largest-entry of a non-zero plant matrix: 1e-50, the mirror bound. Single tiny entries
+/// are harmless (CM4's A has entries of 1e-70 next to 1e4), but a matrix made only of them is a
+/// plant on a scale the absolute parts of the stability and norm tests cannot resolve: HE1 scaled
+/// by 1e-140 could not be stabilised, and scaled by 1e-300 it gave γ = ∞ for stable loops.
+pub const MIN_PLANT_MAGNITUDE: f64 = 1e-50;
+
+/// Checks a plant matrix against the magnitude bounds: no entry above [`MAX_PLANT_MAGNITUDE`] (the
+/// first one is named, 1-based), and a non-zero matrix has an entry of at least
+/// [`MIN_PLANT_MAGNITUDE`].
+pub fn check_magnitudes(m: faer::MatRef<'_, f64>) -> Result<(), MatrixJsonError> {
+    let mut largest = 0.0f64;
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            let x = m[(i, j)];
+            if !(x.abs() <= MAX_PLANT_MAGNITUDE) {
+                return Err(MatrixJsonError::Magnitude { row: i + 1, col: j + 1, value: x });
+            }
+            largest = largest.max(x.abs());
+        }
+    }
+    if largest > 0.0 && largest < MIN_PLANT_MAGNITUDE {
+        return Err(MatrixJsonError::Negligible { largest });
+    }
+    Ok(())
 }
 
 pub(crate) fn json_type(v: &Value) -> &'static str {
@@ -196,6 +251,20 @@ mod tests {
         let e = matrix_from_json(Some(&json!([])), usize::MAX, 0).unwrap_err();
         assert!(matches!(e, MatrixJsonError::TooLarge { .. }), "{e}");
         assert_eq!(matrix_from_json(Some(&json!([])), 0, 1000).unwrap().ncols(), 1000);
+    }
+
+    #[test]
+    fn magnitudes_outside_the_bounds_are_named() {
+        // issue 34 item 6: D11 = 1e200 gave γ = NaN with exit 0; scaled plants gave γ = ∞.
+        let m = Mat::from_fn(2, 2, |i, j| [[1.0, 0.0], [-1e200, 1e-300]][i][j]);
+        let e = check_magnitudes(m.as_ref()).unwrap_err();
+        assert_eq!(e, MatrixJsonError::Magnitude { row: 2, col: 1, value: -1e200 });
+        // a tiny entry next to ordinary ones is fine, a matrix of tiny entries is not
+        let m = Mat::from_fn(1, 4, |_, j| [0.0, MAX_PLANT_MAGNITUDE, 1e-300, -MIN_PLANT_MAGNITUDE][j]);
+        check_magnitudes(m.as_ref()).unwrap();
+        let m = Mat::from_fn(1, 2, |_, j| [1e-300, 0.0][j]);
+        assert_eq!(check_magnitudes(m.as_ref()).unwrap_err(), MatrixJsonError::Negligible { largest: 1e-300 });
+        check_magnitudes(Mat::<f64>::zeros(2, 2).as_ref()).unwrap();
     }
 
     #[test]

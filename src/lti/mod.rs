@@ -22,6 +22,7 @@ pub mod kernel_bench;
 mod level_set_pencil;
 mod lyapunov;
 mod mat_file;
+mod mat_inflate;
 mod matrix_json;
 mod plant;
 mod plant_library;
@@ -59,12 +60,15 @@ pub use hinf::{
 pub use interrupt::{Interrupt, Interrupted};
 pub use lyapunov::{lyapunov_residual, solve_lyapunov, stable_antistable_basis, LyapunovError, LYAPUNOV_RESIDUAL_TOL};
 pub use mat_file::{is_mat_path, read_mat_vars, write_mat, MatReadError, MatVar};
-pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError};
+pub use matrix_json::{matrix_from_json, matrix_to_json, MatrixJsonError, MAX_PLANT_MAGNITUDE, MIN_PLANT_MAGNITUDE};
 pub use plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
 pub use plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub(crate) use riccati::balance_scaling;
 pub use riccati::{care_residual, solve_care, CareSolution, RiccatiError};
 pub(crate) use spectral::abscissa_of;
 pub(crate) use spectral::eigenvalues as eigenvalues_of;
-pub use spectral::{is_stable, spectral_abscissa, spectral_abscissa_grad, MIN_EIGVEC_COSINE};
+pub use spectral::{
+    is_stable, is_stable_with_margin, spectral_abscissa, spectral_abscissa_grad, stability_margin, MIN_EIGVEC_COSINE,
+    STABILITY_MARGIN_RTOL,
+};
 pub use state_space::StateSpace;

@@ -9,9 +9,13 @@
 //!
 //! A plant file is a JSON object with `name`, optional `description`, `source` (a citation string
 //! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices
-//! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows. Other keys (`notes`, `check`, …)
-//! are kept as provenance. [`Plant::from_json_str`] validates everything and names the file, the
-//! field and the row/column of the first thing wrong.
+//! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows; optional `notes` and `check` are
+//! kept as provenance, and an optional `order` must equal `dims.n`. No entry may exceed 1e50
+//! in absolute value, and a non-zero matrix needs an entry of 1e-50 or more
+//! (`matrix_json::check_magnitudes`). Any other top-level
+//! key is an error naming it ([`PlantErrorKind::UnknownKey`]): a misspelt `D12` or a key this version does
+//! not know must not be silently ignored. [`Plant::from_json_str`] validates everything and names
+//! the file, the field and the row/column of the first thing wrong.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -22,7 +26,7 @@ use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
 use super::mat_file::{json_number, read_char_var, read_mat_vars, var_to_json, write_mat, MatReadError, MatVar};
-use super::matrix_json::{json_shape, matrix_from_json, MatrixJsonError};
+use super::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
 
 /// Sizes of a generalised plant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -116,6 +120,12 @@ pub enum PlantErrorKind {
         /// Field name.
         field: &'static str,
     },
+    /// A top-level key the plant format does not have.
+    #[error("unknown key `{key}` (a plant file holds {})", PLANT_KEYS.join(", "))]
+    UnknownKey {
+        /// The key as written in the file.
+        key: String,
+    },
     /// A field has the wrong type or an impossible value.
     #[error("field `{field}`: {problem}")]
     BadField {
@@ -159,6 +169,27 @@ pub(crate) const MATRICES: [(&str, &str, &str); 9] = [
     ("D22", "p2", "m2"),
 ];
 
+/// Every top-level key of a plant file: the provenance fields, `dims`, `order` and the nine
+/// matrices.
+pub(crate) const PLANT_KEYS: [&str; 16] = [
+    "name",
+    "description",
+    "source",
+    "notes",
+    "check",
+    "order",
+    "dims",
+    "A",
+    "B1",
+    "B2",
+    "C1",
+    "C2",
+    "D11",
+    "D12",
+    "D21",
+    "D22",
+];
+
 impl Dims {
     fn get(&self, name: &str) -> usize {
         match name {
@@ -181,11 +212,18 @@ impl Plant {
             let err = |kind| PlantError { file: path.to_path_buf(), kind };
             let bytes = crate::input::read_capped(path, crate::input::MAX_PLANT_BYTES, "plant file")
                 .map_err(|e| err(PlantErrorKind::Io(e)))?;
-            return plant_from_mat(&bytes, path).map_err(err);
+            return Self::from_mat_bytes(&bytes, path);
         }
         let text = crate::input::read_capped_string(path, crate::input::MAX_PLANT_BYTES, "plant file")
             .map_err(|e| PlantError { file: path.to_path_buf(), kind: PlantErrorKind::Io(e) })?;
         Self::from_json_str(&text, path)
+    }
+
+    /// Reads and validates a plant from the bytes of a MAT-file; `file` names it in errors, and
+    /// its stem names the plant when the file has no `name` variable.
+    pub fn from_mat_bytes(bytes: &[u8], file: impl AsRef<Path>) -> Result<Plant, PlantError> {
+        let file = file.as_ref();
+        plant_from_mat(bytes, file).map_err(|kind| PlantError { file: file.to_path_buf(), kind })
     }
 
     /// Parses and validates a plant from JSON text; `file` names it in errors.
@@ -198,6 +236,9 @@ impl Plant {
 
     pub(crate) fn from_json_value(doc: &Value) -> Result<Plant, PlantErrorKind> {
         let obj = doc.as_object().ok_or(PlantErrorKind::NotObject)?;
+        if let Some(key) = obj.keys().find(|k| !PLANT_KEYS.contains(&k.as_str())) {
+            return Err(PlantErrorKind::UnknownKey { key: key.clone() });
+        }
         let name = match obj.get("name") {
             None => return Err(PlantErrorKind::MissingField { field: "name" }),
             Some(Value::String(s)) if !s.trim().is_empty() => s.clone(),
@@ -230,6 +271,11 @@ impl Plant {
                     _ => String::new(),
                 };
                 PlantErrorKind::Matrix { matrix: key, problem, hint }
+            })?;
+            check_magnitudes(m.as_ref()).map_err(|problem| PlantErrorKind::Matrix {
+                matrix: key,
+                problem,
+                hint: String::new(),
             })?;
             mats.push(m);
         }

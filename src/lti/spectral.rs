@@ -51,11 +51,36 @@ pub fn spectral_abscissa(a: MatRef<'_, f64>) -> f64 {
 /// The one stability test of the crate. Strict, because α = 0 puts a pole on the imaginary axis:
 /// the system is then not asymptotically stable and its H∞ norm is infinite (or undefined), so a
 /// controller at α = 0 is no stabilising controller. A NaN abscissa (a failed computation) is
-/// not stable. No margin is added: the computed α of a marginal system is what the γ and the
-/// tables report, and the H∞ computation checks its own poles (docs/ALGORITHMS.md §3.1, §5).
+/// not stable. No margin is added: this is the optimiser's test (its objective must not move);
+/// verification and reports use [`is_stable_with_margin`] (docs/ALGORITHMS.md §3.1, §5).
 /// −∞ (an empty matrix, e.g. Ak of an order-0 controller) counts as stable.
 pub fn is_stable(spectral_abscissa: f64) -> bool {
     spectral_abscissa < 0.0
+}
+
+/// Relative stability margin of verification and reporting: 1e-12 (about 4 500 ulps of 1).
+///
+/// The optimiser decides with [`is_stable`] (α < 0, so its objective and its controllers are
+/// what they always were); whatever verifies or reports a controller decides with
+/// [`is_stable_with_margin`]: α < −[`stability_margin`]. A computed abscissa carries a rounding
+/// error of about ε_mach·‖A‖ (more for non-normal matrices), so α = −4.4e-16 on a matrix of norm
+/// 1 is not evidence of stability: the closed loop may have a pole on the imaginary axis. The
+/// margin is far below any damping a design aims at (a stable Ak near the axis costs ε‖K‖∞ ~
+/// 1/|α|), so no real result is refused by it.
+pub const STABILITY_MARGIN_RTOL: f64 = 1e-12;
+
+/// The stability margin of a system matrix `a`: [`STABILITY_MARGIN_RTOL`] · max(1, ‖a‖_F), the
+/// scale of the rounding error of its computed eigenvalues (the Frobenius norm bounds the 2-norm
+/// and costs one pass).
+pub fn stability_margin(a: MatRef<'_, f64>) -> f64 {
+    STABILITY_MARGIN_RTOL * a.norm_l2().max(1.0)
+}
+
+/// Whether a system of state matrix `a` with spectral abscissa `alpha` is stable with the
+/// verification margin: α < −[`stability_margin`]`(a)`. NaN is not stable; −∞ (an empty matrix)
+/// is.
+pub fn is_stable_with_margin(alpha: f64, a: MatRef<'_, f64>) -> bool {
+    alpha < -stability_margin(a)
 }
 
 /// Eigenvalues of a real square matrix; `None` on non-finite input or failure. From n =
@@ -187,6 +212,22 @@ pub fn spectral_abscissa_grad(a: MatRef<'_, f64>) -> Option<(f64, Mat<f64>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_verification_margin_scales_with_the_matrix() {
+        // issue 34 item 7: α = −4.4e-16 was called stable.
+        let one = faer::Mat::from_fn(2, 2, |i, j| if i == j { -1.0 } else { 0.0 });
+        assert!(!is_stable_with_margin(-4.4e-16, one.as_ref()));
+        assert!(is_stable_with_margin(-1e-11, one.as_ref()));
+        assert!(!is_stable_with_margin(f64::NAN, one.as_ref()));
+        let big = faer::Mat::from_fn(1, 1, |_, _| -1e6);
+        assert_eq!(stability_margin(big.as_ref()), 1e-6);
+        assert!(!is_stable_with_margin(-1e-7, big.as_ref()));
+        let empty = faer::Mat::<f64>::zeros(0, 0);
+        assert!(is_stable_with_margin(f64::NEG_INFINITY, empty.as_ref()));
+        // the optimiser's test is unchanged
+        assert!(is_stable(-4.4e-16));
+    }
 
     #[test]
     fn empty_and_nan() {

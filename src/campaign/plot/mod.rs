@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use super::compare::full_order_rows;
 use super::record::JobRecord;
-use super::reduce::{best_per_order, BestRow, PlantMap};
+use super::reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
 use super::reference::{RefMethod, ReferenceRow};
 use super::report::ReportError;
 use super::trace::{read_iterations, TraceError};
@@ -65,33 +65,44 @@ pub enum PlotError {
     },
 }
 
-/// What `campaign plot` wrote, and what it skipped with the reason.
+/// What `campaign plot` wrote, what it skipped with the reason, and what failed.
 #[derive(Debug, Default)]
 pub struct PlotSummary {
     /// Files written.
     pub files: Vec<PathBuf>,
-    /// Figures not drawn (e.g. no trace of the best job), one line each.
+    /// Figures not drawn for want of data (no trace of the best job, a damaged trace), one
+    /// line each.
     pub skipped: Vec<String>,
+    /// Figures that could not be drawn or written (the error), one line each. The other figures
+    /// are still made; `campaign plot` exits non-zero when this is not empty.
+    pub failed: Vec<String>,
 }
 
-/// A plant name as a file-name part: letters, digits, `-`, `_`, `.`; anything else becomes `_`.
+/// Longest plant-name part of a figure's file name, in bytes (a file name must stay well below
+/// the usual 255-byte limit with its prefix, order and extension).
+pub const MAX_FILE_PART: usize = 64;
+
+/// A plant name as a file-name part: letters, digits, `-`, `_`, `.` are kept and anything else
+/// becomes `_`; when that changed the name, or it is longer than [`MAX_FILE_PART`], a short hash
+/// is appended (`sanitise::as_key`), so different names never share figure files (`X+1`
+/// and `X_1` once did) and every name fits.
 pub fn file_part(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect()
+    super::sanitise::as_key(name, |c| c.is_ascii_alphanumeric() || "-_.".contains(c), '_', MAX_FILE_PART)
 }
 
 /// The γ-vs-order figure of each plant in `best`.
 pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<GammaOrderFigure> {
     let full = full_order_rows(best, plants, reference);
-    let mut names: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
+    let mut names: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
     names.dedup();
     names
         .into_iter()
-        .map(|p| {
+        .map(|(p, fp)| {
             let ours =
                 best.iter().filter(|r| r.plant == p && r.gamma.is_finite()).map(|r| (r.order, r.gamma)).collect();
             let mut paper: Vec<(usize, f64)> = reference
                 .iter()
-                .filter(|r| r.plant == p && r.method == RefMethod::Hifoo)
+                .filter(|r| r.is_for(fp) && r.method == RefMethod::Hifoo)
                 .map(|r| (r.order, r.gamma))
                 .collect();
             paper.sort_by_key(|x| x.0);
@@ -102,8 +113,10 @@ pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[Ref
 }
 
 /// Writes every figure of a campaign into `<campaign_dir>/plots/`. Traces are read from
-/// `<campaign_dir>/traces/`; a best job without a trace (or a failed trace read) is skipped with
-/// its reason in the summary, not an error.
+/// `<campaign_dir>/traces/`; a best job without a trace (or with a trace that cannot be read) is
+/// skipped with its reason in the summary, and a figure that cannot be drawn or written is in
+/// its `failed` list: neither stops the other figures. Only a plots folder that cannot be made
+/// is an error.
 pub fn write_plots(
     campaign_dir: &Path,
     records: &[JobRecord],
@@ -114,8 +127,12 @@ pub fn write_plots(
     std::fs::create_dir_all(&dir).map_err(|source| ReportError::Io { path: dir.clone(), source })?;
     let best = best_per_order(records, plants);
     let mut out = PlotSummary::default();
+    let keep = |made: Result<Vec<PathBuf>, PlotError>, out: &mut PlotSummary| match made {
+        Ok(files) => out.files.extend(files),
+        Err(e) => out.failed.push(e.to_string()),
+    };
     for fig in gamma_order_figures(&best, plants, reference) {
-        out.files.extend(write_png_and_svg(&fig, &dir.join(format!("gamma-vs-order_{}", file_part(&fig.plant))))?);
+        keep(write_png_and_svg(&fig, &dir.join(format!("gamma-vs-order_{}", file_part(&fig.plant)))), &mut out);
     }
     for row in &best {
         let tag = format!("{}_nK{}", file_part(&row.plant), row.order);
@@ -135,7 +152,7 @@ pub fn write_plots(
             match read_iterations(&trace) {
                 Ok(iterations) if !iterations.is_empty() => {
                     let fig = ConvergenceFigure { title: format!("convergence: {title}"), iterations };
-                    out.files.extend(write_png_and_svg(&fig, &dir.join(format!("convergence_{tag}")))?);
+                    keep(write_png_and_svg(&fig, &dir.join(format!("convergence_{tag}"))), &mut out);
                 }
                 Ok(_) => out.skipped.push(format!("{}: no iterations in the trace", trace.display())),
                 Err(e) => out.skipped.push(format!("convergence of {tag}: {e}")),
@@ -143,13 +160,18 @@ pub fn write_plots(
         } else {
             out.skipped.push(format!("convergence of {tag}: no trace {}", trace.display()));
         }
-        let (Some(plant), Some(rec)) = (plants.get(&row.plant_fingerprint), records.iter().find(|r| r.job_id.0 == job))
-        else {
-            continue;
-        };
+        let Some(plant) = plants.get(&row.plant_fingerprint) else { continue };
+        // The job's record that re-verified best (the one the row reports), not merely the
+        // first record of the job id: a duplicate may carry another controller.
+        let verified = records.iter().filter(|r| r.job_id.0 == job).filter_map(|r| match verify(r, plant) {
+            Verdict::Verified { gamma, .. } => Some((gamma, r)),
+            Verdict::Rejected(_) => None,
+        });
+        let Some((_, rec)) = verified.min_by(|a, b| a.0.total_cmp(&b.0)) else { continue };
         let Some(k) = rec.controller() else { continue };
-        let fig = sigma_figure(plant, k, format!("σ-plot: {title}"))?;
-        out.files.extend(write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}")))?);
+        let made = sigma_figure(plant, k, format!("σ-plot: {title}"))
+            .and_then(|fig| write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}"))));
+        keep(made, &mut out);
     }
     Ok(out)
 }
@@ -157,4 +179,22 @@ pub fn write_plots(
 /// The σ-plot of `k` on `plant`.
 pub fn sigma_figure(plant: &Plant, k: &Controller, title: String) -> Result<SigmaFigure, PlotError> {
     SigmaFigure::new(plant, k, title.clone()).map_err(|e| PlotError::System { what: title, message: e.to_string() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_parts_are_unique_and_bounded() {
+        assert_eq!(file_part("HE1"), "HE1");
+        assert_eq!(file_part("X_1"), "X_1");
+        let changed = file_part("X+1");
+        assert!(changed.starts_with("X_1-") && changed.len() == 12, "{changed}");
+        assert_ne!(file_part("X+1"), file_part("X*1"));
+        let long = file_part(&"Y".repeat(300));
+        assert_eq!(long.len(), MAX_FILE_PART);
+        assert_ne!(long, file_part(&"Y".repeat(301)));
+        assert!(file_part("ü/..").chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)));
+    }
 }

@@ -1,0 +1,136 @@
+//! Faults of the results folder during `campaign run` (issue 34, items 2 and 11). Item 11: traces
+//! that cannot be written (a full disk) fail the run (exit 1, saying so) though the results are
+//! journaled. Item 2: the journal (or the whole results folder) removed or replaced while
+//! `campaign run` appends to it. The run must notice before its next append, stop with an error
+//! (non-zero exit) naming what happened, and lose no finished record: everything the journal
+//! held and the record that found it gone are in a rescued journal of the folder, which a resume
+//! reads.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Stdio};
+use std::time::{Duration, Instant};
+
+use hinfix::campaign::{journals_in, read_journal, FAKE_RUNNER_ENV};
+
+mod common;
+
+const PLANTS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/plants");
+
+/// Fake jobs of 10 × 30 ms each, two at a time: a record arrives about every 150 ms.
+fn spawn_run(dir: &Path) -> Child {
+    let f = dir.join("c.toml");
+    std::fs::write(&f, "name = \"t\"\n[defaults]\nseeds = 30\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+    std::process::Command::new(common::fake_campaign_bin())
+        .args(["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
+        .args(["--threads", "2"])
+        .env("HINFIX_PLANTS", PLANTS)
+        .env(FAKE_RUNNER_ENV, "30")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn ids_in(path: &Path) -> BTreeSet<String> {
+    read_journal(path).unwrap().records.into_iter().map(|r| r.job_id.0).collect()
+}
+
+/// Waits until the journal holds at least `n` records and returns their ids.
+fn wait_records(journal: &Path, n: usize) -> BTreeSet<String> {
+    let t = Instant::now();
+    loop {
+        let ids = ids_in(journal);
+        if ids.len() >= n {
+            return ids;
+        }
+        assert!(t.elapsed() < Duration::from_secs(60), "the run journaled only {} records", ids.len());
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Every record id in the journals of `folder` (the folder as it is after the run).
+fn remaining(folder: &Path) -> BTreeSet<String> {
+    journals_in(folder).unwrap().iter().flat_map(|j| ids_in(j)).collect()
+}
+
+fn scratch(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hinfix-jfault-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs the campaign, applies `fault` to its folder after 3 records, and checks the run's end.
+fn fault_during_run(tag: &str, what: &str, fault: impl FnOnce(&Path)) {
+    let dir = scratch(tag);
+    let folder = dir.join("r").join("t");
+    let journal = folder.join("runs.jsonl");
+    let child = spawn_run(&dir);
+    let before = wait_records(&journal, 3);
+    fault(&folder);
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{tag}: the run exited 0 after its journal was {what}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stderr.contains(&format!("runs.jsonl: the journal was {what}")), "{tag}: {stderr}");
+    // issue 34 item 11: no internal names (the cancel reason was printed as `CallbackError`)
+    assert!(!stderr.contains("CallbackError"), "{stderr}");
+    assert!(stderr.contains("runs.rescued-") && stderr.contains("which a resume reads"), "{tag}: {stderr}");
+    let after = remaining(&folder);
+    assert!(before.is_subset(&after), "{tag}: finished records lost: {:?}", before.difference(&after));
+    assert!(after.len() > before.len(), "{tag}: the record that found the journal gone was lost");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn journal_deleted_during_a_run_stops_it_and_loses_nothing() {
+    fault_during_run("deleted", "deleted", |folder| std::fs::remove_file(folder.join("runs.jsonl")).unwrap());
+}
+
+#[test]
+fn journal_replaced_during_a_run_stops_it_and_loses_nothing() {
+    fault_during_run("replaced", "replaced by another file", |folder| {
+        let other = folder.join("other");
+        std::fs::write(&other, b"").unwrap();
+        std::fs::rename(&other, folder.join("runs.jsonl")).unwrap();
+    });
+}
+
+#[test]
+fn results_folder_deleted_during_a_run_stops_it_and_loses_nothing() {
+    fault_during_run("folder", "deleted", |folder| {
+        // a trace file being created meanwhile can make one attempt fail with "not empty"
+        for _ in 0..20 {
+            match std::fs::remove_dir_all(folder) {
+                Ok(()) => return,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => return,
+                Err(_) => std::thread::sleep(Duration::from_millis(1)),
+            }
+        }
+        panic!("could not remove {}", folder.display());
+    });
+}
+
+#[test]
+fn traces_that_cannot_be_written_fail_the_run_and_say_so() {
+    // issue 34 item 11: a full disk while writing traces exited 0 and the traces were lost. A
+    // file where the traces folder should be fails every trace the same way.
+    let dir = scratch("traces");
+    let folder = dir.join("r").join("t");
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::write(folder.join("traces"), b"not a folder").unwrap();
+    let f = dir.join("c.toml");
+    std::fs::write(&f, "name = \"t\"\n[defaults]\nseeds = 2\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
+    let out = std::process::Command::new(common::fake_campaign_bin())
+        .args(["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"])
+        .env("HINFIX_PLANTS", PLANTS)
+        .env(FAKE_RUNNER_ENV, "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("warning(s) above") && stderr.contains("traces"), "{stderr}");
+    assert_eq!(ids_in(&folder.join("runs.jsonl")).len(), 2, "the results are journaled");
+    let _ = std::fs::remove_dir_all(&dir);
+}
