@@ -273,19 +273,8 @@ fn a_changed_plant_named_like_a_paper_plant_is_not_compared_with_the_paper() {
     let mut changed = he1.clone();
     changed.a[(0, 0)] += 1e-3;
     let reference = load_default_reference().unwrap();
-    let row = |p: &Plant| BestRow {
-        plant: "HE1".into(),
-        plant_fingerprint: p.fingerprint(),
-        order: 1,
-        gamma: 0.2,
-        job_id: None,
-        eps: None,
-        seed: None,
-        runs: 1,
-        verified: 1,
-        failed: 0,
-        unverified: 0,
-    };
+    let row =
+        |p: &Plant| BestRow { gamma: 0.2, runs: 1, verified: 1, ..BestRow::new("HE1".into(), p.fingerprint(), 1) };
     let rows = compare_rows(&[row(&he1), row(&changed)], &[], &reference);
     assert_eq!(rows[0].paper, 0.1235, "the shipped HE1 is compared with the paper's");
     assert!(rows[1].paper.is_nan() && rows[1].literature.is_empty(), "{:?}", rows[1]);

@@ -41,22 +41,15 @@ fn reference() -> Vec<ReferenceRow> {
 
 fn row(plant: &str, order: usize, gamma: f64) -> BestRow {
     BestRow {
-        plant: plant.into(),
-        plant_fingerprint: fingerprint(plant),
-        order,
         gamma,
         job_id: Some("j".into()),
         eps: Some(1e-3),
         seed: Some(0),
-        k_hinf: Some(10.0),
-        alpha_k: Some(-1.0),
-        cpu_to_best_s: Some(0.5),
-        chain_cpu_to_best_s: Some(0.5),
         runs: 2,
         verified: 1,
         near_best: 1,
         failed: 1,
-        unverified: 0,
+        ..BestRow::new(plant.into(), fingerprint(plant), order)
     }
 }
 

@@ -193,27 +193,9 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
     let mut rows: BTreeMap<(String, usize), (BestRow, Vec<f64>)> = BTreeMap::new();
     for (r, verdict) in per_job.values().map(|(r, v)| (*r, v.clone())) {
         let label = labels[&r.plant_fingerprint].clone();
-        let (row, gammas) = rows.entry((label.clone(), r.order)).or_insert_with(|| {
-            let row = BestRow {
-                plant: label,
-                plant_fingerprint: r.plant_fingerprint.clone(),
-                order: r.order,
-                gamma: f64::NAN,
-                job_id: None,
-                eps: None,
-                seed: None,
-                k_hinf: None,
-                alpha_k: None,
-                cpu_to_best_s: None,
-                chain_cpu_to_best_s: None,
-                runs: 0,
-                verified: 0,
-                near_best: 0,
-                failed: 0,
-                unverified: 0,
-            };
-            (row, Vec::new())
-        });
+        let (row, gammas) = rows
+            .entry((label.clone(), r.order))
+            .or_insert_with(|| (BestRow::new(label, r.plant_fingerprint.clone(), r.order), Vec::new()));
         row.runs += 1;
         match verdict {
             Some(Verdict::Verified { gamma, alpha_k, k_hinf, .. }) => {
@@ -240,6 +222,30 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
             row
         })
         .collect()
+}
+
+impl BestRow {
+    /// The row of a (plant, order) before any record: γ NaN, no best job, every count 0.
+    pub fn new(plant: String, plant_fingerprint: String, order: usize) -> BestRow {
+        BestRow {
+            plant,
+            plant_fingerprint,
+            order,
+            gamma: f64::NAN,
+            job_id: None,
+            eps: None,
+            seed: None,
+            k_hinf: None,
+            alpha_k: None,
+            cpu_to_best_s: None,
+            chain_cpu_to_best_s: None,
+            runs: 0,
+            verified: 0,
+            near_best: 0,
+            failed: 0,
+            unverified: 0,
+        }
+    }
 }
 
 impl Verdict {
