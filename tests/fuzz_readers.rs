@@ -20,7 +20,7 @@ use std::sync::OnceLock;
 use hinfix::campaign::parse_journal;
 use hinfix::campaign::JobRecord;
 use hinfix::campaign::{expand, Campaign, RunnerTag};
-use hinfix::campaign::{summarise_bytes, TraceError, TraceWriter};
+use hinfix::campaign::{summarise_bytes, TraceError, TraceLevel, TraceWriter};
 use hinfix::design::{validate, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats};
 use hinfix::lti::{read_mat_vars, Controller, Plant};
 use proptest::prelude::*;
@@ -389,7 +389,7 @@ fn trace_bytes() -> &'static [u8] {
     static T: OnceLock<Vec<u8>> = OnceLock::new();
     T.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let mut w = TraceWriter::create(dir.path(), "job").unwrap();
+        let mut w = TraceWriter::create(dir.path(), "job", TraceLevel::Full).unwrap();
         for i in 0..30 {
             let x = i as f64;
             w.record_iter(&hinfix::design::DesignIterRecord {
