@@ -438,13 +438,12 @@ fn each_message(path: &Path, f: impl FnMut(&str, u32, Value)) -> Result<(), Trac
 /// sees none of a file that turns out damaged.
 fn each_message_in(bytes: &[u8], path: &Path, mut f: impl FnMut(&str, u32, Value)) -> Result<(), TraceError> {
     let mcap_err = |source| TraceError::Mcap { path: path.to_path_buf(), source };
-    let parsed = crate::panic_guard::catch_quietly(|| -> Result<Vec<(String, u32, Vec<u8>)>, mcap::McapError> {
-        mcap::MessageStream::new(bytes)?
-            .map(|m| m.map(|m| (m.channel.topic.clone(), m.sequence, m.data.into_owned())))
-            .collect()
+    let damaged = |message| TraceError::Damaged { path: path.to_path_buf(), message };
+    let parsed = crate::panic_guard::catch_quietly(|| -> Result<Vec<(String, u32, Vec<u8>)>, TraceError> {
+        check_chunk_sizes(bytes).map_err(damaged)?;
+        read_messages(bytes).map_err(mcap_err)
     })
-    .map_err(|message| TraceError::Damaged { path: path.to_path_buf(), message })?
-    .map_err(mcap_err)?;
+    .map_err(damaged)??;
     for (index, (topic, sequence, data)) in parsed.into_iter().enumerate() {
         let v: Value = serde_json::from_slice(&data).map_err(|source| TraceError::Json {
             path: path.to_path_buf(),
@@ -455,6 +454,68 @@ fn each_message_in(bytes: &[u8], path: &Path, mut f: impl FnMut(&str, u32, Value
         f(&topic, sequence, v);
     }
     Ok(())
+}
+
+/// Refuses a trace whose chunk declares more than [`crate::input::MAX_TRACE_BYTES`] of
+/// uncompressed data: the `mcap` reader allocates the declared size before decompressing, and a
+/// damaged size field (8 bytes overwritten) asked for 2·10¹⁴ bytes, an allocation failure that
+/// aborts the process (no panic to catch). The writer's chunks hold at most about 64 KiB. The
+/// scan reads the records as they are, without decompressing; a record it cannot read makes the
+/// file damaged (the decompressing reader parses chunk headers on a path of its own, and would
+/// trust a size that this scan never reached).
+fn check_chunk_sizes(bytes: &[u8]) -> Result<(), String> {
+    let records = mcap::read::LinearReader::new(bytes).map_err(|e| e.to_string())?;
+    for record in records {
+        match record {
+            Ok(mcap::records::Record::Chunk { header, .. })
+                if header.uncompressed_size > crate::input::MAX_TRACE_BYTES =>
+            {
+                return Err(format!(
+                    "a chunk declares {} uncompressed bytes, more than the trace limit of {}",
+                    header.uncompressed_size,
+                    crate::input::MAX_TRACE_BYTES
+                ));
+            }
+            Ok(_) => {}
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    Ok(())
+}
+
+/// The trace's messages as (topic, sequence number, data), in file order, with every record's
+/// length bounded by [`crate::input::MAX_TRACE_BYTES`] — inside decompressed chunks too, where
+/// `mcap::MessageStream` sets no bound and reserves whatever length a damaged record declares
+/// (8·10¹⁸ bytes from garbage that zstd decoded: an allocation failure, which aborts).
+fn read_messages(bytes: &[u8]) -> Result<Vec<(String, u32, Vec<u8>)>, mcap::McapError> {
+    use mcap::records::Record;
+    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+    let limit = usize::try_from(crate::input::MAX_TRACE_BYTES).unwrap_or(usize::MAX);
+    let mut reader = LinearReader::new_with_options(LinearReaderOptions::default().with_record_length_limit(limit));
+    let (mut rest, mut topics, mut out) = (bytes, BTreeMap::new(), Vec::new());
+    while let Some(event) = reader.next_event() {
+        match event? {
+            LinearReadEvent::ReadRequest(need) => {
+                let len = need.min(rest.len());
+                reader.insert(len).copy_from_slice(&rest[..len]);
+                reader.notify_read(len);
+                rest = &rest[len..];
+            }
+            LinearReadEvent::Record { data, opcode } => match mcap::parse_record(opcode, data)? {
+                Record::Channel(c) => {
+                    topics.insert(c.id, c.topic);
+                }
+                Record::Message { header, data } => {
+                    let topic = topics
+                        .get(&header.channel_id)
+                        .ok_or(mcap::McapError::UnknownChannel(header.sequence, header.channel_id))?;
+                    out.push((topic.clone(), header.sequence, data.into_owned()));
+                }
+                _ => {}
+            },
+        }
+    }
+    Ok(out)
 }
 
 /// One [`ITER_TOPIC`] message, as read back (the fields the convergence plot needs).
