@@ -90,7 +90,7 @@ def main():
                         return fmt.format(float(row[key]))
                     except ValueError:
                         return "–"
-                ours, paper, ratio = num("ours", "{:.4g}"), num("paper", "{:.4g}"), num("ratio", "{:.4f}")
+                ours, paper, ratio = num("ours", "{:#.4g}"), num("paper", "{:#.4g}"), num("ratio", "{:.4f}")
                 print(f"| {row['plant']} | {row['order']} | {ours} | {paper} | {ratio} |")
 
 
