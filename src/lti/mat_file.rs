@@ -93,7 +93,7 @@ pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadEr
         }
         let data = real_f64(a.data()).ok_or_else(|| bad("is complex; a matrix here must be real".into()))?;
         let (rows, cols) = (a.size()[0], a.size()[1]);
-        if data.len() != rows * cols {
+        if rows.checked_mul(cols) != Some(data.len()) {
             return Err(bad(format!("holds {} entries for a {rows}×{cols} array", data.len())));
         }
         out.insert(a.name().to_string(), MatVar { rows, cols, data });
