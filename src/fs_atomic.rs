@@ -130,7 +130,7 @@ mod tests {
 
     #[test]
     fn concurrent_writers_of_one_file_all_succeed() {
-        // issue 34 item 10: `design --out` probed `<out>.tmp`, one name for every writer; two
+        // `design --out` probed `<out>.tmp`, one name for every writer; two
         // runs at once deleted each other's probe and one failed (about 1 in 8).
         let d = scratch("concurrent");
         let p = d.join("K.json");

@@ -115,7 +115,7 @@ mod tests {
 
     #[test]
     fn a_byte_order_mark_is_dropped_and_non_files_are_named() {
-        // issue 34 item 11: a BOM made the JSON error unclear; a directory or /dev/zero as a plant
+        // A BOM made the JSON error unclear; a directory or /dev/zero as a plant
         // was said not to exist.
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("f.json");

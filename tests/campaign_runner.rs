@@ -97,14 +97,21 @@ fn kill_minus_nine_at_random_moments_then_resume_equals_an_uninterrupted_run() {
     assert_eq!(journal(&killed), expected);
 }
 
-#[test]
-fn torn_last_line_is_reported_ignored_and_cut_off() {
-    let dir = scratch("torn");
+/// A one-seed fake campaign run to its end in a scratch folder `tag`: the campaign file, the
+/// results folder, the journal's path and its bytes.
+fn finished_fake_campaign(tag: &str) -> (PathBuf, PathBuf, PathBuf, Vec<u8>) {
+    let dir = scratch(tag);
     let file = campaign_file(&dir, 5.0, 1);
     let results = dir.join("r");
     run_to_end(&file, &results, true);
     let path = results.join("t").join("runs.jsonl");
     let complete = std::fs::read(&path).unwrap();
+    (file, results, path, complete)
+}
+
+#[test]
+fn torn_last_line_is_reported_ignored_and_cut_off() {
+    let (file, results, path, complete) = finished_fake_campaign("torn");
     let lines: Vec<&[u8]> = complete.split_inclusive(|&b| b == b'\n').collect();
     // Drop the last record and leave half of it, as a kill in mid-write would.
     let last = lines[lines.len() - 1];
@@ -123,13 +130,8 @@ fn torn_last_line_is_reported_ignored_and_cut_off() {
 
 #[test]
 fn whole_last_record_without_newline_is_kept_not_cut() {
-    // issue 34 item 3: a valid last record lacking only its newline was taken for torn and cut.
-    let dir = scratch("nonl");
-    let file = campaign_file(&dir, 5.0, 1);
-    let results = dir.join("r");
-    run_to_end(&file, &results, true);
-    let path = results.join("t").join("runs.jsonl");
-    let complete = std::fs::read(&path).unwrap();
+    // A valid last record lacking only its newline was taken for torn and cut.
+    let (file, results, path, complete) = finished_fake_campaign("nonl");
     let n = complete.iter().filter(|&&b| b == b'\n').count();
     std::fs::write(&path, &complete[..complete.len() - 1]).unwrap();
     let read = read_journal(&path).unwrap();

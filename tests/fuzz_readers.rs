@@ -1,4 +1,4 @@
-//! Property-based fuzzing of every reader of outside input (issue 15, item 10; issue 34, item 1):
+//! Property-based fuzzing of every reader of outside input:
 //! the plant and controller JSON readers, the campaign-file reader, the journal reader, the MCAP
 //! trace reader (mutations of a real trace), the MAT-file reader (mutations of real plant files,
 //! plain and compressed), and `design::validate`. The property is always the same: any input gives `Ok` or a clear `Err`,
@@ -529,7 +529,7 @@ fn all(cases: u32) -> Vec<(&'static str, Counts)> {
 
 #[test]
 fn trace_with_eight_bytes_overwritten_anywhere_is_an_error_not_a_panic() {
-    // issue 34 item 1: a real trace with 8 bytes overwritten made the mcap reader panic (slice
+    // A real trace with 8 bytes overwritten made the mcap reader panic (slice
     // index out of range), and `campaign trace` exit 101. Every offset, three fillers.
     let good = trace_bytes();
     assert!(summarise_bytes(good, Path::new("t.mcap")).unwrap().iterations > 0);

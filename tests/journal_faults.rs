@@ -1,6 +1,5 @@
-//! Faults of the results folder during `campaign run` (issue 34, items 2 and 11). Item 11: traces
-//! that cannot be written (a full disk) fail the run (exit 1, saying so) though the results are
-//! journaled. Item 2: the journal (or the whole results folder) removed or replaced while
+//! Faults of the results folder during `campaign run`. Traces that cannot be written (a full
+//! disk) fail the run (exit 1, saying so) though the results are journaled. The journal (or the whole results folder) removed or replaced while
 //! `campaign run` appends to it. The run must notice before its next append, stop with an error
 //! (non-zero exit) naming what happened, and lose no finished record: everything the journal
 //! held and the record that found it gone are in a rescued journal of the folder, which a resume
@@ -74,7 +73,7 @@ fn fault_during_run(tag: &str, what: &str, fault: impl FnOnce(&Path)) {
     assert!(!out.status.success(), "{tag}: the run exited 0 after its journal was {what}: {stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(stderr.contains(&format!("runs.jsonl: the journal was {what}")), "{tag}: {stderr}");
-    // issue 34 item 11: no internal names (the cancel reason was printed as `CallbackError`)
+    // No internal names (the cancel reason was printed as `CallbackError`)
     assert!(!stderr.contains("CallbackError"), "{stderr}");
     assert!(stderr.contains("runs.rescued-") && stderr.contains("which a resume reads"), "{tag}: {stderr}");
     let after = remaining(&folder);
@@ -114,7 +113,7 @@ fn results_folder_deleted_during_a_run_stops_it_and_loses_nothing() {
 
 #[test]
 fn traces_that_cannot_be_written_fail_the_run_and_say_so() {
-    // issue 34 item 11: a full disk while writing traces exited 0 and the traces were lost. A
+    // A full disk while writing traces exited 0 and the traces were lost. A
     // file where the traces folder should be fails every trace the same way.
     let dir = scratch("traces");
     let folder = dir.join("r").join("t");

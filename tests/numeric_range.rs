@@ -1,5 +1,5 @@
-//! Issue 34, items 6 and 7: numbers at the edges of what can be computed. Item 7: a closed loop
-//! is stable only with a margin (α < −1e-12 · max(1, ‖A_cl‖_F)). Item 6: numbers out of the
+//! Numbers at the edges of what can be computed. A closed loop is stable only with a margin
+//! (α < −1e-12 · max(1, ‖A_cl‖_F)). Numbers out of the
 //! range the norm can be computed in are a clear error with
 //! a non-zero exit, never a NaN or ∞ result called success. Plant entries are bounded on load
 //! (at most `MAX_PLANT_MAGNITUDE`; a non-zero matrix needs an entry of `MIN_PLANT_MAGNITUDE` or
@@ -99,7 +99,7 @@ fn design_and_check_never_call_a_nan_result_success() {
 
 #[test]
 fn check_calls_a_loop_within_the_margin_unstable() {
-    // issue 34 item 7: α = −4.4e-16 was called stable.
+    // Α = −4.4e-16 was called stable.
     let dir = tempfile::tempdir().unwrap();
     let plant = dir.path().join("edge.json");
     let doc = serde_json::json!({

@@ -233,7 +233,7 @@ fn unknown_name_lists_the_library() {
 
 #[test]
 fn unknown_top_level_key_is_rejected_by_name() {
-    // issue 34 item 12: a misspelt matrix (`d12`) or a key this version does not know was ignored.
+    // A misspelt matrix (`d12`) or a key this version does not know was ignored.
     for key in ["d12", "Ts", "comment"] {
         let text = with(|o| {
             o.insert(key.into(), json!(1));
@@ -254,7 +254,7 @@ fn unknown_top_level_key_is_rejected_by_name() {
 
 #[test]
 fn each_shipped_plant_has_its_fingerprint_in_the_reference_table() {
-    // issue 34 item 5: the paper's values are matched by content fingerprint, not by name.
+    // The paper's values are matched by content fingerprint, not by name.
     let table = hinfix::campaign::PAPER_PLANT_FINGERPRINTS;
     let shipped = hinfix::lti::shipped_plants().unwrap();
     assert_eq!(table.len(), shipped.len());

@@ -89,7 +89,7 @@ fn every_figure_kind_is_rendered_for_a_small_real_campaign() {
     let svg = std::fs::read_to_string(plots.join("convergence_REA2_nK1.svg")).unwrap();
     assert!(svg.contains("CPU time (s)"), "convergence x axis");
 
-    // issue 34 item 1: a trace with 8 bytes overwritten made the MCAP reader panic, so `campaign
+    // A trace with 8 bytes overwritten made the MCAP reader panic, so `campaign
     // trace` exited 101 and `campaign plot` died. Damage the order-1 trace where the reader
     // panics (found with the library, so the test keeps hitting that path).
     let traces: Vec<PathBuf> =
@@ -142,7 +142,7 @@ fn tiny_plant(dir: &Path, file: &str, name: &str, c: f64) -> PathBuf {
 
 #[test]
 fn plant_names_never_share_or_overflow_figure_files() {
-    // issue 34 item 9: plants "X+1" and "X_1" wrote the same figure files, and a 300-character
+    // Plants "X+1" and "X_1" wrote the same figure files, and a 300-character
     // name failed with "File name too long" and stopped the later figures.
     let dir = tempfile::tempdir().unwrap();
     let long = "Y".repeat(300);

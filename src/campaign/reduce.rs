@@ -191,14 +191,14 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
         Some(total)
     };
     let mut rows: BTreeMap<(String, usize), (BestRow, Vec<f64>)> = BTreeMap::new();
-    for (r, verdict) in per_job.values().map(|(r, v)| (*r, v.clone())) {
+    for &(r, ref verdict) in per_job.values() {
         let label = labels[&r.plant_fingerprint].clone();
         let (row, gammas) = rows
             .entry((label.clone(), r.order))
             .or_insert_with(|| (BestRow::new(label, r.plant_fingerprint.clone(), r.order), Vec::new()));
         row.runs += 1;
         match verdict {
-            Some(Verdict::Verified { gamma, alpha_k, k_hinf, .. }) => {
+            &Some(Verdict::Verified { gamma, alpha_k, k_hinf, .. }) => {
                 row.verified += 1;
                 gammas.push(gamma);
                 if !(gamma >= row.gamma) {
@@ -379,7 +379,7 @@ mod tests {
 
     #[test]
     fn a_closed_loop_inside_the_stability_margin_is_not_verified() {
-        // issue 34 item 7: a closed loop with α = −4.4e-16 was called stable.
+        // A closed loop with α = −4.4e-16 was called stable.
         let p = plant_with_pole("P", -4.4e-16, 1.0);
         let Verdict::Rejected(why) = verify(&record(&p, "P", 0), &p) else { panic!("α = −4.4e-16 verified") };
         assert!(why.contains("must be below −1.0e-12"), "{why}");
@@ -389,7 +389,7 @@ mod tests {
 
     #[test]
     fn a_controller_of_another_order_than_its_job_is_rejected() {
-        // issue 34 item 4: an order-0 job's record carrying a stable order-2 controller was
+        // An order-0 job's record carrying a stable order-2 controller was
         // re-verified and reported.
         let p = plant("P", 1.0);
         let mut rec = record(&p, "P", 0);

@@ -432,7 +432,7 @@ mod tests {
 
     #[test]
     fn slurm_time_is_bounded() {
-        // issue 34 item 11: cpumax = inf gave a time of 213503982334601 days.
+        // Cpumax = inf gave a time of 213503982334601 days.
         assert_eq!(slurm_time(90061.2), "1-01:01:02");
         assert!(slurm_time(f64::INFINITY).starts_with("UNLIMITED"));
         assert!(slurm_time(f64::NAN).starts_with("UNLIMITED"));

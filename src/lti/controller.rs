@@ -304,7 +304,7 @@ mod tests {
 
     #[test]
     fn unknown_key_is_named() {
-        // issue 34 item 12: a misspelt or unknown key was ignored.
+        // A misspelt or unknown key was ignored.
         let text = r#"{"AK": [], "BK": [], "CK": [[]], "DK": [[1.0]], "Dk": [[2.0]]}"#;
         let e = Controller::from_json_str(text, "k.json").unwrap_err();
         assert!(matches!(&e.kind, ControllerErrorKind::UnknownKey { key } if key == "Dk"), "{e}");

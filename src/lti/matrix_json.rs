@@ -255,7 +255,7 @@ mod tests {
 
     #[test]
     fn magnitudes_outside_the_bounds_are_named() {
-        // issue 34 item 6: D11 = 1e200 gave γ = NaN with exit 0; scaled plants gave γ = ∞.
+        // D11 = 1e200 gave γ = NaN with exit 0; scaled plants gave γ = ∞.
         let m = Mat::from_fn(2, 2, |i, j| [[1.0, 0.0], [-1e200, 1e-300]][i][j]);
         let e = check_magnitudes(m.as_ref()).unwrap_err();
         assert_eq!(e, MatrixJsonError::Magnitude { row: 2, col: 1, value: -1e200 });

@@ -215,7 +215,7 @@ mod tests {
 
     #[test]
     fn the_verification_margin_scales_with_the_matrix() {
-        // issue 34 item 7: α = −4.4e-16 was called stable.
+        // Α = −4.4e-16 was called stable.
         let one = faer::Mat::from_fn(2, 2, |i, j| if i == j { -1.0 } else { 0.0 });
         assert!(!is_stable_with_margin(-4.4e-16, one.as_ref()));
         assert!(is_stable_with_margin(-1e-11, one.as_ref()));
