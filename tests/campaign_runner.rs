@@ -167,7 +167,7 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     assert_eq!(traces.len(), 1);
     assert_eq!(traces[0].extension().unwrap(), "mcap");
     let s = summarise(&traces[0]).unwrap();
-    // The trace counts steps as the journal does (issue 15: 3 313 against 3 306); the starting
+    // The trace counts steps as the journal does (they once differed: 3 313 against 3 306); the starting
     // points of every local search (f_s and f_h) and of the final gradient sampling are extra
     // messages.
     let search = designed.search.clone();

@@ -16,7 +16,7 @@
 //! `cargo test --release --test hinf_property -- --ignored --nocapture`, which prints the counts
 //! and the worst relative error.
 //!
-//! A second, large-order family ([`member_large`], issue 13) covers n = 30…60, where the level-set
+//! A second, large-order family ([`member_large`]) covers n = 30…60, where the level-set
 //! test takes Van Loan's squared spectrum, with hard shapes (modes spread over seven decades, two
 //! nearly equal peaks, a dominant peak near ω = 0 or at high ω); its warm-started norm is hinted
 //! at the best lower local peak. Fast subset in `cargo test`; full family (1500 systems) ignored.

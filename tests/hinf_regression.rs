@@ -15,7 +15,7 @@ fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/hinf-regression").join(name)
 }
 
-/// Plant "my3" with a second-order controller (issue 13): σmax(D_cl) = 1.8446145 lies 4.2e-6
+/// Plant "my3" with a second-order controller: σmax(D_cl) = 1.8446145 lies 4.2e-6
 /// (relative) below the peak 1.8446223 at 7.3665 rad/s, and a lower local maximum 1.8446154 at
 /// 0.833 rad/s. The norm used to stop at the local maximum: the level-set test at that level has
 /// κ = γ²/(γ² − σmax(D)²) ≈ 1e6. The reference peak was located with numpy/scipy (dense solves on
@@ -32,7 +32,7 @@ fn my3_with_second_order_controller_reaches_the_true_peak() {
 }
 
 /// COMPleib NN5 (v1.1, not a shipped plant) with a first-order controller from a design run
-/// (issue 12's COMPleib check): σmax(T(iω)) rises from 238.9220 at ω = 0 to the peak 238.9575 at
+/// (a check of designs on held-out COMPleib entries): σmax(T(iω)) rises from 238.9220 at ω = 0 to the peak 238.9575 at
 /// ω = 0.0548. At the level (1 + tol)·σ(0) the crossing just above ω = 0 was lost (one crossing
 /// found, at 0.0808), the interval [0, 0.0808] was never evaluated, and the norm came out
 /// 238.9220, 1.5e-4 low. Reference: SLICOT AB13DD (python-control 0.10.2 / slycot 0.7.1,
@@ -77,7 +77,7 @@ fn assert_closed_loop_reaches_peak(
 }
 
 /// Closed loops of COMPleib AC4 with second-order controllers, met in one design run (ε = 1e-3,
-/// seed 1, max_starts 44, issue 12's COMPleib check), where the norm warm-started at the previous
+/// seed 1, max_starts 44, a check on held-out COMPleib entries), where the norm warm-started at the previous
 /// peak (the design objective's path) came out low by 9e-6 to 6.6e-4 (`old_warm_value` in the
 /// fixture): started on a hinted local peak, the level-set test missed the slightly higher true
 /// peak. Reference: SLICOT AB13DD on each closed loop (tol 1e-12), re-checked by dense evaluation.
@@ -86,7 +86,7 @@ fn ac4_warm_started_norms_reach_the_true_peak() {
     assert_cases_reach_reference("ac4_warm_cases.json", 5, 5e-6);
 }
 
-/// Systems of order 30 to 59 (the squared level-set path, issue 13) from the large-order property
+/// Systems of order 30 to 59 (the squared level-set path) from the large-order property
 /// family, on which the cold or the hinted norm came out low by 2.7e-4 to 2.8e-2: the squared
 /// spectrum lost the crossings of narrow low-frequency peaks (seeds 323, 243, 850, 15) or placed
 /// them at the wrong frequency (1588), and the pencil's crossing mapped to ω = ∞ hid a peak at
@@ -100,7 +100,7 @@ fn large_order_norms_reach_the_true_peak() {
 /// A system of order 45 from the large-order property family (seed 2313) on which the norm hinted
 /// at the runner-up peak came out 1.1e-6 low: at the level (1 + tol)·γ_L of that peak the true
 /// peak's two crossings were a near-tangent pair that rounding split off the imaginary axis by
-/// three times the axis threshold, so the squared spectrum reported none (issue 13). Eigenvalues
+/// three times the axis threshold, so the squared spectrum reported none. Eigenvalues
 /// that close to the axis are now probed. Reference: the family's modal sweep truth.
 #[test]
 fn near_tangent_crossings_split_off_the_axis_are_probed() {

@@ -1,4 +1,4 @@
-//! Budget and cancellation inside one evaluation (issue 15, item 4): the stop hook
+//! Budget and cancellation inside one evaluation: the stop hook
 //! (`lti::Interrupt`) is polled inside the H∞ norm, an interrupted evaluation yields no value, and
 //! the optimiser then stops with its honest reason, keeping the last completed value.
 //!

@@ -1,4 +1,4 @@
-//! `Objective::eval_below` (issue 13): an objective may reject a line-search trial point by a
+//! `Objective::eval_below`: an objective may reject a line-search trial point by a
 //! lower bound that already fails the Armijo condition. The rejection must be exact — the
 //! optimiser takes bit-for-bit the same path as with the full evaluation — and it must happen.
 

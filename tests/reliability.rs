@@ -1,5 +1,6 @@
-//! Regression tests of issue 15 (reliability): every bad input a clear error, a journal always
-//! readable, honest statuses and exit codes. One test (or more) per numbered item of the issue.
+//! Reliability at the edges: every bad input a clear error, a journal always readable, honest
+//! statuses and exit codes, signals that stop a run cleanly. Grouped by theme (the section
+//! comments below).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -115,7 +116,7 @@ fn same(a: f64, b: f64) -> bool {
 }
 
 #[test]
-fn item1_non_finite_values_in_every_numeric_field_round_trip_through_the_journal() {
+fn non_finite_values_in_every_numeric_field_round_trip_through_the_journal() {
     let dir = scratch("nonfinite");
     let path = dir.join("runs.jsonl");
     let (mut w, _) = hinfix::campaign::JournalWriter::open(&path).unwrap();
@@ -174,7 +175,7 @@ fn replace_floats(v: &mut Value, with: &Value) {
 }
 
 #[test]
-fn item1_every_float_field_of_a_record_takes_the_string_form_and_null() {
+fn every_float_field_of_a_record_takes_the_string_form_and_null() {
     // Catches a float field added later without the one serialisation path: such a field would
     // refuse "inf" here.
     let base = serde_json::to_value(all_floats(0.5)).unwrap();
@@ -187,8 +188,8 @@ fn item1_every_float_field_of_a_record_takes_the_string_form_and_null() {
 }
 
 #[test]
-fn item1_old_journal_with_nulls_reads_and_a_corrupt_complete_last_line_is_not_deleted() {
-    // The line of issue 15: eps = 1e300 made ε‖K‖∞ = inf → objective null, dnorm null.
+fn old_journal_with_nulls_reads_and_a_corrupt_complete_last_line_is_not_deleted() {
+    // A line a design with eps = 1e300 wrote: made ε‖K‖∞ = inf → objective null, dnorm null.
     let mut v = serde_json::to_value(all_floats(0.5)).unwrap();
     replace_floats(&mut v, &Value::Null);
     let line = v.to_string();
@@ -209,10 +210,10 @@ fn item1_old_journal_with_nulls_reads_and_a_corrupt_complete_last_line_is_not_de
 }
 
 // ---------------------------------------------------------------------------------------------
-// 2. Bounded counts, 3. one validation
+// 2. Bounded counts and one validation
 
 #[test]
-fn item2_huge_counts_are_clear_errors() {
+fn huge_counts_are_clear_errors() {
     let cases: &[(&str, &str)] = &[
         ("orders = { from = -9223372036854775808, to = 0 }", "0..=200"),
         ("orders = { from = 0, to = 9223372036854775807 }", "0..=200"),
@@ -259,7 +260,7 @@ fn item2_huge_counts_are_clear_errors() {
 }
 
 #[test]
-fn item3_campaign_check_calls_design_validate_before_any_job() {
+fn campaign_check_calls_design_validate_before_any_job() {
     let cases: &[(&str, &str, usize)] = &[
         ("orders = [9]", "exceeds the plant order n = 4", 5),
         ("orders = [1]\nhinf_tol = 1e-15", "hinf_tol", 6),
@@ -293,10 +294,10 @@ fn item3_campaign_check_calls_design_validate_before_any_job() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 4. Input size
+// 3. Input size
 
 #[test]
-fn item4_dev_zero_as_any_input_is_a_clear_error() {
+fn dev_zero_as_any_input_is_a_clear_error() {
     if !Path::new("/dev/zero").exists() {
         return;
     }
@@ -310,13 +311,11 @@ fn item4_dev_zero_as_any_input_is_a_clear_error() {
         vec!["design", "--plant", "/dev/zero", "--order", "1", "--out", out.to_str().unwrap()],
     ];
     for args in runs {
-        let t = Instant::now();
         let (code, _, err) = output(&mut cli(&args));
         assert_eq!(code, Some(1), "{args:?}: {err}");
         assert!(err.contains("limit for a"), "{args:?}: {err}");
         assert!(err.contains("/dev/zero"), "{args:?}: {err}");
         assert_no_panic(&err);
-        assert!(t.elapsed() < Duration::from_secs(60), "{args:?} took {:?}", t.elapsed());
     }
 }
 
@@ -350,7 +349,7 @@ fn big_plant(dir: &Path, n: usize) -> PathBuf {
 }
 
 #[test]
-fn item4_full_order_gamma_is_skipped_above_the_documented_n() {
+fn full_order_gamma_is_skipped_above_the_documented_n() {
     let dir = scratch("bigplant");
     let p = big_plant(&dir, hinfix::campaign::FULL_ORDER_MAX_N + 1);
     let (code, out, err) = output(&mut cli(&["plant", p.to_str().unwrap()]));
@@ -359,7 +358,7 @@ fn item4_full_order_gamma_is_skipped_above_the_documented_n() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 5. Signals
+// 4. Signals
 
 fn slow_campaign(dir: &Path) -> PathBuf {
     let f = dir.join("c.toml");
@@ -402,7 +401,7 @@ fn tmp_traces(dir: &Path) -> Vec<PathBuf> {
 }
 
 #[test]
-fn item5_sigterm_and_sighup_stop_like_ctrl_c() {
+fn sigterm_and_sighup_stop_like_ctrl_c() {
     for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGHUP, 129), (libc::SIGINT, 130)] {
         let dir = scratch(&format!("sig{sig}"));
         let child = spawn_slow(&dir);
@@ -419,31 +418,34 @@ fn item5_sigterm_and_sighup_stop_like_ctrl_c() {
 }
 
 #[test]
-fn item5_second_ctrl_c_stops_at_once() {
+fn second_ctrl_c_stops_at_once() {
     let dir = scratch("sigint2");
     let f = slow_campaign(&dir);
-    // A pause of 3 s per fake iteration: the first Ctrl-C would wait for it.
+    // A pause of 60 s per fake iteration: after the first Ctrl-C the run waits for the jobs in
+    // flight to reach their next check, then prints its summary. The second Ctrl-C must end the
+    // process at once, without that summary: which of the two happened is read from stderr, so
+    // the test does not depend on how fast the machine is.
     let child =
-        fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "3000")
+        fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "60000")
             .stdout(Stdio::null())
-            .stderr(Stdio::null())
+            .stderr(Stdio::piped())
             .spawn()
             .unwrap();
     wait_started(&dir);
     signal(&child, libc::SIGINT);
     std::thread::sleep(Duration::from_millis(100));
-    let t = Instant::now();
     signal(&child, libc::SIGINT);
     let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(130));
-    assert!(t.elapsed() < Duration::from_millis(1500), "{:?}", t.elapsed());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(!err.contains("rerun the same command to resume"), "the run waited for its jobs: {err}");
 }
 
 // ---------------------------------------------------------------------------------------------
-// 6. Names
+// 5. Names
 
 #[test]
-fn item6_hostile_names_reach_no_output_raw() {
+fn hostile_names_reach_no_output_raw() {
     let dir = scratch("names");
     let text = std::fs::read_to_string(format!("{PLANTS}/HE1.json")).unwrap();
     let mut doc: Value = serde_json::from_str(&text).unwrap();
@@ -478,10 +480,10 @@ fn item6_hostile_names_reach_no_output_raw() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 7. Exit codes and statuses
+// 6. Exit codes and statuses
 
 #[test]
-fn item7_design_and_check_exit_4_when_not_stabilised() {
+fn design_and_check_exit_4_when_not_stabilised() {
     let dir = scratch("exit4");
     // An unstable mode (λ = 1) that u cannot reach.
     let plant = r#"{"name": "unreachable", "dims": {"n": 2, "m1": 1, "m2": 1, "p1": 1, "p2": 1},
@@ -530,11 +532,11 @@ fn item7_design_and_check_exit_4_when_not_stabilised() {
 }
 
 #[test]
-fn item7_failed_means_one_thing_in_best_csv() {
+fn failed_means_one_thing_in_best_csv() {
     let plant = std::sync::Arc::new(Plant::load(format!("{PLANTS}/HE1.json")).unwrap());
     let plants: PlantMap = [(plant.fingerprint(), plant)].into_iter().collect();
     let not_stab = record(Ok(outcome(DesignStatus::NotStabilised { best_alpha: 0.5 }, f64::INFINITY)));
-    // another job of the same (plant, order): records of one job id count once (issue 14)
+    // another job of the same (plant, order): records of one job id count once
     let mut failed = record(Err("boom".into()));
     failed.job_id.0 = format!("{}-other", failed.job_id.0);
     let rows = best_per_order(&[not_stab.clone(), failed.clone()], &plants);
@@ -543,7 +545,7 @@ fn item7_failed_means_one_thing_in_best_csv() {
 }
 
 #[test]
-fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
+fn converged_and_stopped_are_told_apart_and_old_optimised_reads() {
     let r = record(Ok(outcome(DesignStatus::Converged, 1.0)));
     let mut v = serde_json::to_value(&r).unwrap();
     assert_eq!(v["status"]["kind"], "converged");
@@ -583,7 +585,7 @@ fn item7_converged_and_stopped_are_told_apart_and_old_optimised_reads() {
 }
 
 #[test]
-fn item7_controller_norm_term_is_flagged() {
+fn controller_norm_term_is_flagged() {
     let p = Plant::load(format!("{PLANTS}/REA2.json")).unwrap();
     for (eps, active) in [(1e3, true), (1e-6, false)] {
         let opts =
@@ -617,10 +619,10 @@ fn item7_controller_norm_term_is_flagged() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 8. The reference table belongs to the program
+// 7. The reference table belongs to the program
 
 #[test]
-fn item8_report_works_with_a_plant_folder_without_reference() {
+fn report_works_with_a_plant_folder_without_reference() {
     let dir = scratch("ownplants");
     let own = dir.join("myplants");
     std::fs::create_dir_all(&own).unwrap();
@@ -640,10 +642,10 @@ fn item8_report_works_with_a_plant_folder_without_reference() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 9. Smaller ones
+// 8. Error texts
 
 #[test]
-fn item9_error_texts() {
+fn error_texts() {
     let dir = scratch("small");
     // plant and controller errors say their text once
     let (code, _, err) = output(&mut cli(&["plant", "/no/such/plant.json"]));
@@ -655,8 +657,8 @@ fn item9_error_texts() {
     let (code, _, err) = output(&mut cli(&["status", "/no/such/c.toml"]));
     assert_eq!(code, Some(1));
     assert!(!err.contains(":0:0") && err.contains("/no/such/c.toml: cannot read"), "{err}");
-    // --out <directory> fails before the design, leaving nothing
-    let t = Instant::now();
+    // --out <directory> fails before the design, leaving nothing: the message is the check made
+    // before any work ("--out …: is a directory; give a file name"), not the failed write after it
     let (code, _, err) = output(&mut cli(&[
         "design",
         "--plant",
@@ -669,8 +671,8 @@ fn item9_error_texts() {
         dir.to_str().unwrap(),
     ]));
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("is a directory"), "{err}");
-    assert!(t.elapsed() < Duration::from_secs(5), "the design ran first: {:?}", t.elapsed());
+    assert!(err.contains("--out ") && err.contains("is a directory; give a file name"), "the design ran first: {err}");
+    assert!(!err.contains("writing "), "the design ran first: {err}");
     assert!(std::fs::read_dir(&dir).unwrap().next().is_none(), "left files behind");
     // --eps -1 is a number, and ε must be > 0
     let k = dir.join("K.json");
