@@ -11,7 +11,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
+use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, DrawError, Figure, FONT_FAMILY};
 use crate::campaign::trace::TraceIteration;
 
 /// Name of the stabilisation phase in traces.
@@ -93,7 +93,7 @@ impl ConvergenceFigure {
         stab: bool,
         caption: Option<&str>,
         y: Y,
-    ) -> Result<(), String>
+    ) -> Result<(), DrawError>
     where
         Y: AsRangedCoord<Value = f64>,
         Y::CoordDescType: ValueFormatter<f64>,
@@ -214,7 +214,7 @@ impl ConvergenceFigure {
         area: &DrawingArea<DB, Shift>,
         stab: bool,
         caption: Option<&str>,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let ys: Vec<f64> = self.points(stab).iter().map(|p| p.1).collect();
         let (lo, hi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
@@ -240,7 +240,7 @@ fn phase_label(phase: &str) -> &str {
 }
 
 impl Figure for ConvergenceFigure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let has_stab = self.iterations.iter().any(|it| it.phase == STABILISATION && it.f.is_finite());
         let has_opt = self.iterations.iter().any(|it| it.phase != STABILISATION && it.f.is_finite());
         match (has_stab, has_opt) {

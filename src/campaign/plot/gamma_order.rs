@@ -6,7 +6,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, Figure, FONT_FAMILY};
+use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, DrawError, Figure, FONT_FAMILY};
 
 /// Data of one γ-vs-order figure.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,7 +33,7 @@ impl GammaOrderFigure {
         spans_decades(lo, hi)
     }
 
-    fn draw_with<DB: DrawingBackend, Y>(&self, root: &DrawingArea<DB, Shift>, y: Y) -> Result<(), String>
+    fn draw_with<DB: DrawingBackend, Y>(&self, root: &DrawingArea<DB, Shift>, y: Y) -> Result<(), DrawError>
     where
         Y: AsRangedCoord<Value = f64>,
         Y::CoordDescType: ValueFormatter<f64>,
@@ -110,7 +110,7 @@ impl GammaOrderFigure {
 }
 
 impl Figure for GammaOrderFigure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let (lo, hi) = self.values().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
         if self.log_axis() {

@@ -24,11 +24,11 @@ use super::reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
 use super::reference::{RefMethod, ReferenceRow};
 use super::report::ReportError;
 use super::trace::{read_iterations, TraceError};
-use crate::lti::{Controller, Plant};
+use crate::lti::{Controller, LtiError, Plant};
 
 pub use convergence::ConvergenceFigure;
 pub use gamma_order::GammaOrderFigure;
-pub use render::{png_bytes, svg_text, write_by_extension, write_png_and_svg, Figure, SIZE};
+pub use render::{png_bytes, svg_text, write_by_extension, write_png_and_svg, DrawError, Figure, SIZE};
 pub use sigma::SigmaFigure;
 
 /// Errors making a figure, naming the file.
@@ -40,8 +40,8 @@ pub enum PlotError {
     Draw {
         /// The figure's file.
         path: PathBuf,
-        /// plotters' or the encoder's message.
-        message: String,
+        /// plotters' or the encoder's error.
+        message: DrawError,
     },
     /// The requested file type is not one we write.
     #[error("{}: the figure's file name must end in .png or .svg", path.display())]
@@ -56,12 +56,12 @@ pub enum PlotError {
     #[error(transparent)]
     Trace(#[from] TraceError),
     /// A controller could not be evaluated on its plant.
-    #[error("{what}: {message}")]
+    #[error("{what}: {source}")]
     System {
         /// Which figure.
         what: String,
         /// What went wrong.
-        message: String,
+        source: LtiError,
     },
 }
 
@@ -178,7 +178,7 @@ pub fn write_plots(
 
 /// The σ-plot of `k` on `plant`.
 pub fn sigma_figure(plant: &Plant, k: &Controller, title: String) -> Result<SigmaFigure, PlotError> {
-    SigmaFigure::new(plant, k, title.clone()).map_err(|e| PlotError::System { what: title, message: e.to_string() })
+    SigmaFigure::new(plant, k, title.clone()).map_err(|e| PlotError::System { what: title, source: e })
 }
 
 #[cfg(test)]

@@ -32,13 +32,26 @@ fn register_font() {
 
 /// A figure that can draw itself on any plotters backend.
 pub trait Figure {
-    /// Draws the whole figure on `root` (already filled white). Errors are plotters' messages.
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+    /// Draws the whole figure on `root` (already filled white).
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError>;
 }
 
-/// Converts any plotters error to its message.
-pub fn msg<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
+/// A drawing error: the message of plotters' error (generic over the backend, so kept as its
+/// text) or of the PNG encoder.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DrawError(pub String);
+
+impl std::fmt::Display for DrawError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DrawError {}
+
+/// Converts any plotters error to a [`DrawError`].
+pub fn msg<E: std::fmt::Display>(e: E) -> DrawError {
+    DrawError(e.to_string())
 }
 
 /// The figure as PNG bytes.
@@ -51,7 +64,7 @@ pub fn png_bytes(fig: &impl Figure, path: &Path) -> Result<Vec<u8>, PlotError> {
         draw_on(fig, &root, path)?;
     }
     let mut out = Vec::new();
-    let encode = |e: png::EncodingError| PlotError::Draw { path: path.to_path_buf(), message: e.to_string() };
+    let encode = |e: png::EncodingError| PlotError::Draw { path: path.to_path_buf(), message: msg(e) };
     let mut enc = png::Encoder::new(&mut out, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
@@ -74,7 +87,7 @@ pub fn svg_text(fig: &impl Figure, path: &Path) -> Result<String, PlotError> {
 }
 
 fn draw_on<DB: DrawingBackend>(fig: &impl Figure, root: &DrawingArea<DB, Shift>, path: &Path) -> Result<(), PlotError> {
-    let err = |message: String| PlotError::Draw { path: path.to_path_buf(), message };
+    let err = |message: DrawError| PlotError::Draw { path: path.to_path_buf(), message };
     root.fill(&WHITE).map_err(msg).map_err(err)?;
     fig.draw(root).map_err(err)?;
     root.present().map_err(msg).map_err(err)
@@ -146,7 +159,7 @@ pub fn tick(x: f64) -> String {
 pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
     pos: SeriesLabelPosition,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     chart
         .configure_series_labels()
         .position(pos)

@@ -9,7 +9,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, draw_legend, msg, tick, Figure, FONT_FAMILY};
+use super::render::{colour, draw_legend, msg, tick, DrawError, Figure, FONT_FAMILY};
 use crate::lti::freq_response::FreqResponse;
 use crate::lti::{closed_loop, hinf_norm, Controller, LtiError, Plant, StateSpace, DEFAULT_HINF_TOL};
 
@@ -86,7 +86,7 @@ impl SigmaFigure {
 }
 
 impl Figure for SigmaFigure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let ys = Self::positive(&self.closed_loop)
             .chain(Self::positive(&self.controller))
             .map(|p| p.1)
