@@ -41,6 +41,13 @@ fn fake_cli(args: &[&str], pause_ms: &str) -> Command {
     c
 }
 
+/// `campaign design --plant PLANT --order ORDER EXTRA… --out OUT`.
+fn design_cli(plant: &str, order: &str, out: &Path, extra: &[&str]) -> Command {
+    let mut c = cli(&["design", "--plant", plant, "--order", order]);
+    c.args(extra).args(["--out", out.to_str().unwrap()]);
+    c
+}
+
 fn output(c: &mut Command) -> (Option<i32>, String, String) {
     let o: Output = c.output().unwrap();
     (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
@@ -241,17 +248,7 @@ fn huge_counts_are_clear_errors() {
     for n in ["100000000", "18446744073709551615"] {
         let dir = scratch("nrand");
         let out = dir.join("K.json");
-        let (code, _, err) = output(&mut cli(&[
-            "design",
-            "--plant",
-            "HE1",
-            "--order",
-            "1",
-            "--nrand",
-            n,
-            "--out",
-            out.to_str().unwrap(),
-        ]));
+        let (code, _, err) = output(&mut design_cli("HE1", "1", &out, &["--nrand", n]));
         assert_eq!(code, Some(1), "{err}");
         assert!(err.contains("nrand") && err.contains("1..=10000"), "{err}");
         assert_no_panic(&err);
@@ -492,20 +489,8 @@ fn design_and_check_exit_4_when_not_stabilised() {
     let p = dir.join("u.json");
     std::fs::write(&p, plant).unwrap();
     let k = dir.join("K.json");
-    let (code, out, err) = output(&mut cli(&[
-        "design",
-        "--plant",
-        p.to_str().unwrap(),
-        "--order",
-        "0",
-        "--cpumax",
-        "2",
-        "--stop-on-stall",
-        "--nrand",
-        "1",
-        "--out",
-        k.to_str().unwrap(),
-    ]));
+    let (code, out, err) =
+        output(&mut design_cli(p.to_str().unwrap(), "0", &k, &["--cpumax", "2", "--stop-on-stall", "--nrand", "1"]));
     assert_eq!(code, Some(4), "{out}{err}");
     assert!(out.contains("NOT STABILISED"), "{out}");
     let (code, out, err) =
@@ -514,18 +499,7 @@ fn design_and_check_exit_4_when_not_stabilised() {
     assert!(out.contains("UNSTABLE"), "{out}");
     // a stabilising controller: exit 0
     let good = dir.join("G.json");
-    let (code, _, err) = output(&mut cli(&[
-        "design",
-        "--plant",
-        "REA2",
-        "--order",
-        "0",
-        "--cpumax",
-        "5",
-        "--stop-on-stall",
-        "--out",
-        good.to_str().unwrap(),
-    ]));
+    let (code, _, err) = output(&mut design_cli("REA2", "0", &good, &["--cpumax", "5", "--stop-on-stall"]));
     assert_eq!(code, Some(0), "{err}");
     let (code, _, err) = output(&mut cli(&["check", "--plant", "REA2", "--controller", good.to_str().unwrap()]));
     assert_eq!(code, Some(0), "{err}");
@@ -598,22 +572,8 @@ fn controller_norm_term_is_flagged() {
     }
     let dir = scratch("normflag");
     let k = dir.join("K.json");
-    let (code, out, err) = output(&mut cli(&[
-        "design",
-        "--plant",
-        "REA2",
-        "--order",
-        "0",
-        "--eps",
-        "1e3",
-        "--cpumax",
-        "5",
-        "--stop-on-stall",
-        "--nrand",
-        "1",
-        "--out",
-        k.to_str().unwrap(),
-    ]));
+    let (code, out, err) =
+        output(&mut design_cli("REA2", "0", &k, &["--eps", "1e3", "--cpumax", "5", "--stop-on-stall", "--nrand", "1"]));
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("controller-norm penalty"), "{out}");
 }
@@ -659,25 +619,14 @@ fn error_texts() {
     assert!(!err.contains(":0:0") && err.contains("/no/such/c.toml: cannot read"), "{err}");
     // --out <directory> fails before the design, leaving nothing: the message is the check made
     // before any work ("--out …: is a directory; give a file name"), not the failed write after it
-    let (code, _, err) = output(&mut cli(&[
-        "design",
-        "--plant",
-        "HE1",
-        "--order",
-        "1",
-        "--cpumax",
-        "30",
-        "--out",
-        dir.to_str().unwrap(),
-    ]));
+    let (code, _, err) = output(&mut design_cli("HE1", "1", &dir, &["--cpumax", "30"]));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("--out ") && err.contains("is a directory; give a file name"), "the design ran first: {err}");
     assert!(!err.contains("writing "), "the design ran first: {err}");
     assert!(std::fs::read_dir(&dir).unwrap().next().is_none(), "left files behind");
     // --eps -1 is a number, and ε must be > 0
     let k = dir.join("K.json");
-    let (code, _, err) =
-        output(&mut cli(&["design", "--plant", "HE1", "--order", "1", "--eps", "-1", "--out", k.to_str().unwrap()]));
+    let (code, _, err) = output(&mut design_cli("HE1", "1", &k, &["--eps", "-1"]));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("ε must be finite and positive (> 0), got -1"), "{err}");
     // did you mean
@@ -685,22 +634,12 @@ fn error_texts() {
     assert_eq!(code, Some(1));
     assert!(err.contains("did you mean `HE1`?"), "{err}");
     // a huge ε prints numbers in scientific notation
-    let (code, out, err) = output(&mut cli(&[
-        "design",
-        "--plant",
+    let (code, out, err) = output(&mut design_cli(
         "REA2",
-        "--order",
         "0",
-        "--eps",
-        "1e300",
-        "--cpumax",
-        "2",
-        "--stop-on-stall",
-        "--nrand",
-        "1",
-        "--out",
-        k.to_str().unwrap(),
-    ]));
+        &k,
+        &["--eps", "1e300", "--cpumax", "2", "--stop-on-stall", "--nrand", "1"],
+    ));
     assert!(code == Some(0) || code == Some(4), "{err}");
     let longest = out.split_whitespace().map(str::len).max().unwrap_or(0);
     assert!(longest < 40, "a {longest}-character word in: {out}");
