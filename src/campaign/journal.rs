@@ -56,14 +56,15 @@ pub enum JournalError {
         source: io::Error,
     },
     /// A complete line (not the last) that is not a valid record.
-    #[error("{}:{line}: corrupt journal line (not a job record): {message}", path.display())]
+    #[error("{}:{line}: corrupt journal line (not a job record): {problem}", path.display())]
     Corrupt {
         /// The journal.
         path: PathBuf,
         /// 1-based line number.
         line: usize,
-        /// What the JSON parser said.
-        message: String,
+        /// What is wrong with the line.
+        #[source]
+        problem: CorruptLine,
     },
     /// A record written by a newer hinfix.
     #[error("{}:{line}: journal record has schema_version {found}, this program reads up to {SCHEMA_VERSION}", path.display())]
@@ -133,17 +134,36 @@ fn io_err(path: &Path) -> impl FnOnce(io::Error) -> JournalError + '_ {
 }
 
 /// Parses one line; `Err` is the parser's message, or the newer schema version.
-fn parse_line(text: &str) -> Result<JobRecord, Result<String, u32>> {
+/// Why a complete journal line is not a job record.
+#[derive(Debug, thiserror::Error)]
+pub enum CorruptLine {
+    /// The line is not UTF-8 text.
+    #[error("not UTF-8: {0}")]
+    NotUtf8(#[from] std::str::Utf8Error),
+    /// The line is not the JSON of a record (the parser's message).
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
+/// Why [`parse_line`] read no record.
+enum LineError {
+    /// Written by a newer hinfix: its schema version.
+    Newer(u32),
+    /// Not a record of any version.
+    Corrupt(CorruptLine),
+}
+
+fn parse_line(text: &str) -> Result<JobRecord, LineError> {
     #[derive(serde::Deserialize)]
     struct Version {
         schema_version: u32,
     }
     if let Ok(v) = serde_json::from_str::<Version>(text) {
         if v.schema_version > SCHEMA_VERSION {
-            return Err(Err(v.schema_version));
+            return Err(LineError::Newer(v.schema_version));
         }
     }
-    serde_json::from_str(text).map_err(|e| Ok(e.to_string()))
+    serde_json::from_str(text).map_err(|e| LineError::Corrupt(e.into()))
 }
 
 /// Reads a journal. A missing file is an empty journal.
@@ -177,7 +197,7 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
                     out.records.push(r);
                     out.unterminated = true;
                 }
-                Ok(Err(Err(found))) => {
+                Ok(Err(LineError::Newer(found))) => {
                     return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found })
                 }
                 _ => {
@@ -188,22 +208,16 @@ pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalEr
         }
         let text = match std::str::from_utf8(raw) {
             Ok(t) => t.trim(),
-            Err(e) => {
-                return Err(JournalError::Corrupt {
-                    path: path.to_path_buf(),
-                    line: line_no,
-                    message: format!("not UTF-8: {e}"),
-                })
-            }
+            Err(e) => return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, problem: e.into() }),
         };
         if !text.is_empty() {
             match parse_line(text) {
                 Ok(r) => out.records.push(r),
-                Err(Err(found)) => {
+                Err(LineError::Newer(found)) => {
                     return Err(JournalError::NewerSchema { path: path.to_path_buf(), line: line_no, found })
                 }
-                Err(Ok(message)) => {
-                    return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, message })
+                Err(LineError::Corrupt(problem)) => {
+                    return Err(JournalError::Corrupt { path: path.to_path_buf(), line: line_no, problem })
                 }
             }
         }
@@ -425,8 +439,8 @@ impl Follower {
                 Err(e) => return Err(io_err(&path)(e)),
             }
             let read = parse_journal(&bytes, &path).map_err(|e| match e {
-                JournalError::Corrupt { path, line, message } => {
-                    JournalError::Corrupt { path, line: line + tail.lines, message }
+                JournalError::Corrupt { path, line, problem } => {
+                    JournalError::Corrupt { path, line: line + tail.lines, problem }
                 }
                 JournalError::NewerSchema { path, line, found } => {
                     JournalError::NewerSchema { path, line: line + tail.lines, found }

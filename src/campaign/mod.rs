@@ -33,15 +33,15 @@ mod trace_filter;
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
 pub use jobs::{expand, job_id, Job, JobId, RunnerTag, JOB_ID_VERSION};
 pub use journal::{
-    is_journal_name, journals_in, parse_journal, read_journal, Follower, JournalError, JournalRead, JournalWriter,
-    TornTail, JOURNAL_FILE,
+    is_journal_name, journals_in, parse_journal, read_journal, CorruptLine, Follower, JournalError, JournalRead,
+    JournalWriter, TornTail, JOURNAL_FILE,
 };
 pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
 pub use provenance::Provenance;
 pub use record::{JobRecord, JobResult, JobStatus, SCHEMA_VERSION};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
 pub use reference::{
-    load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow,
+    load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_MAX_N};

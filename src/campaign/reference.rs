@@ -92,15 +92,28 @@ pub enum ReferenceError {
         source: std::io::Error,
     },
     /// A row is malformed.
-    #[error("reference table {}, line {line}: {message}", path.display())]
+    #[error("reference table {}, line {line}: {problem}", path.display())]
     Row {
         /// File.
         path: PathBuf,
         /// 1-based line in the file.
         line: u64,
         /// What is wrong.
-        message: String,
+        #[source]
+        problem: RowProblem,
     },
+}
+
+/// What is wrong with a row of the reference table.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RowProblem {
+    /// Not a row of the table's columns (the CSV reader's message).
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
+    /// γ is not a positive number.
+    #[error("gamma must be a positive number, found {0}")]
+    Gamma(f64),
 }
 
 mod stable_word {
@@ -134,16 +147,13 @@ pub(crate) fn parse_reference(input: impl std::io::Read, path: &Path) -> Result<
     let mut rows = Vec::new();
     let mut reader = csv::Reader::from_reader(input);
     for rec in reader.deserialize::<ReferenceRow>() {
-        let row_err = |line: u64, message: String| ReferenceError::Row { path: path.to_path_buf(), line, message };
+        let row_err = |line: u64, problem: RowProblem| ReferenceError::Row { path: path.to_path_buf(), line, problem };
         let row = rec.map_err(|e| {
             let line = e.position().map_or(0, |p| p.line());
-            row_err(line, e.to_string())
+            row_err(line, e.into())
         })?;
         if !(row.gamma.is_finite() && row.gamma > 0.0) {
-            return Err(row_err(
-                rows.len() as u64 + 2,
-                format!("gamma must be a positive number, found {}", row.gamma),
-            ));
+            return Err(row_err(rows.len() as u64 + 2, RowProblem::Gamma(row.gamma)));
         }
         rows.push(row);
     }

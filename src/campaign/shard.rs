@@ -35,21 +35,41 @@ pub struct ShardError {
     /// The value given.
     pub text: String,
     /// What is wrong.
-    pub reason: String,
+    pub reason: ShardProblem,
+}
+
+/// What is wrong with a `--shard` value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum ShardProblem {
+    /// No `/` between K and N.
+    #[error("no '/'")]
+    NoSlash,
+    /// K does not parse.
+    #[error("K is not a whole number")]
+    BadK,
+    /// N does not parse.
+    #[error("N is not a whole number")]
+    BadN,
+    /// N = 0.
+    #[error("N must be at least 1")]
+    ZeroN,
+    /// K = 0 or K > N.
+    #[error("K must be between 1 and N")]
+    KOutOfRange,
 }
 
 impl FromStr for Shard {
     type Err = ShardError;
     fn from_str(text: &str) -> Result<Shard, ShardError> {
-        let bad = |reason: &str| ShardError { text: text.to_string(), reason: reason.to_string() };
-        let (k, n) = text.trim().split_once('/').ok_or_else(|| bad("no '/'"))?;
-        let k: usize = k.trim().parse().map_err(|_| bad("K is not a whole number"))?;
-        let n: usize = n.trim().parse().map_err(|_| bad("N is not a whole number"))?;
+        let bad = |reason: ShardProblem| ShardError { text: text.to_string(), reason };
+        let (k, n) = text.trim().split_once('/').ok_or_else(|| bad(ShardProblem::NoSlash))?;
+        let k: usize = k.trim().parse().map_err(|_| bad(ShardProblem::BadK))?;
+        let n: usize = n.trim().parse().map_err(|_| bad(ShardProblem::BadN))?;
         if n == 0 {
-            return Err(bad("N must be at least 1"));
+            return Err(bad(ShardProblem::ZeroN));
         }
         if k == 0 || k > n {
-            return Err(bad("K must be between 1 and N"));
+            return Err(bad(ShardProblem::KOutOfRange));
         }
         Ok(Shard { k, n })
     }
