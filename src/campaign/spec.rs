@@ -21,7 +21,7 @@ use toml::Spanned;
 
 pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
 use super::trace_filter::TraceLevel;
-use crate::design::{DesignOptions, ObjectiveKind, VariableScaling};
+use crate::design::{DesignOptions, OptionValue};
 use crate::lti::Plant;
 
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
@@ -60,67 +60,104 @@ pub struct SpecError {
 // ---------------------------------------------------------------------------------------------
 // Raw (serde) form
 
-/// Declares a raw (serde) table with the design settings allowed both in `[defaults]` and in a
-/// `[[problem]]`, between the table's own leading and trailing keys: one list of the shared keys,
-/// so the two tables cannot drift apart.
-macro_rules! with_design_settings {
-    ($(#[$attr:meta])* struct $name:ident { $($head:tt)* } { $($tail:tt)* }) => {
-        $(#[$attr])*
-        struct $name {
-            $($head)*
-            eps: Option<Spanned<EpsList>>,
-            seeds: Option<Spanned<Seeds>>,
-            cpumax: Option<Spanned<f64>>,
-            nrand: Option<Spanned<usize>>,
-            objective: Option<ObjectiveKind>,
-            maxit: Option<Spanned<usize>>,
-            normtol: Option<Spanned<f64>>,
-            evaldist: Option<Spanned<f64>>,
-            hinf_tol: Option<Spanned<f64>>,
-            gradient_sampling: Option<bool>,
-            maxevals: Option<Spanned<usize>>,
-            stall_starts: Option<Spanned<usize>>,
-            stall_rtol: Option<Spanned<f64>>,
-            max_starts: Option<Spanned<usize>>,
-            hop_scales: Option<Spanned<Vec<f64>>>,
-            central_gammas: Option<Spanned<Vec<f64>>>,
-            random_scales: Option<Spanned<Vec<f64>>>,
-            open_loop_start: Option<bool>,
-            variable_scaling: Option<VariableScaling>,
-            spend_budget: Option<bool>,
-            continue_at_maxit: Option<bool>,
-            continued_maxit: Option<Spanned<usize>>,
-            return_gs_reserve: Option<bool>,
-            refine_rtol: Option<Spanned<f64>>,
-            eps_continuation: Option<bool>,
-            continued_cpumax: Option<Spanned<f64>>,
-            // Not a design setting (no `DesignOptions` field, not in the job id); layered alike.
-            trace: Option<TraceLevel>,
-            $($tail)*
+/// The campaign's design settings come from the option table
+/// ([`crate::design::design_option_table!`], in design/options.rs): this callback declares the
+/// raw tables `[defaults]` and `[[problem]]` and their layering ([`Layered`]) with one key per
+/// option marked `key layered` there, after the campaign's own settings given as its arguments
+/// (`key: type`). A new design option thus becomes a campaign key, with its span for errors,
+/// without a line here.
+macro_rules! campaign_settings {
+    ({ $($args:tt)* } $($entries:tt)*) => {
+        campaign_settings!(@walk { $($args)* } [] $($entries)*);
+    };
+    // keep the layered options as `field: the type of its setting`
+    (@walk $args:tt [$($keep:tt)*]
+        $(#[$attr:meta])* $field:ident : $ty:ty = $default:expr, key layered, flag $flag:literal,
+        accepts $accepts:expr, check $check:expr, doc $doc:literal;
+        $($rest:tt)*
+    ) => {
+        campaign_settings!(@walk $args [$($keep)* $field: <$ty as OptionValue>::Setting,] $($rest)*);
+    };
+    // skip the others (order, eps, seed: lists of jobs, below; options without a key)
+    (@walk $args:tt [$($keep:tt)*]
+        $(#[$attr:meta])* $field:ident : $ty:ty = $default:expr, key $key:literal, flag $flag:literal,
+        accepts $accepts:expr, check $check:expr, doc $doc:literal;
+        $($rest:tt)*
+    ) => {
+        campaign_settings!(@walk $args [$($keep)*] $($rest)*);
+    };
+    (@walk { $($own:ident : $own_ty:ty,)* } [$($design:ident : $design_ty:ty,)*]) => {
+        /// `[defaults]`: the settings, plus the campaign-wide `threads`.
+        #[derive(Debug, Default, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct RawDefaults {
+            $($own: Option<Spanned<$own_ty>>,)*
+            $($design: Option<Spanned<$design_ty>>,)*
+            threads: Option<Spanned<usize>>,
+        }
+
+        /// One `[[problem]]`: its plant and orders, then the settings.
+        #[derive(Debug, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct RawProblem {
+            plant: Spanned<String>,
+            orders: Spanned<Orders>,
+            #[serde(default)]
+            warm_start: bool,
+            $($own: Option<Spanned<$own_ty>>,)*
+            $($design: Option<Spanned<$design_ty>>,)*
+        }
+
+        /// Step 3a: the settings of one problem, each from the `[[problem]]`, else from
+        /// `[defaults]` (else, in [`Layered::options`], from [`DesignOptions::default`]), with
+        /// the span of the value used.
+        struct Layered {
+            $($own: Setting<$own_ty>,)*
+            $($design: Setting<$design_ty>,)*
+        }
+
+        impl Layered {
+            fn new(p: &RawProblem, d: &RawDefaults) -> Layered {
+                Layered {
+                    $($own: layer(&p.$own, &d.$own),)*
+                    $($design: layer(&p.$design, &d.$design),)*
+                }
+            }
+
+            /// The options common to the problem's jobs (order, ε and seed are set per job).
+            /// Values are only collected here; `design::validate` judges them
+            /// ([`check_options`]).
+            fn options(&self) -> DesignOptions {
+                let mut o = DesignOptions::default();
+                $(
+                    if let Some((v, _)) = &self.$design {
+                        o.$design = OptionValue::from_setting(v.clone());
+                    }
+                )*
+                o
+            }
+
+            /// The span of the value behind a `DesignError::Options` field (None: not a
+            /// setting, or not given).
+            fn span_of(&self, field: &str) -> Option<Range<usize>> {
+                match field {
+                    $(stringify!($own) => self.$own.as_ref().map(|(_, s)| s.clone()),)*
+                    $(stringify!($design) => self.$design.as_ref().map(|(_, s)| s.clone()),)*
+                    _ => None,
+                }
+            }
         }
     };
 }
 
-with_design_settings! {
-    /// `[defaults]`: the design settings, plus the campaign-wide `threads`.
-    #[derive(Debug, Default, Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct RawDefaults {} {
-        threads: Option<Spanned<usize>>,
-    }
-}
-
-with_design_settings! {
-    /// One `[[problem]]`: its plant and orders, then the design settings.
-    #[derive(Debug, Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct RawProblem {
-        plant: Spanned<String>,
-        orders: Spanned<Orders>,
-        #[serde(default)]
-        warm_start: bool,
-    } {}
-}
+crate::design::design_option_table!(campaign_settings {
+    eps: EpsList,
+    seeds: Seeds,
+    eps_continuation: bool,
+    continued_cpumax: f64,
+    // Not a design setting (no `DesignOptions` field, not in the job id); layered alike.
+    trace: TraceLevel,
+});
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -357,8 +394,8 @@ fn check_threads(threads: Option<&Spanned<usize>>, src: &Source) -> Result<Optio
 /// plant loaded and its options judged.
 fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Source) -> Result<Problem, SpecError> {
     let settings = Layered::new(p, d);
-    let eps = check_eps(settings.eps.as_ref(), src)?;
-    let seeds = check_seeds(settings.seeds.as_ref(), src)?;
+    let eps = check_eps(&settings.eps, src)?;
+    let seeds = check_seeds(&settings.seeds, src)?;
     let orders = check_orders(&p.orders, src)?;
     let base = settings.options();
     let (plant_path, plant) = load_plant(&p.plant, base_dir, src)?;
@@ -372,10 +409,10 @@ fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Sourc
         eps,
         seeds,
         warm_start: p.warm_start,
-        eps_continuation: settings.eps_continuation.unwrap_or(false),
+        eps_continuation: settings.eps_continuation.as_ref().is_some_and(|(b, _)| *b),
         continued_cpumax: settings.continued_cpumax.as_ref().map(|(x, _)| *x),
         base,
-        trace: p.trace.or(d.trace).unwrap_or_default(),
+        trace: settings.trace.as_ref().map(|(t, _)| *t).unwrap_or_default(),
         location: Location::of_offset(src.text, p.plant.span().start),
     })
 }
@@ -388,177 +425,31 @@ fn layer<T: Clone>(problem: &Option<Spanned<T>>, defaults: &Option<Spanned<T>>) 
     problem.as_ref().or(defaults.as_ref()).map(|s| (s.get_ref().clone(), s.span()))
 }
 
-/// Step 3a: the design settings of one problem, each from the `[[problem]]`, else from
-/// `[defaults]` (else, in [`Layered::options`], from [`DesignOptions::default`]), with the span
-/// of the value used.
-struct Layered {
-    eps: Option<Spanned<EpsList>>,
-    seeds: Option<Spanned<Seeds>>,
-    objective: Option<ObjectiveKind>,
-    gradient_sampling: Option<bool>,
-    cpumax: Setting<f64>,
-    normtol: Setting<f64>,
-    evaldist: Setting<f64>,
-    hinf_tol: Setting<f64>,
-    stall_rtol: Setting<f64>,
-    nrand: Setting<usize>,
-    maxit: Setting<usize>,
-    maxevals: Setting<usize>,
-    max_starts: Setting<usize>,
-    stall_starts: Setting<usize>,
-    hop_scales: Setting<Vec<f64>>,
-    central_gammas: Setting<Vec<f64>>,
-    random_scales: Setting<Vec<f64>>,
-    open_loop_start: Option<bool>,
-    variable_scaling: Option<VariableScaling>,
-    spend_budget: Option<bool>,
-    continue_at_maxit: Option<bool>,
-    continued_maxit: Setting<usize>,
-    return_gs_reserve: Option<bool>,
-    refine_rtol: Setting<f64>,
-    eps_continuation: Option<bool>,
-    continued_cpumax: Setting<f64>,
-}
-
-impl Layered {
-    fn new(p: &RawProblem, d: &RawDefaults) -> Layered {
-        Layered {
-            eps: p.eps.clone().or_else(|| d.eps.clone()),
-            seeds: p.seeds.clone().or_else(|| d.seeds.clone()),
-            objective: p.objective.or(d.objective),
-            gradient_sampling: p.gradient_sampling.or(d.gradient_sampling),
-            cpumax: layer(&p.cpumax, &d.cpumax),
-            normtol: layer(&p.normtol, &d.normtol),
-            evaldist: layer(&p.evaldist, &d.evaldist),
-            hinf_tol: layer(&p.hinf_tol, &d.hinf_tol),
-            stall_rtol: layer(&p.stall_rtol, &d.stall_rtol),
-            nrand: layer(&p.nrand, &d.nrand),
-            maxit: layer(&p.maxit, &d.maxit),
-            maxevals: layer(&p.maxevals, &d.maxevals),
-            max_starts: layer(&p.max_starts, &d.max_starts),
-            stall_starts: layer(&p.stall_starts, &d.stall_starts),
-            hop_scales: layer(&p.hop_scales, &d.hop_scales),
-            central_gammas: layer(&p.central_gammas, &d.central_gammas),
-            random_scales: layer(&p.random_scales, &d.random_scales),
-            open_loop_start: p.open_loop_start.or(d.open_loop_start),
-            variable_scaling: p.variable_scaling.or(d.variable_scaling),
-            spend_budget: p.spend_budget.or(d.spend_budget),
-            continue_at_maxit: p.continue_at_maxit.or(d.continue_at_maxit),
-            continued_maxit: layer(&p.continued_maxit, &d.continued_maxit),
-            return_gs_reserve: p.return_gs_reserve.or(d.return_gs_reserve),
-            refine_rtol: layer(&p.refine_rtol, &d.refine_rtol),
-            eps_continuation: p.eps_continuation.or(d.eps_continuation),
-            continued_cpumax: layer(&p.continued_cpumax, &d.continued_cpumax),
-        }
-    }
-
-    /// The options common to the problem's jobs (order, ε and seed are set per job). Values are
-    /// only collected here; `design::validate` judges them ([`check_options`]).
-    fn options(&self) -> DesignOptions {
-        let mut o = DesignOptions::default();
-        let value = |s: &Setting<f64>, default: f64| s.as_ref().map_or(default, |(x, _)| *x);
-        let count = |s: &Setting<usize>, default: usize| s.as_ref().map_or(default, |(x, _)| *x);
-        o.cpumax = value(&self.cpumax, o.cpumax);
-        o.normtol = value(&self.normtol, o.normtol);
-        o.evaldist = value(&self.evaldist, o.evaldist);
-        o.hinf_tol = value(&self.hinf_tol, o.hinf_tol);
-        o.stall_rtol = value(&self.stall_rtol, o.stall_rtol);
-        o.refine_rtol = value(&self.refine_rtol, o.refine_rtol);
-        o.nrand = count(&self.nrand, o.nrand);
-        o.maxit = count(&self.maxit, o.maxit);
-        o.continued_maxit = count(&self.continued_maxit, o.continued_maxit);
-        o.stall_starts = count(&self.stall_starts, o.stall_starts);
-        if let Some((x, _)) = &self.maxevals {
-            o.maxevals = Some(*x);
-        }
-        if let Some((x, _)) = &self.max_starts {
-            o.max_starts = Some(*x);
-        }
-        if let Some((x, _)) = &self.hop_scales {
-            o.hop_scales = x.clone();
-        }
-        if let Some((x, _)) = &self.central_gammas {
-            o.central_gammas = x.clone();
-        }
-        if let Some((x, _)) = &self.random_scales {
-            o.random_scales = x.clone();
-        }
-        if let Some(b) = self.open_loop_start {
-            o.open_loop_start = b;
-        }
-        if let Some(b) = self.variable_scaling {
-            o.variable_scaling = b;
-        }
-        if let Some(b) = self.spend_budget {
-            o.spend_budget = b;
-        }
-        if let Some(b) = self.continue_at_maxit {
-            o.continue_at_maxit = b;
-        }
-        if let Some(b) = self.return_gs_reserve {
-            o.return_gs_reserve = b;
-        }
-        if let Some(k) = self.objective {
-            o.objective = k;
-        }
-        if let Some(g) = self.gradient_sampling {
-            o.gradient_sampling = g;
-        }
-        o
-    }
-
-    /// The span of the value behind a `DesignError::Options` field (None: not a setting).
-    fn span_of(&self, field: &str) -> Option<Range<usize>> {
-        fn span<T>(s: &Setting<T>) -> Option<Range<usize>> {
-            s.as_ref().map(|(_, r)| r.clone())
-        }
-        match field {
-            "eps" => self.eps.as_ref().map(|s| s.span()),
-            "cpumax" => span(&self.cpumax),
-            "normtol" => span(&self.normtol),
-            "evaldist" => span(&self.evaldist),
-            "hinf_tol" => span(&self.hinf_tol),
-            "stall_rtol" => span(&self.stall_rtol),
-            "refine_rtol" => span(&self.refine_rtol),
-            "nrand" => span(&self.nrand),
-            "maxit" => span(&self.maxit),
-            "continued_maxit" => span(&self.continued_maxit),
-            "maxevals" => span(&self.maxevals),
-            "max_starts" => span(&self.max_starts),
-            "stall_starts" => span(&self.stall_starts),
-            "hop_scales" => span(&self.hop_scales),
-            "central_gammas" => span(&self.central_gammas),
-            "random_scales" => span(&self.random_scales),
-            _ => None,
-        }
-    }
-}
-
 /// Step 3b: the weights ε (default: [`DesignOptions::default`]'s).
-fn check_eps(eps: Option<&Spanned<EpsList>>, src: &Source) -> Result<Vec<f64>, SpecError> {
-    let Some(s) = eps else { return Ok(vec![DesignOptions::default().eps]) };
-    let v = s.get_ref().0.clone();
+fn check_eps(eps: &Setting<EpsList>, src: &Source) -> Result<Vec<f64>, SpecError> {
+    let Some((EpsList(v), span)) = eps else { return Ok(vec![DesignOptions::default().eps]) };
+    let v = v.clone();
     if v.is_empty() {
-        return Err(src.error(s.span(), "eps must list at least one weight"));
+        return Err(src.error(span.clone(), "eps must list at least one weight"));
     }
     if has_duplicates(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()) {
-        return Err(src.error(s.span(), "eps lists the same weight twice"));
+        return Err(src.error(span.clone(), "eps lists the same weight twice"));
     }
     Ok(v)
 }
 
 /// Step 3c: the seeds (default: seed 0).
-fn check_seeds(seeds: Option<&Spanned<Seeds>>, src: &Source) -> Result<Vec<u64>, SpecError> {
-    let Some(s) = seeds else { return Ok(vec![0]) };
-    let Seeds(v, _) = s.get_ref().clone();
+fn check_seeds(seeds: &Setting<Seeds>, src: &Source) -> Result<Vec<u64>, SpecError> {
+    let Some((Seeds(v, _), span)) = seeds else { return Ok(vec![DesignOptions::default().seed]) };
+    let v = v.clone();
     if v.is_empty() {
-        return Err(src.error(s.span(), "seeds must list at least one seed"));
+        return Err(src.error(span.clone(), "seeds must list at least one seed"));
     }
     if let Some(bad) = v.iter().find(|x| **x < 0) {
-        return Err(src.error(s.span(), format!("seeds must be non-negative integers, found {bad}")));
+        return Err(src.error(span.clone(), format!("seeds must be non-negative integers, found {bad}")));
     }
     if has_duplicates(&v) {
-        return Err(src.error(s.span(), "seeds lists the same seed twice"));
+        return Err(src.error(span.clone(), "seeds lists the same seed twice"));
     }
     Ok(v.into_iter().map(|x| x as u64).collect())
 }
@@ -691,6 +582,7 @@ fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::{ObjectiveKind, VariableScaling};
 
     fn parse(text: &str) -> Result<Campaign, SpecError> {
         Campaign::from_toml_str(text, Path::new("test.toml"))

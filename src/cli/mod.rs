@@ -31,6 +31,17 @@ pub struct Cli {
     command: Command,
 }
 
+#[cfg(test)]
+impl Cli {
+    /// The arguments of a `design` command line.
+    fn design_args(&self) -> Option<&design::DesignArgs> {
+        match &self.command {
+            Command::Design(a) => Some(a),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Run a campaign file (plants × orders × ε × seeds), resuming where it stopped.
