@@ -51,7 +51,7 @@ pub use scheduler::{
     JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Solo,
 };
 pub use spec::{
-    Campaign, Location, Problem, SpecError, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER, MAX_SEEDS,
+    Campaign, Location, Problem, SpecError, SpecProblem, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER, MAX_SEEDS,
     MAX_THREADS,
 };
 pub use trace::{

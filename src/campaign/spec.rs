@@ -54,7 +54,89 @@ pub struct SpecError {
     /// Where in it.
     pub location: Location,
     /// What is wrong.
-    pub message: String,
+    pub message: SpecProblem,
+}
+
+/// What is wrong in a campaign file: the message of a [`SpecError`].
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SpecProblem {
+    /// The file could not be read.
+    #[error("cannot read the campaign file: {0}")]
+    Read(std::io::Error),
+    /// Not TOML, an unknown key or a value of the wrong type (toml's message).
+    #[error("{}", .0.message().trim())]
+    Toml(Box<toml::de::Error>),
+    /// The campaign name is longer than [`MAX_NAME_CHARS`].
+    #[error("campaign name is longer than {MAX_NAME_CHARS} characters")]
+    NameTooLong,
+    /// The campaign name (given) cannot name a folder.
+    #[error("campaign name {0:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)")]
+    BadName(String),
+    /// `threads` (given) outside 1..=[`MAX_THREADS`].
+    #[error("threads must be in 1..={MAX_THREADS}, found {0}")]
+    Threads(usize),
+    /// No `[[problem]]`.
+    #[error("the campaign has no [[problem]] entries")]
+    NoProblems,
+    /// `eps = []`.
+    #[error("eps must list at least one weight")]
+    NoEps,
+    /// A weight listed twice.
+    #[error("eps lists the same weight twice")]
+    RepeatedEps,
+    /// `seeds = []`.
+    #[error("seeds must list at least one seed")]
+    NoSeeds,
+    /// A negative seed (given).
+    #[error("seeds must be non-negative integers, found {0}")]
+    NegativeSeed(i64),
+    /// A seed listed twice.
+    #[error("seeds lists the same seed twice")]
+    RepeatedSeed,
+    /// `orders = []`.
+    #[error("orders must list at least one controller order")]
+    NoOrders,
+    /// An order (given) outside 0..=[`MAX_ORDER`].
+    #[error("controller orders must be integers in 0..={MAX_ORDER}, found {0}")]
+    OrderOutOfRange(i64),
+    /// An order listed twice.
+    #[error("orders lists the same order twice")]
+    RepeatedOrder,
+    /// `plant = ""`.
+    #[error("plant must name a plant (e.g. \"HE1\") or a plant file")]
+    NoPlant,
+    /// A plant path that is no file (why).
+    #[error("plant file {} {why}", path.display())]
+    NotAFile {
+        /// The path, resolved against the campaign file's folder.
+        path: PathBuf,
+        /// What it is instead (`crate::input::not_a_file`).
+        why: String,
+    },
+    /// The plant could not be found or loaded.
+    #[error("{0}")]
+    Plant(Box<crate::lti::PlantError>),
+    /// The problem's design options, as `design::validate` judges them.
+    #[error("{0}")]
+    Options(Box<crate::design::DesignError>),
+    /// More than [`MAX_JOBS`] jobs.
+    #[error("the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)")]
+    TooManyJobs,
+    /// A problem makes a job an earlier problem makes.
+    #[error("this problem repeats a job of the problem at line {first_line} (plant {plant}, order {order}, ε {eps}, seed {seed})")]
+    RepeatedJob {
+        /// The line of the earlier problem.
+        first_line: usize,
+        /// The plant's name.
+        plant: String,
+        /// The job's order.
+        order: usize,
+        /// Its ε.
+        eps: f64,
+        /// Its seed.
+        seed: u64,
+    },
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -312,7 +394,7 @@ impl Campaign {
                 SpecError {
                     file: path.to_path_buf(),
                     location: Location { line: 0, column: 0 },
-                    message: format!("cannot read the campaign file: {e}"),
+                    message: SpecProblem::Read(e),
                 }
             })?;
         Campaign::from_toml_str(&text, path)
@@ -326,7 +408,7 @@ impl Campaign {
         let name = check_name(&raw.name, &src)?;
         let threads = check_threads(raw.defaults.threads.as_ref(), &src)?;
         if raw.problems.is_empty() {
-            return Err(src.error(0..0, "the campaign has no [[problem]] entries"));
+            return Err(src.error(0..0, SpecProblem::NoProblems));
         }
         let base_dir = file.parent().unwrap_or(Path::new("."));
         let problems = raw
@@ -349,32 +431,25 @@ struct Source<'a> {
 
 impl Source<'_> {
     /// An error at the start of `span`.
-    fn error(&self, span: Range<usize>, message: impl Into<String>) -> SpecError {
-        SpecError {
-            file: self.file.to_path_buf(),
-            location: Location::of_offset(self.text, span.start),
-            message: message.into(),
-        }
+    fn error(&self, span: Range<usize>, message: SpecProblem) -> SpecError {
+        SpecError { file: self.file.to_path_buf(), location: Location::of_offset(self.text, span.start), message }
     }
 }
 
 /// Step 1: the TOML into the raw tables (unknown keys and wrong types fail here, at their span).
 fn parse(src: &Source) -> Result<RawCampaign, SpecError> {
-    toml::from_str(src.text).map_err(|e| src.error(e.span().unwrap_or(0..0), e.message().trim()))
+    toml::from_str(src.text).map_err(|e| src.error(e.span().unwrap_or(0..0), SpecProblem::Toml(Box::new(e))))
 }
 
 /// Step 2a: the campaign name, which names the results folder.
 fn check_name(name: &Spanned<String>, src: &Source) -> Result<String, SpecError> {
     let text = name.get_ref().clone();
     if text.chars().count() > MAX_NAME_CHARS {
-        return Err(src.error(name.span(), format!("campaign name is longer than {MAX_NAME_CHARS} characters")));
+        return Err(src.error(name.span(), SpecProblem::NameTooLong));
     }
     if text.is_empty() || !text.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) || text.starts_with('.')
     {
-        return Err(src.error(
-            name.span(),
-            format!("campaign name {text:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)"),
-        ));
+        return Err(src.error(name.span(), SpecProblem::BadName(text)));
     }
     Ok(text)
 }
@@ -383,7 +458,7 @@ fn check_name(name: &Spanned<String>, src: &Source) -> Result<String, SpecError>
 fn check_threads(threads: Option<&Spanned<usize>>, src: &Source) -> Result<Option<usize>, SpecError> {
     match threads {
         Some(t) if !(1..=MAX_THREADS).contains(t.get_ref()) => {
-            Err(src.error(t.span(), format!("threads must be in 1..={MAX_THREADS}, found {}", t.get_ref())))
+            Err(src.error(t.span(), SpecProblem::Threads(*t.get_ref())))
         }
         Some(t) => Ok(Some(*t.get_ref())),
         None => Ok(None),
@@ -430,10 +505,10 @@ fn check_eps(eps: &Setting<EpsList>, src: &Source) -> Result<Vec<f64>, SpecError
     let Some((EpsList(v), span)) = eps else { return Ok(vec![DesignOptions::default().eps]) };
     let v = v.clone();
     if v.is_empty() {
-        return Err(src.error(span.clone(), "eps must list at least one weight"));
+        return Err(src.error(span.clone(), SpecProblem::NoEps));
     }
     if has_duplicates(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()) {
-        return Err(src.error(span.clone(), "eps lists the same weight twice"));
+        return Err(src.error(span.clone(), SpecProblem::RepeatedEps));
     }
     Ok(v)
 }
@@ -443,13 +518,13 @@ fn check_seeds(seeds: &Setting<Seeds>, src: &Source) -> Result<Vec<u64>, SpecErr
     let Some((Seeds(v, _), span)) = seeds else { return Ok(vec![DesignOptions::default().seed]) };
     let v = v.clone();
     if v.is_empty() {
-        return Err(src.error(span.clone(), "seeds must list at least one seed"));
+        return Err(src.error(span.clone(), SpecProblem::NoSeeds));
     }
     if let Some(bad) = v.iter().find(|x| **x < 0) {
-        return Err(src.error(span.clone(), format!("seeds must be non-negative integers, found {bad}")));
+        return Err(src.error(span.clone(), SpecProblem::NegativeSeed(*bad)));
     }
     if has_duplicates(&v) {
-        return Err(src.error(span.clone(), "seeds lists the same seed twice"));
+        return Err(src.error(span.clone(), SpecProblem::RepeatedSeed));
     }
     Ok(v.into_iter().map(|x| x as u64).collect())
 }
@@ -458,13 +533,13 @@ fn check_seeds(seeds: &Setting<Seeds>, src: &Source) -> Result<Vec<u64>, SpecErr
 fn check_orders(orders: &Spanned<Orders>, src: &Source) -> Result<Vec<usize>, SpecError> {
     let (v, span) = (&orders.get_ref().0, orders.span());
     if v.is_empty() {
-        return Err(src.error(span, "orders must list at least one controller order"));
+        return Err(src.error(span, SpecProblem::NoOrders));
     }
     if let Some(bad) = v.iter().find(|o| **o < 0 || **o > MAX_ORDER as i64) {
-        return Err(src.error(span, format!("controller orders must be integers in 0..={MAX_ORDER}, found {bad}")));
+        return Err(src.error(span, SpecProblem::OrderOutOfRange(*bad)));
     }
     if has_duplicates(v) {
-        return Err(src.error(span, "orders lists the same order twice"));
+        return Err(src.error(span, SpecProblem::RepeatedOrder));
     }
     let mut sorted: Vec<usize> = v.iter().map(|o| *o as usize).collect();
     sorted.sort_unstable();
@@ -474,7 +549,7 @@ fn check_orders(orders: &Spanned<Orders>, src: &Source) -> Result<Vec<usize>, Sp
 /// Step 3e: the plant, resolved ([`resolve_plant_arg`]) and loaded; errors point at `plant`.
 fn load_plant(plant: &Spanned<String>, base_dir: &Path, src: &Source) -> Result<(PathBuf, Plant), SpecError> {
     let path = resolve_plant_arg(plant.get_ref(), base_dir).map_err(|m| src.error(plant.span(), m))?;
-    let loaded = Plant::load(&path).map_err(|e| src.error(plant.span(), e.to_string()))?;
+    let loaded = Plant::load(&path).map_err(|e| src.error(plant.span(), SpecProblem::Plant(Box::new(e))))?;
     Ok((path, loaded))
 }
 
@@ -505,7 +580,7 @@ fn check_options(
                     crate::design::DesignError::Options { field, .. } => settings.span_of(field),
                     _ => None,
                 };
-                return Err(src.error(span.unwrap_or(p.plant.span()), err.to_string()));
+                return Err(src.error(span.unwrap_or(p.plant.span()), SpecProblem::Options(Box::new(err))));
             }
         }
     }
@@ -519,12 +594,7 @@ fn check_job_count(problems: &[Problem], raw: &[RawProblem], src: &Source) -> Re
         let n = p.orders.len().saturating_mul(p.eps.len()).saturating_mul(p.seeds.len());
         total = total.saturating_add(n);
         if total > MAX_JOBS {
-            return Err(src.error(
-                raw_p.plant.span(),
-                format!(
-                    "the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)"
-                ),
-            ));
+            return Err(src.error(raw_p.plant.span(), SpecProblem::TooManyJobs));
         }
     }
     Ok(())
@@ -541,14 +611,13 @@ fn check_unique_jobs(campaign: &Campaign) -> Result<(), SpecError> {
             return Err(SpecError {
                 file: campaign.file.clone(),
                 location: p.location,
-                message: format!(
-                    "this problem repeats a job of the problem at line {} (plant {}, order {}, ε {}, seed {})",
-                    campaign.problems[first].location.line,
-                    p.plant.name,
-                    j.options.order,
-                    j.options.eps,
-                    j.options.seed
-                ),
+                message: SpecProblem::RepeatedJob {
+                    first_line: campaign.problems[first].location.line,
+                    plant: p.plant.name.clone(),
+                    order: j.options.order,
+                    eps: j.options.eps,
+                    seed: j.options.seed,
+                },
             });
         }
     }
@@ -562,20 +631,20 @@ fn has_duplicates<T: Ord + Clone>(v: &[T]) -> bool {
 }
 
 /// A bare name goes to the plant library; a path is taken relative to the campaign file.
-fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, String> {
+fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, SpecProblem> {
     if arg.is_empty() {
-        return Err("plant must name a plant (e.g. \"HE1\") or a plant file".into());
+        return Err(SpecProblem::NoPlant);
     }
     let is_path = arg.contains('/') || arg.ends_with(".json") || arg.ends_with(".mat");
     if is_path {
         let p = Path::new(arg);
         let p = if p.is_absolute() { p.to_path_buf() } else { base_dir.join(p) };
         if let Some(why) = crate::input::not_a_file(&p) {
-            return Err(format!("plant file {} {why}", p.display()));
+            return Err(SpecProblem::NotAFile { path: p, why });
         }
         Ok(p)
     } else {
-        crate::lti::resolve_plant(arg).map_err(|e| e.to_string())
+        crate::lti::resolve_plant(arg).map_err(|e| SpecProblem::Plant(Box::new(e)))
     }
 }
 
@@ -665,15 +734,15 @@ objective = "plain"
         let c = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
         assert_eq!(c.problems[0].base.variable_scaling, VariableScaling::Alternate, "the default");
         let e = err("name = \"t\"\n[defaults]\nvariable_scaling = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
-        assert!(e.message.contains("variable_scaling") || e.location.line == 3, "{e}");
+        assert!(e.message.to_string().contains("variable_scaling") || e.location.line == 3, "{e}");
         let e = err(
             "name = \"t\"\n[defaults]\nvariable_scaling = \"sometimes\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n",
         );
         assert_eq!(e.location.line, 3, "{e}");
-        assert!(e.message.contains("alternate") && e.message.contains("sometimes"), "{e}");
+        assert!(e.message.to_string().contains("alternate") && e.message.to_string().contains("sometimes"), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
-        assert!(e.message.contains("random_scales"), "{e}");
+        assert!(e.message.to_string().contains("random_scales"), "{e}");
     }
 
     #[test]
@@ -691,7 +760,7 @@ objective = "plain"
         );
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nspend_budget = 1\n");
         assert_eq!(e.location.line, 5, "{e}");
-        assert!(e.message.contains("bool"), "{e}");
+        assert!(e.message.to_string().contains("bool"), "{e}");
     }
 
     #[test]
@@ -708,7 +777,7 @@ objective = "plain"
         assert_eq!((d.problems[0].eps_continuation, d.problems[0].continued_cpumax), (false, None));
         let e = err("name = \"t\"\n[defaults]\ncpumax = 5.0\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_cpumax = -1.0\n");
         assert_eq!(e.location.line, 7, "{e}");
-        assert!(e.message.contains("cpumax"), "{e}");
+        assert!(e.message.to_string().contains("cpumax"), "{e}");
     }
 
     #[test]
@@ -732,7 +801,7 @@ objective = "plain"
         assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_maxit = 1000000000\n");
         assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
-        assert!(e.message.contains("continued_maxit"), "{e}");
+        assert!(e.message.to_string().contains("continued_maxit"), "{e}");
     }
 
     #[test]
@@ -756,7 +825,7 @@ objective = "plain"
         assert_eq!(ids(&c), ids(&parse(&text("", "")).unwrap()));
         let e = err(&text("", "trace = \"verbose\""));
         assert_eq!((e.location.line, e.location.column), (7, 9), "{e}");
-        assert!(e.message.contains("verbose") && e.message.contains("sparse"), "{e}");
+        assert!(e.message.to_string().contains("verbose") && e.message.to_string().contains("sparse"), "{e}");
         let e = err(&text("trace = true", ""));
         assert_eq!((e.location.line, e.location.column), (3, 9), "{e}");
         assert!(e.to_string().starts_with("test.toml:3:9: "), "{e}");
@@ -766,13 +835,13 @@ objective = "plain"
     fn unknown_key_names_line_and_column() {
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nordres = [2]\n");
         assert_eq!((e.location.line, e.location.column), (5, 1), "{e}");
-        assert!(e.message.contains("ordres"), "{e}");
+        assert!(e.message.to_string().contains("ordres"), "{e}");
         let text = e.to_string();
         assert!(text.starts_with("test.toml:5:1: "), "{text}");
 
         let e = err("name = \"t\"\n[defaults]\n  cpu_max = 3\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
         assert_eq!((e.location.line, e.location.column), (3, 3), "{e}");
-        assert!(e.message.contains("cpu_max"), "{e}");
+        assert!(e.message.to_string().contains("cpu_max"), "{e}");
     }
 
     #[test]
@@ -784,7 +853,7 @@ objective = "plain"
         assert_eq!((e.location.line, e.location.column), (4, 10), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nobjective = \"h2\"\n");
         assert_eq!(e.location.line, 5, "{e}");
-        assert!(e.message.contains("h2"), "{e}");
+        assert!(e.message.to_string().contains("h2"), "{e}");
         let e = err("name = 3\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
         assert_eq!((e.location.line, e.location.column), (1, 8), "{e}");
     }
@@ -809,7 +878,7 @@ objective = "plain"
         for (text, line, col, word) in cases {
             let e = err(text);
             assert_eq!((e.location.line, e.location.column), (*line, *col), "{text}\n→ {e}");
-            assert!(e.message.contains(word), "{text}\n→ {e}");
+            assert!(e.message.to_string().contains(word), "{text}\n→ {e}");
         }
     }
 
@@ -819,7 +888,7 @@ objective = "plain"
             "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n[[problem]]\nplant = \"HE1\"\norders = [2]\n",
         );
         assert_eq!(e.location.line, 6, "{e}");
-        assert!(e.message.contains("repeats"), "{e}");
+        assert!(e.message.to_string().contains("repeats"), "{e}");
     }
 
     #[test]

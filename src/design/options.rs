@@ -71,6 +71,11 @@ pub const DEFAULT_REFINE_RTOL: f64 = 0.0;
 /// Default of [`DesignOptions::continued_maxit`].
 pub const DEFAULT_CONTINUED_MAXIT: usize = 3000;
 
+/// A name that is no [`VariableScaling`] mode (the name given).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("expected \"off\", \"alternate\" or \"always\" (or a boolean), found {0:?}")]
+pub struct UnknownVariableScaling(pub String);
+
 /// Which coordinates the local searches of a run use (docs/ALGORITHMS.md §8.6): the controller's
 /// parameters x, or the plant-scaled variables x̃ with x = d ∘ x̃ (`design::scaling`). A plant
 /// whose channels are alike has d = 1: every mode is then the unscaled search, bit for bit.
@@ -103,12 +108,12 @@ impl VariableScaling {
     }
 
     /// Reads a name ("off", "alternate", "always"; also "false" / "true").
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, UnknownVariableScaling> {
         match s {
             "off" | "false" => Ok(VariableScaling::Off),
             "alternate" => Ok(VariableScaling::Alternate),
             "always" | "true" => Ok(VariableScaling::Always),
-            other => Err(format!("expected \"off\", \"alternate\" or \"always\" (or a boolean), found {other:?}")),
+            other => Err(UnknownVariableScaling(other.to_string())),
         }
     }
 
