@@ -25,7 +25,7 @@ use crate::optim::RunControl;
 use anyhow::Context;
 
 use super::{fmt_num, signals, EXIT_NOT_STABILISED};
-use crate::campaign::sanitise::for_terminal;
+use crate::campaign::for_terminal;
 
 /// The default of a flag: the option's default ([`DesignOptions::default`], the option table of
 /// design/options.rs), never a literal of its own.
