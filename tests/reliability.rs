@@ -268,14 +268,14 @@ fn campaign_check_calls_design_validate_before_any_job() {
     for (problem, word, line) in cases {
         let text = format!("name = \"t\"\n[defaults]\n[[problem]]\nplant = \"HE1\"\n{problem}\n");
         let e = campaign(&text).expect_err(problem);
-        assert!(e.message.contains(word), "{problem} → {e}");
+        assert!(e.message.to_string().contains(word), "{problem} → {e}");
         assert_eq!(e.location.line, *line, "{problem} → {e}");
         // the very message `design` gives for the same option
-        assert!(e.message.starts_with("invalid design option"), "{e}");
+        assert!(e.message.to_string().starts_with("invalid design option"), "{e}");
     }
     let long = "x".repeat(101);
     let e = campaign(&format!("name = \"{long}\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n")).unwrap_err();
-    assert!(e.message.contains("longer than 100"), "{e}");
+    assert!(e.message.to_string().contains("longer than 100"), "{e}");
 
     // and through the binary: nothing runs, exit 1, no journal.
     let dir = scratch("validate");

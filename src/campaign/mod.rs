@@ -6,10 +6,11 @@
 //! [`JournalWriter`]), the trace writer ([`TraceWriter`]), the progress reporter and the report
 //! writers ([`write_reports`]) each consume what they need.
 //!
-//! The modules are crate-private; what is API is re-exported here (the command line, `crate::cli`,
-//! also reaches a few crate-private helpers by path).
+//! The modules are crate-private; what is API is re-exported here, and the command line
+//! (`crate::cli`) uses only that: [`status`] and [`report`] give it typed results to print.
 pub(crate) mod claims;
 mod compare;
+#[cfg(any(test, feature = "test-support"))]
 pub(crate) mod fake;
 mod jobs;
 pub(crate) mod journal;
@@ -27,9 +28,12 @@ pub(crate) mod sanitise;
 pub(crate) mod scheduler;
 pub(crate) mod shard;
 mod spec;
+mod status;
 pub(crate) mod trace;
 mod trace_filter;
 
+pub use claims::unix_now;
+#[cfg(any(test, feature = "test-support"))]
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
 pub use jobs::{expand, job_id, Job, JobId, RunnerTag, JOB_ID_VERSION};
 pub use journal::{
@@ -37,6 +41,7 @@ pub use journal::{
     JournalWriter, TornTail, JOURNAL_FILE,
 };
 pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
+pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
 pub use record::{JobRecord, JobResult, JobStatus, SCHEMA_VERSION};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
@@ -45,14 +50,20 @@ pub use reference::{
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_MAX_N};
-pub use run::{campaign_dir, journal_path, run_jobs, RunError, RunOutcome};
+pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
+pub use sanitise::for_terminal;
 pub use scheduler::{
     execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, DesignRunner, ExecuteError, ExecuteOptions,
     JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Solo,
 };
+pub use shard::{select as shard_jobs, Shard};
 pub use spec::{
-    Campaign, Location, Problem, SpecError, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER, MAX_SEEDS,
-    MAX_THREADS,
+    Campaign, Location, Problem, SpecError, SpecProblem, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER,
+    MAX_SEEDS, MAX_THREADS,
+};
+pub use status::{
+    plant_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus, DuplicateJob,
+    PlantStatus, RunningJob, ShardLoad,
 };
 pub use trace::{
     iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,

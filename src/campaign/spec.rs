@@ -21,7 +21,7 @@ use toml::Spanned;
 
 pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
 use super::trace_filter::TraceLevel;
-use crate::design::{DesignOptions, ObjectiveKind, VariableScaling};
+use crate::design::{DesignOptions, OptionValue};
 use crate::lti::Plant;
 
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
@@ -54,73 +54,192 @@ pub struct SpecError {
     /// Where in it.
     pub location: Location,
     /// What is wrong.
-    pub message: String,
+    pub message: SpecProblem,
+}
+
+/// What is wrong in a campaign file: the message of a [`SpecError`].
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SpecProblem {
+    /// The file could not be read.
+    #[error("cannot read the campaign file: {0}")]
+    Read(std::io::Error),
+    /// Not TOML, an unknown key or a value of the wrong type (toml's message).
+    #[error("{}", .0.message().trim())]
+    Toml(Box<toml::de::Error>),
+    /// The campaign name is longer than [`MAX_NAME_CHARS`].
+    #[error("campaign name is longer than {MAX_NAME_CHARS} characters")]
+    NameTooLong,
+    /// The campaign name (given) cannot name a folder.
+    #[error("campaign name {0:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)")]
+    BadName(String),
+    /// `threads` (given) outside 1..=[`MAX_THREADS`].
+    #[error("threads must be in 1..={MAX_THREADS}, found {0}")]
+    Threads(usize),
+    /// No `[[problem]]`.
+    #[error("the campaign has no [[problem]] entries")]
+    NoProblems,
+    /// `eps = []`.
+    #[error("eps must list at least one weight")]
+    NoEps,
+    /// A weight listed twice.
+    #[error("eps lists the same weight twice")]
+    RepeatedEps,
+    /// `seeds = []`.
+    #[error("seeds must list at least one seed")]
+    NoSeeds,
+    /// A negative seed (given).
+    #[error("seeds must be non-negative integers, found {0}")]
+    NegativeSeed(i64),
+    /// A seed listed twice.
+    #[error("seeds lists the same seed twice")]
+    RepeatedSeed,
+    /// `orders = []`.
+    #[error("orders must list at least one controller order")]
+    NoOrders,
+    /// An order (given) outside 0..=[`MAX_ORDER`].
+    #[error("controller orders must be integers in 0..={MAX_ORDER}, found {0}")]
+    OrderOutOfRange(i64),
+    /// An order listed twice.
+    #[error("orders lists the same order twice")]
+    RepeatedOrder,
+    /// `plant = ""`.
+    #[error("plant must name a plant (e.g. \"HE1\") or a plant file")]
+    NoPlant,
+    /// A plant path that is no file (why).
+    #[error("plant file {} {why}", path.display())]
+    NotAFile {
+        /// The path, resolved against the campaign file's folder.
+        path: PathBuf,
+        /// What it is instead (`crate::input::not_a_file`).
+        why: String,
+    },
+    /// The plant could not be found or loaded.
+    #[error("{0}")]
+    Plant(Box<crate::lti::PlantError>),
+    /// The problem's design options, as `design::validate` judges them.
+    #[error("{0}")]
+    Options(Box<crate::design::DesignError>),
+    /// More than [`MAX_JOBS`] jobs.
+    #[error("the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)")]
+    TooManyJobs,
+    /// A problem makes a job an earlier problem makes.
+    #[error("this problem repeats a job of the problem at line {first_line} (plant {plant}, order {order}, ε {eps}, seed {seed})")]
+    RepeatedJob {
+        /// The line of the earlier problem.
+        first_line: usize,
+        /// The plant's name.
+        plant: String,
+        /// The job's order.
+        order: usize,
+        /// Its ε.
+        eps: f64,
+        /// Its seed.
+        seed: u64,
+    },
 }
 
 // ---------------------------------------------------------------------------------------------
 // Raw (serde) form
 
-/// Declares a raw (serde) table with the design settings allowed both in `[defaults]` and in a
-/// `[[problem]]`, between the table's own leading and trailing keys: one list of the shared keys,
-/// so the two tables cannot drift apart.
-macro_rules! with_design_settings {
-    ($(#[$attr:meta])* struct $name:ident { $($head:tt)* } { $($tail:tt)* }) => {
-        $(#[$attr])*
-        struct $name {
-            $($head)*
-            eps: Option<Spanned<EpsList>>,
-            seeds: Option<Spanned<Seeds>>,
-            cpumax: Option<Spanned<f64>>,
-            nrand: Option<Spanned<usize>>,
-            objective: Option<ObjectiveKind>,
-            maxit: Option<Spanned<usize>>,
-            normtol: Option<Spanned<f64>>,
-            evaldist: Option<Spanned<f64>>,
-            hinf_tol: Option<Spanned<f64>>,
-            gradient_sampling: Option<bool>,
-            maxevals: Option<Spanned<usize>>,
-            stall_starts: Option<Spanned<usize>>,
-            stall_rtol: Option<Spanned<f64>>,
-            max_starts: Option<Spanned<usize>>,
-            hop_scales: Option<Spanned<Vec<f64>>>,
-            central_gammas: Option<Spanned<Vec<f64>>>,
-            random_scales: Option<Spanned<Vec<f64>>>,
-            open_loop_start: Option<bool>,
-            variable_scaling: Option<VariableScaling>,
-            spend_budget: Option<bool>,
-            continue_at_maxit: Option<bool>,
-            continued_maxit: Option<Spanned<usize>>,
-            return_gs_reserve: Option<bool>,
-            refine_rtol: Option<Spanned<f64>>,
-            eps_continuation: Option<bool>,
-            continued_cpumax: Option<Spanned<f64>>,
-            // Not a design setting (no `DesignOptions` field, not in the job id); layered alike.
-            trace: Option<TraceLevel>,
-            $($tail)*
+/// The campaign's design settings come from the option table
+/// ([`crate::design::design_option_table!`], in design/options.rs): this callback declares the
+/// raw tables `[defaults]` and `[[problem]]` and their layering ([`Layered`]) with one key per
+/// option marked `key layered` there, after the campaign's own settings given as its arguments
+/// (`key: type`). A new design option thus becomes a campaign key, with its span for errors,
+/// without a line here.
+macro_rules! campaign_settings {
+    ({ $($args:tt)* } $($entries:tt)*) => {
+        campaign_settings!(@walk { $($args)* } [] $($entries)*);
+    };
+    // keep the layered options as `field: the type of its setting`
+    (@walk $args:tt [$($keep:tt)*]
+        $(#[$attr:meta])* $field:ident : $ty:ty = $default:expr, key layered, flag $flag:literal,
+        accepts $accepts:expr, check $check:expr, doc $doc:literal;
+        $($rest:tt)*
+    ) => {
+        campaign_settings!(@walk $args [$($keep)* $field: <$ty as OptionValue>::Setting,] $($rest)*);
+    };
+    // skip the others (order, eps, seed: lists of jobs, below; options without a key)
+    (@walk $args:tt [$($keep:tt)*]
+        $(#[$attr:meta])* $field:ident : $ty:ty = $default:expr, key $key:literal, flag $flag:literal,
+        accepts $accepts:expr, check $check:expr, doc $doc:literal;
+        $($rest:tt)*
+    ) => {
+        campaign_settings!(@walk $args [$($keep)*] $($rest)*);
+    };
+    (@walk { $($own:ident : $own_ty:ty,)* } [$($design:ident : $design_ty:ty,)*]) => {
+        /// `[defaults]`: the settings, plus the campaign-wide `threads`.
+        #[derive(Debug, Default, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct RawDefaults {
+            $($own: Option<Spanned<$own_ty>>,)*
+            $($design: Option<Spanned<$design_ty>>,)*
+            threads: Option<Spanned<usize>>,
+        }
+
+        /// One `[[problem]]`: its plant and orders, then the settings.
+        #[derive(Debug, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct RawProblem {
+            plant: Spanned<String>,
+            orders: Spanned<Orders>,
+            #[serde(default)]
+            warm_start: bool,
+            $($own: Option<Spanned<$own_ty>>,)*
+            $($design: Option<Spanned<$design_ty>>,)*
+        }
+
+        /// Step 3a: the settings of one problem, each from the `[[problem]]`, else from
+        /// `[defaults]` (else, in [`Layered::options`], from [`DesignOptions::default`]), with
+        /// the span of the value used.
+        struct Layered {
+            $($own: Setting<$own_ty>,)*
+            $($design: Setting<$design_ty>,)*
+        }
+
+        impl Layered {
+            fn new(p: &RawProblem, d: &RawDefaults) -> Layered {
+                Layered {
+                    $($own: layer(&p.$own, &d.$own),)*
+                    $($design: layer(&p.$design, &d.$design),)*
+                }
+            }
+
+            /// The options common to the problem's jobs (order, ε and seed are set per job).
+            /// Values are only collected here; `design::validate` judges them
+            /// ([`check_options`]).
+            fn options(&self) -> DesignOptions {
+                let mut o = DesignOptions::default();
+                $(
+                    if let Some((v, _)) = &self.$design {
+                        o.$design = OptionValue::from_setting(v.clone());
+                    }
+                )*
+                o
+            }
+
+            /// The span of the value behind a `DesignError::Options` field (None: not a
+            /// setting, or not given).
+            fn span_of(&self, field: &str) -> Option<Range<usize>> {
+                match field {
+                    $(stringify!($own) => self.$own.as_ref().map(|(_, s)| s.clone()),)*
+                    $(stringify!($design) => self.$design.as_ref().map(|(_, s)| s.clone()),)*
+                    _ => None,
+                }
+            }
         }
     };
 }
 
-with_design_settings! {
-    /// `[defaults]`: the design settings, plus the campaign-wide `threads`.
-    #[derive(Debug, Default, Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct RawDefaults {} {
-        threads: Option<Spanned<usize>>,
-    }
-}
-
-with_design_settings! {
-    /// One `[[problem]]`: its plant and orders, then the design settings.
-    #[derive(Debug, Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct RawProblem {
-        plant: Spanned<String>,
-        orders: Spanned<Orders>,
-        #[serde(default)]
-        warm_start: bool,
-    } {}
-}
+crate::design::design_option_table!(campaign_settings {
+    eps: EpsList,
+    seeds: Seeds,
+    eps_continuation: bool,
+    continued_cpumax: f64,
+    // Not a design setting (no `DesignOptions` field, not in the job id); layered alike.
+    trace: TraceLevel,
+});
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -275,7 +394,7 @@ impl Campaign {
                 SpecError {
                     file: path.to_path_buf(),
                     location: Location { line: 0, column: 0 },
-                    message: format!("cannot read the campaign file: {e}"),
+                    message: SpecProblem::Read(e),
                 }
             })?;
         Campaign::from_toml_str(&text, path)
@@ -289,7 +408,7 @@ impl Campaign {
         let name = check_name(&raw.name, &src)?;
         let threads = check_threads(raw.defaults.threads.as_ref(), &src)?;
         if raw.problems.is_empty() {
-            return Err(src.error(0..0, "the campaign has no [[problem]] entries"));
+            return Err(src.error(0..0, SpecProblem::NoProblems));
         }
         let base_dir = file.parent().unwrap_or(Path::new("."));
         let problems = raw
@@ -312,32 +431,25 @@ struct Source<'a> {
 
 impl Source<'_> {
     /// An error at the start of `span`.
-    fn error(&self, span: Range<usize>, message: impl Into<String>) -> SpecError {
-        SpecError {
-            file: self.file.to_path_buf(),
-            location: Location::of_offset(self.text, span.start),
-            message: message.into(),
-        }
+    fn error(&self, span: Range<usize>, message: SpecProblem) -> SpecError {
+        SpecError { file: self.file.to_path_buf(), location: Location::of_offset(self.text, span.start), message }
     }
 }
 
 /// Step 1: the TOML into the raw tables (unknown keys and wrong types fail here, at their span).
 fn parse(src: &Source) -> Result<RawCampaign, SpecError> {
-    toml::from_str(src.text).map_err(|e| src.error(e.span().unwrap_or(0..0), e.message().trim()))
+    toml::from_str(src.text).map_err(|e| src.error(e.span().unwrap_or(0..0), SpecProblem::Toml(Box::new(e))))
 }
 
 /// Step 2a: the campaign name, which names the results folder.
 fn check_name(name: &Spanned<String>, src: &Source) -> Result<String, SpecError> {
     let text = name.get_ref().clone();
     if text.chars().count() > MAX_NAME_CHARS {
-        return Err(src.error(name.span(), format!("campaign name is longer than {MAX_NAME_CHARS} characters")));
+        return Err(src.error(name.span(), SpecProblem::NameTooLong));
     }
     if text.is_empty() || !text.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) || text.starts_with('.')
     {
-        return Err(src.error(
-            name.span(),
-            format!("campaign name {text:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)"),
-        ));
+        return Err(src.error(name.span(), SpecProblem::BadName(text)));
     }
     Ok(text)
 }
@@ -346,7 +458,7 @@ fn check_name(name: &Spanned<String>, src: &Source) -> Result<String, SpecError>
 fn check_threads(threads: Option<&Spanned<usize>>, src: &Source) -> Result<Option<usize>, SpecError> {
     match threads {
         Some(t) if !(1..=MAX_THREADS).contains(t.get_ref()) => {
-            Err(src.error(t.span(), format!("threads must be in 1..={MAX_THREADS}, found {}", t.get_ref())))
+            Err(src.error(t.span(), SpecProblem::Threads(*t.get_ref())))
         }
         Some(t) => Ok(Some(*t.get_ref())),
         None => Ok(None),
@@ -357,8 +469,8 @@ fn check_threads(threads: Option<&Spanned<usize>>, src: &Source) -> Result<Optio
 /// plant loaded and its options judged.
 fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Source) -> Result<Problem, SpecError> {
     let settings = Layered::new(p, d);
-    let eps = check_eps(settings.eps.as_ref(), src)?;
-    let seeds = check_seeds(settings.seeds.as_ref(), src)?;
+    let eps = check_eps(&settings.eps, src)?;
+    let seeds = check_seeds(&settings.seeds, src)?;
     let orders = check_orders(&p.orders, src)?;
     let base = settings.options();
     let (plant_path, plant) = load_plant(&p.plant, base_dir, src)?;
@@ -372,10 +484,10 @@ fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Sourc
         eps,
         seeds,
         warm_start: p.warm_start,
-        eps_continuation: settings.eps_continuation.unwrap_or(false),
+        eps_continuation: settings.eps_continuation.as_ref().is_some_and(|(b, _)| *b),
         continued_cpumax: settings.continued_cpumax.as_ref().map(|(x, _)| *x),
         base,
-        trace: p.trace.or(d.trace).unwrap_or_default(),
+        trace: settings.trace.as_ref().map(|(t, _)| *t).unwrap_or_default(),
         location: Location::of_offset(src.text, p.plant.span().start),
     })
 }
@@ -388,177 +500,31 @@ fn layer<T: Clone>(problem: &Option<Spanned<T>>, defaults: &Option<Spanned<T>>) 
     problem.as_ref().or(defaults.as_ref()).map(|s| (s.get_ref().clone(), s.span()))
 }
 
-/// Step 3a: the design settings of one problem, each from the `[[problem]]`, else from
-/// `[defaults]` (else, in [`Layered::options`], from [`DesignOptions::default`]), with the span
-/// of the value used.
-struct Layered {
-    eps: Option<Spanned<EpsList>>,
-    seeds: Option<Spanned<Seeds>>,
-    objective: Option<ObjectiveKind>,
-    gradient_sampling: Option<bool>,
-    cpumax: Setting<f64>,
-    normtol: Setting<f64>,
-    evaldist: Setting<f64>,
-    hinf_tol: Setting<f64>,
-    stall_rtol: Setting<f64>,
-    nrand: Setting<usize>,
-    maxit: Setting<usize>,
-    maxevals: Setting<usize>,
-    max_starts: Setting<usize>,
-    stall_starts: Setting<usize>,
-    hop_scales: Setting<Vec<f64>>,
-    central_gammas: Setting<Vec<f64>>,
-    random_scales: Setting<Vec<f64>>,
-    open_loop_start: Option<bool>,
-    variable_scaling: Option<VariableScaling>,
-    spend_budget: Option<bool>,
-    continue_at_maxit: Option<bool>,
-    continued_maxit: Setting<usize>,
-    return_gs_reserve: Option<bool>,
-    refine_rtol: Setting<f64>,
-    eps_continuation: Option<bool>,
-    continued_cpumax: Setting<f64>,
-}
-
-impl Layered {
-    fn new(p: &RawProblem, d: &RawDefaults) -> Layered {
-        Layered {
-            eps: p.eps.clone().or_else(|| d.eps.clone()),
-            seeds: p.seeds.clone().or_else(|| d.seeds.clone()),
-            objective: p.objective.or(d.objective),
-            gradient_sampling: p.gradient_sampling.or(d.gradient_sampling),
-            cpumax: layer(&p.cpumax, &d.cpumax),
-            normtol: layer(&p.normtol, &d.normtol),
-            evaldist: layer(&p.evaldist, &d.evaldist),
-            hinf_tol: layer(&p.hinf_tol, &d.hinf_tol),
-            stall_rtol: layer(&p.stall_rtol, &d.stall_rtol),
-            nrand: layer(&p.nrand, &d.nrand),
-            maxit: layer(&p.maxit, &d.maxit),
-            maxevals: layer(&p.maxevals, &d.maxevals),
-            max_starts: layer(&p.max_starts, &d.max_starts),
-            stall_starts: layer(&p.stall_starts, &d.stall_starts),
-            hop_scales: layer(&p.hop_scales, &d.hop_scales),
-            central_gammas: layer(&p.central_gammas, &d.central_gammas),
-            random_scales: layer(&p.random_scales, &d.random_scales),
-            open_loop_start: p.open_loop_start.or(d.open_loop_start),
-            variable_scaling: p.variable_scaling.or(d.variable_scaling),
-            spend_budget: p.spend_budget.or(d.spend_budget),
-            continue_at_maxit: p.continue_at_maxit.or(d.continue_at_maxit),
-            continued_maxit: layer(&p.continued_maxit, &d.continued_maxit),
-            return_gs_reserve: p.return_gs_reserve.or(d.return_gs_reserve),
-            refine_rtol: layer(&p.refine_rtol, &d.refine_rtol),
-            eps_continuation: p.eps_continuation.or(d.eps_continuation),
-            continued_cpumax: layer(&p.continued_cpumax, &d.continued_cpumax),
-        }
-    }
-
-    /// The options common to the problem's jobs (order, ε and seed are set per job). Values are
-    /// only collected here; `design::validate` judges them ([`check_options`]).
-    fn options(&self) -> DesignOptions {
-        let mut o = DesignOptions::default();
-        let value = |s: &Setting<f64>, default: f64| s.as_ref().map_or(default, |(x, _)| *x);
-        let count = |s: &Setting<usize>, default: usize| s.as_ref().map_or(default, |(x, _)| *x);
-        o.cpumax = value(&self.cpumax, o.cpumax);
-        o.normtol = value(&self.normtol, o.normtol);
-        o.evaldist = value(&self.evaldist, o.evaldist);
-        o.hinf_tol = value(&self.hinf_tol, o.hinf_tol);
-        o.stall_rtol = value(&self.stall_rtol, o.stall_rtol);
-        o.refine_rtol = value(&self.refine_rtol, o.refine_rtol);
-        o.nrand = count(&self.nrand, o.nrand);
-        o.maxit = count(&self.maxit, o.maxit);
-        o.continued_maxit = count(&self.continued_maxit, o.continued_maxit);
-        o.stall_starts = count(&self.stall_starts, o.stall_starts);
-        if let Some((x, _)) = &self.maxevals {
-            o.maxevals = Some(*x);
-        }
-        if let Some((x, _)) = &self.max_starts {
-            o.max_starts = Some(*x);
-        }
-        if let Some((x, _)) = &self.hop_scales {
-            o.hop_scales = x.clone();
-        }
-        if let Some((x, _)) = &self.central_gammas {
-            o.central_gammas = x.clone();
-        }
-        if let Some((x, _)) = &self.random_scales {
-            o.random_scales = x.clone();
-        }
-        if let Some(b) = self.open_loop_start {
-            o.open_loop_start = b;
-        }
-        if let Some(b) = self.variable_scaling {
-            o.variable_scaling = b;
-        }
-        if let Some(b) = self.spend_budget {
-            o.spend_budget = b;
-        }
-        if let Some(b) = self.continue_at_maxit {
-            o.continue_at_maxit = b;
-        }
-        if let Some(b) = self.return_gs_reserve {
-            o.return_gs_reserve = b;
-        }
-        if let Some(k) = self.objective {
-            o.objective = k;
-        }
-        if let Some(g) = self.gradient_sampling {
-            o.gradient_sampling = g;
-        }
-        o
-    }
-
-    /// The span of the value behind a `DesignError::Options` field (None: not a setting).
-    fn span_of(&self, field: &str) -> Option<Range<usize>> {
-        fn span<T>(s: &Setting<T>) -> Option<Range<usize>> {
-            s.as_ref().map(|(_, r)| r.clone())
-        }
-        match field {
-            "eps" => self.eps.as_ref().map(|s| s.span()),
-            "cpumax" => span(&self.cpumax),
-            "normtol" => span(&self.normtol),
-            "evaldist" => span(&self.evaldist),
-            "hinf_tol" => span(&self.hinf_tol),
-            "stall_rtol" => span(&self.stall_rtol),
-            "refine_rtol" => span(&self.refine_rtol),
-            "nrand" => span(&self.nrand),
-            "maxit" => span(&self.maxit),
-            "continued_maxit" => span(&self.continued_maxit),
-            "maxevals" => span(&self.maxevals),
-            "max_starts" => span(&self.max_starts),
-            "stall_starts" => span(&self.stall_starts),
-            "hop_scales" => span(&self.hop_scales),
-            "central_gammas" => span(&self.central_gammas),
-            "random_scales" => span(&self.random_scales),
-            _ => None,
-        }
-    }
-}
-
 /// Step 3b: the weights ε (default: [`DesignOptions::default`]'s).
-fn check_eps(eps: Option<&Spanned<EpsList>>, src: &Source) -> Result<Vec<f64>, SpecError> {
-    let Some(s) = eps else { return Ok(vec![DesignOptions::default().eps]) };
-    let v = s.get_ref().0.clone();
+fn check_eps(eps: &Setting<EpsList>, src: &Source) -> Result<Vec<f64>, SpecError> {
+    let Some((EpsList(v), span)) = eps else { return Ok(vec![DesignOptions::default().eps]) };
+    let v = v.clone();
     if v.is_empty() {
-        return Err(src.error(s.span(), "eps must list at least one weight"));
+        return Err(src.error(span.clone(), SpecProblem::NoEps));
     }
     if has_duplicates(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()) {
-        return Err(src.error(s.span(), "eps lists the same weight twice"));
+        return Err(src.error(span.clone(), SpecProblem::RepeatedEps));
     }
     Ok(v)
 }
 
 /// Step 3c: the seeds (default: seed 0).
-fn check_seeds(seeds: Option<&Spanned<Seeds>>, src: &Source) -> Result<Vec<u64>, SpecError> {
-    let Some(s) = seeds else { return Ok(vec![0]) };
-    let Seeds(v, _) = s.get_ref().clone();
+fn check_seeds(seeds: &Setting<Seeds>, src: &Source) -> Result<Vec<u64>, SpecError> {
+    let Some((Seeds(v, _), span)) = seeds else { return Ok(vec![DesignOptions::default().seed]) };
+    let v = v.clone();
     if v.is_empty() {
-        return Err(src.error(s.span(), "seeds must list at least one seed"));
+        return Err(src.error(span.clone(), SpecProblem::NoSeeds));
     }
     if let Some(bad) = v.iter().find(|x| **x < 0) {
-        return Err(src.error(s.span(), format!("seeds must be non-negative integers, found {bad}")));
+        return Err(src.error(span.clone(), SpecProblem::NegativeSeed(*bad)));
     }
     if has_duplicates(&v) {
-        return Err(src.error(s.span(), "seeds lists the same seed twice"));
+        return Err(src.error(span.clone(), SpecProblem::RepeatedSeed));
     }
     Ok(v.into_iter().map(|x| x as u64).collect())
 }
@@ -567,13 +533,13 @@ fn check_seeds(seeds: Option<&Spanned<Seeds>>, src: &Source) -> Result<Vec<u64>,
 fn check_orders(orders: &Spanned<Orders>, src: &Source) -> Result<Vec<usize>, SpecError> {
     let (v, span) = (&orders.get_ref().0, orders.span());
     if v.is_empty() {
-        return Err(src.error(span, "orders must list at least one controller order"));
+        return Err(src.error(span, SpecProblem::NoOrders));
     }
     if let Some(bad) = v.iter().find(|o| **o < 0 || **o > MAX_ORDER as i64) {
-        return Err(src.error(span, format!("controller orders must be integers in 0..={MAX_ORDER}, found {bad}")));
+        return Err(src.error(span, SpecProblem::OrderOutOfRange(*bad)));
     }
     if has_duplicates(v) {
-        return Err(src.error(span, "orders lists the same order twice"));
+        return Err(src.error(span, SpecProblem::RepeatedOrder));
     }
     let mut sorted: Vec<usize> = v.iter().map(|o| *o as usize).collect();
     sorted.sort_unstable();
@@ -583,7 +549,7 @@ fn check_orders(orders: &Spanned<Orders>, src: &Source) -> Result<Vec<usize>, Sp
 /// Step 3e: the plant, resolved ([`resolve_plant_arg`]) and loaded; errors point at `plant`.
 fn load_plant(plant: &Spanned<String>, base_dir: &Path, src: &Source) -> Result<(PathBuf, Plant), SpecError> {
     let path = resolve_plant_arg(plant.get_ref(), base_dir).map_err(|m| src.error(plant.span(), m))?;
-    let loaded = Plant::load(&path).map_err(|e| src.error(plant.span(), e.to_string()))?;
+    let loaded = Plant::load(&path).map_err(|e| src.error(plant.span(), SpecProblem::Plant(Box::new(e))))?;
     Ok((path, loaded))
 }
 
@@ -614,7 +580,7 @@ fn check_options(
                     crate::design::DesignError::Options { field, .. } => settings.span_of(field),
                     _ => None,
                 };
-                return Err(src.error(span.unwrap_or(p.plant.span()), err.to_string()));
+                return Err(src.error(span.unwrap_or(p.plant.span()), SpecProblem::Options(Box::new(err))));
             }
         }
     }
@@ -628,12 +594,7 @@ fn check_job_count(problems: &[Problem], raw: &[RawProblem], src: &Source) -> Re
         let n = p.orders.len().saturating_mul(p.eps.len()).saturating_mul(p.seeds.len());
         total = total.saturating_add(n);
         if total > MAX_JOBS {
-            return Err(src.error(
-                raw_p.plant.span(),
-                format!(
-                    "the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)"
-                ),
-            ));
+            return Err(src.error(raw_p.plant.span(), SpecProblem::TooManyJobs));
         }
     }
     Ok(())
@@ -650,14 +611,13 @@ fn check_unique_jobs(campaign: &Campaign) -> Result<(), SpecError> {
             return Err(SpecError {
                 file: campaign.file.clone(),
                 location: p.location,
-                message: format!(
-                    "this problem repeats a job of the problem at line {} (plant {}, order {}, ε {}, seed {})",
-                    campaign.problems[first].location.line,
-                    p.plant.name,
-                    j.options.order,
-                    j.options.eps,
-                    j.options.seed
-                ),
+                message: SpecProblem::RepeatedJob {
+                    first_line: campaign.problems[first].location.line,
+                    plant: p.plant.name.clone(),
+                    order: j.options.order,
+                    eps: j.options.eps,
+                    seed: j.options.seed,
+                },
             });
         }
     }
@@ -671,26 +631,27 @@ fn has_duplicates<T: Ord + Clone>(v: &[T]) -> bool {
 }
 
 /// A bare name goes to the plant library; a path is taken relative to the campaign file.
-fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, String> {
+fn resolve_plant_arg(arg: &str, base_dir: &Path) -> Result<PathBuf, SpecProblem> {
     if arg.is_empty() {
-        return Err("plant must name a plant (e.g. \"HE1\") or a plant file".into());
+        return Err(SpecProblem::NoPlant);
     }
     let is_path = arg.contains('/') || arg.ends_with(".json") || arg.ends_with(".mat");
     if is_path {
         let p = Path::new(arg);
         let p = if p.is_absolute() { p.to_path_buf() } else { base_dir.join(p) };
         if let Some(why) = crate::input::not_a_file(&p) {
-            return Err(format!("plant file {} {why}", p.display()));
+            return Err(SpecProblem::NotAFile { path: p, why });
         }
         Ok(p)
     } else {
-        crate::lti::resolve_plant(arg).map_err(|e| e.to_string())
+        crate::lti::resolve_plant(arg).map_err(|e| SpecProblem::Plant(Box::new(e)))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::{ObjectiveKind, VariableScaling};
 
     fn parse(text: &str) -> Result<Campaign, SpecError> {
         Campaign::from_toml_str(text, Path::new("test.toml"))
@@ -773,15 +734,15 @@ objective = "plain"
         let c = parse("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
         assert_eq!(c.problems[0].base.variable_scaling, VariableScaling::Alternate, "the default");
         let e = err("name = \"t\"\n[defaults]\nvariable_scaling = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
-        assert!(e.message.contains("variable_scaling") || e.location.line == 3, "{e}");
+        assert!(e.message.to_string().contains("variable_scaling") || e.location.line == 3, "{e}");
         let e = err(
             "name = \"t\"\n[defaults]\nvariable_scaling = \"sometimes\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n",
         );
         assert_eq!(e.location.line, 3, "{e}");
-        assert!(e.message.contains("alternate") && e.message.contains("sometimes"), "{e}");
+        assert!(e.message.to_string().contains("alternate") && e.message.to_string().contains("sometimes"), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nrandom_scales = [1.0, 0.0]\n");
         assert_eq!((e.location.line, e.location.column), (5, 17), "{e}");
-        assert!(e.message.contains("random_scales"), "{e}");
+        assert!(e.message.to_string().contains("random_scales"), "{e}");
     }
 
     #[test]
@@ -799,7 +760,7 @@ objective = "plain"
         );
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nspend_budget = 1\n");
         assert_eq!(e.location.line, 5, "{e}");
-        assert!(e.message.contains("bool"), "{e}");
+        assert!(e.message.to_string().contains("bool"), "{e}");
     }
 
     #[test]
@@ -816,7 +777,7 @@ objective = "plain"
         assert_eq!((d.problems[0].eps_continuation, d.problems[0].continued_cpumax), (false, None));
         let e = err("name = \"t\"\n[defaults]\ncpumax = 5.0\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_cpumax = -1.0\n");
         assert_eq!(e.location.line, 7, "{e}");
-        assert!(e.message.contains("cpumax"), "{e}");
+        assert!(e.message.to_string().contains("cpumax"), "{e}");
     }
 
     #[test]
@@ -840,7 +801,7 @@ objective = "plain"
         assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncontinued_maxit = 1000000000\n");
         assert_eq!((e.location.line, e.location.column), (5, 19), "{e}");
-        assert!(e.message.contains("continued_maxit"), "{e}");
+        assert!(e.message.to_string().contains("continued_maxit"), "{e}");
     }
 
     #[test]
@@ -864,7 +825,7 @@ objective = "plain"
         assert_eq!(ids(&c), ids(&parse(&text("", "")).unwrap()));
         let e = err(&text("", "trace = \"verbose\""));
         assert_eq!((e.location.line, e.location.column), (7, 9), "{e}");
-        assert!(e.message.contains("verbose") && e.message.contains("sparse"), "{e}");
+        assert!(e.message.to_string().contains("verbose") && e.message.to_string().contains("sparse"), "{e}");
         let e = err(&text("trace = true", ""));
         assert_eq!((e.location.line, e.location.column), (3, 9), "{e}");
         assert!(e.to_string().starts_with("test.toml:3:9: "), "{e}");
@@ -874,13 +835,13 @@ objective = "plain"
     fn unknown_key_names_line_and_column() {
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nordres = [2]\n");
         assert_eq!((e.location.line, e.location.column), (5, 1), "{e}");
-        assert!(e.message.contains("ordres"), "{e}");
+        assert!(e.message.to_string().contains("ordres"), "{e}");
         let text = e.to_string();
         assert!(text.starts_with("test.toml:5:1: "), "{text}");
 
         let e = err("name = \"t\"\n[defaults]\n  cpu_max = 3\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
         assert_eq!((e.location.line, e.location.column), (3, 3), "{e}");
-        assert!(e.message.contains("cpu_max"), "{e}");
+        assert!(e.message.to_string().contains("cpu_max"), "{e}");
     }
 
     #[test]
@@ -892,7 +853,7 @@ objective = "plain"
         assert_eq!((e.location.line, e.location.column), (4, 10), "{e}");
         let e = err("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\nobjective = \"h2\"\n");
         assert_eq!(e.location.line, 5, "{e}");
-        assert!(e.message.contains("h2"), "{e}");
+        assert!(e.message.to_string().contains("h2"), "{e}");
         let e = err("name = 3\n[[problem]]\nplant = \"HE1\"\norders = [1]\n");
         assert_eq!((e.location.line, e.location.column), (1, 8), "{e}");
     }
@@ -917,7 +878,7 @@ objective = "plain"
         for (text, line, col, word) in cases {
             let e = err(text);
             assert_eq!((e.location.line, e.location.column), (*line, *col), "{text}\n→ {e}");
-            assert!(e.message.contains(word), "{text}\n→ {e}");
+            assert!(e.message.to_string().contains(word), "{text}\n→ {e}");
         }
     }
 
@@ -927,7 +888,7 @@ objective = "plain"
             "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n[[problem]]\nplant = \"HE1\"\norders = [2]\n",
         );
         assert_eq!(e.location.line, 6, "{e}");
-        assert!(e.message.contains("repeats"), "{e}");
+        assert!(e.message.to_string().contains("repeats"), "{e}");
     }
 
     #[test]

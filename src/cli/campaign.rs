@@ -1,26 +1,15 @@
 //! `campaign run | status | report | trace`: the command-line edge of `crate::campaign`. All the
 //! work is in the library (spec, jobs, scheduler, journal, progress, trace, report); this file
 //! only parses arguments, wires the pieces together and maps outcomes to exit codes.
-use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use crate::campaign::claims::{unix_now, ClaimDir};
-use crate::campaign::fake::FakeRunner;
-use crate::campaign::journal::{journals_in, Follower};
-use crate::campaign::progress::{Display, Reporter};
-use crate::campaign::record::JobRecord;
-use crate::campaign::reduce::plant_labels;
-use crate::campaign::run::{campaign_dir, duplicate_ids, records_for, run_jobs};
-use crate::campaign::scheduler::{DesignRunner, ExecuteOptions, JobRunner};
-use crate::campaign::shard::{self, Shard};
 use crate::campaign::{
-    expand, load_default_reference, summarise, trace_observers, write_reports, Campaign, Job, PlantMap, RunnerTag,
-    TraceLevel,
+    campaign_dir, expand, for_terminal, journals_in, load_default_reference, plant_map, records_for, run_jobs,
+    shard_jobs, shard_plan, summarise, trace_observers, Campaign, CampaignStatus, DesignRunner, ExecuteOptions,
+    Follower, Job, JobRecord, JobRunner, ProgressDisplay, Reporter, RunnerTag, Shard, TornTail, TraceLevel,
 };
 use anyhow::Context;
-
-use crate::campaign::sanitise::for_terminal;
 
 use super::{signals, EXIT_JOBS_FAILED};
 
@@ -124,29 +113,22 @@ struct Loaded {
 
 /// Loads the campaign file and expands its jobs for `fake` (the machinery tests' fake runner,
 /// [`crate::cli::main_with`]) or, when `None`, for the design.
-fn load(a: &CampaignFileArgs, fake: Option<FakeRunner>) -> anyhow::Result<Loaded> {
+fn load(a: &CampaignFileArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<Loaded> {
     let campaign = Campaign::load(&a.file)?;
     // The fake runner makes jobs with different ids, so its records can never be mistaken for
     // real ones.
-    let fake = fake.map(|f| Box::new(f) as Box<dyn JobRunner>);
     let tag = if fake.is_some() { RunnerTag::Fake } else { RunnerTag::Design };
     let jobs = expand(&campaign, tag);
     let dir = campaign_dir(&a.results, &campaign.name);
     Ok(Loaded { campaign, jobs, dir, fake })
 }
 
-/// The campaign's plants by content fingerprint (their identity in records).
-fn plant_map(c: &Campaign) -> PlantMap {
-    c.problems.iter().map(|p| (p.fingerprint.clone(), p.plant.clone())).collect::<BTreeMap<_, _>>()
-}
-
 /// Reduces `records` (the campaign's, duplicates included) to the report files in `dir` and
 /// prints the comparison, and how many jobs were journaled more than once.
 fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Result<()> {
-    let reference = load_default_reference().context("reading the paper's reference table")?;
-    let summary = write_reports(dir, records, &plant_map(c), &reference)?;
-    print!("{summary}");
-    let dups = duplicate_ids(records);
+    let report = crate::campaign::report(dir, c, records)?;
+    print!("{}", report.summary);
+    let dups = &report.duplicates;
     if !dups.is_empty() {
         let extra: usize = dups.iter().map(|(_, n)| n - 1).sum();
         eprintln!(
@@ -158,11 +140,11 @@ fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Resul
 }
 
 /// `campaign run FILE`.
-pub fn run(a: RunArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+pub fn run(a: RunArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign, fake)?;
     std::fs::create_dir_all(&l.dir).with_context(|| format!("creating {}", l.dir.display()))?;
     let jobs = match a.shard {
-        Some(s) => shard::select(&l.jobs, s),
+        Some(s) => shard_jobs(&l.jobs, s),
         None => l.jobs.clone(),
     };
     let threads = l.campaign.threads(a.threads.map(|t| t as usize));
@@ -175,7 +157,7 @@ pub fn run(a: RunArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
         None => &DesignRunner,
     };
     let observers = trace_observers(&l.dir.join("traces"), l.campaign.trace_levels(a.trace));
-    let mut reporter = Reporter::new(&jobs, Display::choose(a.no_progress));
+    let mut reporter = Reporter::new(&jobs, ProgressDisplay::choose(a.no_progress));
     let (name, dir) = (for_terminal(&l.campaign.name), for_terminal(&l.dir.display().to_string()));
     match a.shard {
         Some(s) => eprintln!("campaign {name} shard {s}: {} of {} jobs → {dir}", jobs.len(), l.jobs.len()),
@@ -222,7 +204,7 @@ pub fn run(a: RunArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn warn_torn(torn: &[(PathBuf, crate::campaign::journal::TornTail)]) {
+fn warn_torn(torn: &[(PathBuf, TornTail)]) {
     for (path, t) in torn {
         eprintln!("warning: {}: line {} is torn ({}); ignored", path.display(), t.line, t.reason);
     }
@@ -252,108 +234,76 @@ fn journaled(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<(Vec<JobRecord>,
 }
 
 /// `campaign status FILE`.
-pub fn status(a: StatusArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+pub fn status(a: StatusArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign, fake)?;
     let (records, journals) = journaled(&l, &a.extra)?;
-    // job id → whether some record of it did not fail
-    let mut done: HashMap<_, bool> = HashMap::new();
-    for r in &records {
-        *done.entry(&r.job_id).or_default() |= !r.failed();
-    }
-    let claims = ClaimDir::new(&l.dir).list()?;
-    let index: HashMap<_, _> = l.jobs.iter().map(|j| (&j.id, j)).collect();
-    let running: HashMap<_, _> = claims
-        .iter()
-        .filter(|c| c.held && !done.contains_key(&c.job))
-        .filter_map(|c| index.get(&c.job).map(|j| (&j.id, c)))
-        .collect();
-    let labels = plant_labels(l.jobs.iter().map(|j| (j.plant_fingerprint.as_str(), j.plant_name.as_str())));
-    // plant → (jobs, done, running, failed), in campaign order; plants by fingerprint.
-    let mut rows: Vec<(&str, usize, usize, usize, usize)> = Vec::new();
-    for j in &l.jobs {
-        let label = labels[&j.plant_fingerprint].as_str();
-        let i = match rows.iter().position(|r| r.0 == label) {
-            Some(i) => i,
-            None => {
-                rows.push((label, 0, 0, 0, 0));
-                rows.len() - 1
-            }
-        };
-        rows[i].1 += 1;
-        if let Some(ok) = done.get(&j.id) {
-            rows[i].2 += 1;
-            rows[i].4 += !ok as usize;
-        } else if running.contains_key(&j.id) {
-            rows[i].3 += 1;
-        }
-    }
-    let names: Vec<String> = journals.iter().map(|p| p.display().to_string()).collect();
-    println!(
-        "campaign {} ({} journal(s): {})",
-        for_terminal(&l.campaign.name),
-        names.len(),
-        for_terminal(&names.join(", "))
-    );
-    println!("{:<16} {:>6} {:>6} {:>8} {:>9} {:>7}", "plant", "jobs", "done", "running", "remaining", "failed");
-    for (p, n, d, r, f) in &rows {
-        println!("{:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", for_terminal(p), n - d - r);
-    }
-    let (n, d, r, f) = rows.iter().fold((0, 0, 0, 0), |acc, x| (acc.0 + x.1, acc.1 + x.2, acc.2 + x.3, acc.3 + x.4));
-    println!("{:<16} {n:>6} {d:>6} {r:>8} {:>9} {f:>7}", "total", n - d - r);
-    if !running.is_empty() {
-        println!("running:");
-        for j in l.jobs.iter().filter(|j| running.contains_key(&j.id)) {
-            let who = match &running[&j.id].owner {
-                Some(o) => format!("{}:{} for {:.0} s", o.host, o.pid, (unix_now() - o.since_unix_s).max(0.0)),
-                None => "(owner not written yet)".into(),
-            };
-            println!("  {}  {}  {}", j.id.short(), for_terminal(&j.label()), for_terminal(&who));
-        }
-    }
-    let stale = claims.iter().filter(|c| !c.held && !done.contains_key(&c.job)).count();
-    if stale > 0 {
-        println!("{stale} claim(s) left by processes that died: those jobs run again at the next `campaign run`");
-    }
-    let dups = duplicate_ids(&records);
-    if !dups.is_empty() {
-        println!(
-            "{} job(s) have more than one record; reports count each once, by its best verified record:",
-            dups.len()
-        );
-        for (id, n) in &dups {
-            let label = index.get(id).map_or_else(String::new, |j| j.label());
-            println!("  {}  {}  {n} records", id.short(), for_terminal(&label));
-        }
-    }
+    let s = crate::campaign::status(&l.jobs, &records, &l.dir)?;
+    print!("{}", status_text(&l.campaign.name, &journals, &s));
     if let Some(n) = a.shards {
         print_shards(&l, n as usize, l.campaign.threads(a.threads.map(|t| t as usize)));
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// The shard plan of `status --shards N`. A shard's wall time is bounded by list scheduling on
-/// `threads` workers: Σ cpumax / threads + its longest warm-start chain (Graham's bound; jobs
-/// stop at their CPU budget, and a worker thread gets a CPU to itself). The array time limit
-/// adds 25 % and 10 minutes for start-up, reports and a loaded node.
-fn print_shards(l: &Loaded, n: usize, threads: usize) {
-    let assign = shard::assign(&l.jobs, n);
-    let index: HashMap<_, _> = l.jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
-    // budget of the chain up to and including each job
-    let mut chain = vec![0.0f64; l.jobs.len()];
-    for (i, j) in l.jobs.iter().enumerate() {
-        let before = j.warm_from.as_ref().and_then(|p| index.get(p)).map_or(0.0, |&p| chain[p]);
-        chain[i] = before + j.options.cpumax;
+/// The status table, the running jobs, stale claims and duplicate records, for the terminal.
+fn status_text(name: &str, journals: &[PathBuf], s: &CampaignStatus) -> String {
+    let mut out = String::new();
+    let names: Vec<String> = journals.iter().map(|p| p.display().to_string()).collect();
+    out +=
+        &format!("campaign {} ({} journal(s): {})\n", for_terminal(name), names.len(), for_terminal(&names.join(", ")));
+    out +=
+        &format!("{:<16} {:>6} {:>6} {:>8} {:>9} {:>7}\n", "plant", "jobs", "done", "running", "remaining", "failed");
+    for p in s.plants.iter().chain([&s.total()]) {
+        out += &format!(
+            "{:<16} {:>6} {:>6} {:>8} {:>9} {:>7}\n",
+            for_terminal(&p.plant),
+            p.jobs,
+            p.done,
+            p.running,
+            p.remaining(),
+            p.failed
+        );
     }
+    if !s.running.is_empty() {
+        out += "running:\n";
+        for j in &s.running {
+            let who = match &j.owner {
+                Some(o) => {
+                    format!("{}:{} for {:.0} s", o.host, o.pid, (crate::campaign::unix_now() - o.since_unix_s).max(0.0))
+                }
+                None => "(owner not written yet)".into(),
+            };
+            out += &format!("  {}  {}  {}\n", j.id.short(), for_terminal(&j.label), for_terminal(&who));
+        }
+    }
+    if s.stale_claims > 0 {
+        out += &format!(
+            "{} claim(s) left by processes that died: those jobs run again at the next `campaign run`\n",
+            s.stale_claims
+        );
+    }
+    if !s.duplicates.is_empty() {
+        out += &format!(
+            "{} job(s) have more than one record; reports count each once, by its best verified record:\n",
+            s.duplicates.len()
+        );
+        for d in &s.duplicates {
+            let label = d.label.clone().unwrap_or_default();
+            out += &format!("  {}  {}  {} records\n", d.id.short(), for_terminal(&label), d.records);
+        }
+    }
+    out
+}
+
+/// The shard plan of `status --shards N` ([`shard_plan`]). The array time limit adds 25 % and
+/// 10 minutes for start-up, reports and a loaded node.
+fn print_shards(l: &Loaded, n: usize, threads: usize) {
     println!("{n} shard(s) at {threads} thread(s) each:");
     println!("{:>8} {:>6} {:>12} {:>14}", "shard", "jobs", "cpu budget", "wall bound");
     let mut worst = 0.0f64;
-    for k in 0..n {
-        let mine: Vec<usize> = (0..l.jobs.len()).filter(|&i| assign[i] == k).collect();
-        let cpu: f64 = mine.iter().map(|&i| l.jobs[i].options.cpumax).sum();
-        let longest = mine.iter().map(|&i| chain[i]).fold(0.0, f64::max);
-        let wall = cpu / threads as f64 + longest;
-        worst = worst.max(wall);
-        println!("{:>8} {:>6} {:>10.0} s {:>12.0} s", format!("{}/{n}", k + 1), mine.len(), cpu, wall);
+    for (k, s) in shard_plan(&l.jobs, n, threads).iter().enumerate() {
+        worst = worst.max(s.wall_bound_s);
+        println!("{:>8} {:>6} {:>10.0} s {:>12.0} s", format!("{}/{n}", k + 1), s.jobs, s.cpu_s, s.wall_bound_s);
     }
     println!("slurm time per task: {}", slurm_time(worst * 1.25 + 600.0));
 }
@@ -386,7 +336,7 @@ fn finished_records(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<Vec<JobRe
 }
 
 /// `campaign report FILE`.
-pub fn report(a: ReportArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+pub fn report(a: ReportArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
     report_into(&l.dir, &l.campaign, &records)?;
@@ -394,7 +344,7 @@ pub fn report(a: ReportArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCod
 }
 
 /// `campaign plot FILE`: figures of the journaled jobs into `<results>/<name>/plots/`.
-pub fn plot(a: PlotArgs, fake: Option<FakeRunner>) -> anyhow::Result<ExitCode> {
+pub fn plot(a: PlotArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
     let reference = load_default_reference().context("reading the paper's reference table")?;

@@ -138,7 +138,7 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     };
     let mut s = format!(
         "plant {} (n = {}), controller of order {}\n",
-        crate::campaign::sanitise::for_terminal(&plant.name),
+        crate::campaign::for_terminal(&plant.name),
         plant.dims.n,
         k.order()
     );

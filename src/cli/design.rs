@@ -18,7 +18,6 @@ use std::sync::Arc;
 
 use crate::design::{
     run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, VariableScaling,
-    DEFAULT_CONTINUED_MAXIT, DEFAULT_REFINE_RTOL, DEFAULT_STALL_STARTS,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
@@ -26,9 +25,25 @@ use crate::optim::RunControl;
 use anyhow::Context;
 
 use super::{fmt_num, signals, EXIT_NOT_STABILISED};
-use crate::campaign::sanitise::for_terminal;
+use crate::campaign::for_terminal;
 
-/// Arguments of `campaign design`.
+/// The default of a flag: the option's default ([`DesignOptions::default`], the option table of
+/// design/options.rs), never a literal of its own.
+fn default() -> DesignOptions {
+    DesignOptions::default()
+}
+
+/// A list default as the comma-separated text its flag reads (`0.01,0.1,1`; `none` when empty).
+fn list_text(v: &[f64]) -> String {
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(",")
+    }
+}
+
+/// Arguments of `campaign design`. Each flag's default is its option's
+/// ([`DesignOptions::default`]); a switch names the side that is not the default.
 #[derive(clap::Args, Debug)]
 pub struct DesignArgs {
     /// Plant name (from plants/) or path to a plant file (JSON, or MATLAB .mat with A B1 B2 C1 C2 D11 D12 D21 D22).
@@ -38,30 +53,30 @@ pub struct DesignArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub order: usize,
     /// Weight ε of ‖K‖∞ and α(Ak) (strong stabilisation), > 0.
-    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = default().eps, allow_hyphen_values = true)]
     pub eps: f64,
     /// Seed of the random starting points.
-    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = default().seed, allow_hyphen_values = true)]
     pub seed: u64,
     /// Budget of the whole design in CPU seconds (thread CPU time, not wall-clock time; a run
     /// it ends is not reproducible bit for bit).
-    #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = default().cpumax, allow_hyphen_values = true)]
     pub cpumax: f64,
     /// Evaluation budget of the whole design (deterministic: same seed, same controller).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_hyphen_values = true)]
     pub maxevals: Option<u64>,
     /// Number of first random starts (HIFOO's nrand), or of perturbations of --init, 1..=10000.
-    #[arg(long, default_value_t = 3, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = default().nrand, allow_hyphen_values = true)]
     pub nrand: usize,
     /// After the first starts, keep starting local searches (basin hops of the best point and
     /// random starts) until a budget ends the run. The stall rule — this many local searches in
     /// a row have not improved the best objective by --stall-rtol — ends runs without any budget
     /// (--cpumax inf and no --maxevals, --max-starts), or with --stop-on-stall any run once a
     /// stabilising controller is found. 0: HIFOO's search (the first starts only).
-    #[arg(long, value_name = "K", default_value_t = DEFAULT_STALL_STARTS, allow_hyphen_values = true)]
+    #[arg(long, value_name = "K", default_value_t = default().stall_starts, allow_hyphen_values = true)]
     pub stall_starts: usize,
     /// Relative improvement that resets the stall count.
-    #[arg(long, value_name = "R", default_value_t = 1e-6, allow_hyphen_values = true)]
+    #[arg(long, value_name = "R", default_value_t = default().stall_rtol, allow_hyphen_values = true)]
     pub stall_rtol: f64,
     /// Let the stall rule end the run even when a budget (--cpumax, --maxevals, --max-starts)
     /// bounds it. By default a bounded run spends its budget: once a stabilising controller is
@@ -76,7 +91,7 @@ pub struct DesignArgs {
     /// BFGS iteration limit of the continued search's local searches on the H∞ objective
     /// (HIFOO's first starts keep its 1000); 0: the same 1000. Only local searches on many
     /// variables reach it.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_CONTINUED_MAXIT, allow_hyphen_values = true)]
+    #[arg(long, value_name = "N", default_value_t = default().continued_maxit, allow_hyphen_values = true)]
     pub continued_maxit: usize,
     /// Keep the whole gradient-sampling reserve (10 % of the budget) to the end. By default
     /// gradient sampling runs on the best controller right after the --nrand first starts (as
@@ -88,19 +103,19 @@ pub struct DesignArgs {
     /// certificate at most this relative amount above the best controller gets gradient sampling
     /// from its end point, so that its basin is judged by a refined value, as the best one's is.
     /// 0: none (the default; 0.03 is the value measured in docs/ALGORITHMS.md §8.3).
-    #[arg(long, value_name = "R", default_value_t = DEFAULT_REFINE_RTOL, allow_hyphen_values = true)]
+    #[arg(long, value_name = "R", default_value_t = default().refine_rtol, allow_hyphen_values = true)]
     pub refine_rtol: f64,
     /// Largest number of local searches (first starts included; deterministic).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), allow_hyphen_values = true)]
     pub max_starts: Option<u64>,
     /// Relative sizes of the basin-hopping perturbations of the best point, comma-separated
     /// (one hop per size, then one random start, in turn). "none": random starts only.
-    #[arg(long, value_name = "R,R,...", default_value = "0.01,0.1,1", allow_hyphen_values = true)]
+    #[arg(long, value_name = "R,R,...", default_value_t = list_text(&default().hop_scales), allow_hyphen_values = true)]
     pub hop_scales: String,
     /// Scales σ of the continued search's fresh random starts σ·N(0, I), comma-separated, used in
     /// turn (the first --nrand starts are always standard normal). Small scales reach small
     /// gains, which badly scaled plants need to be stabilised.
-    #[arg(long, value_name = "S,S,...", default_value = "1,0.1,0.01", allow_hyphen_values = true)]
+    #[arg(long, value_name = "S,S,...", default_value_t = list_text(&default().random_scales), allow_hyphen_values = true)]
     pub random_scales: String,
     /// Do not make the open-loop start K = 0 (by default one more first start after the random
     /// ones: Bk, Ck, Dk = 0 and Ak a stable diagonal).
@@ -114,13 +129,13 @@ pub struct DesignArgs {
     /// bare --variable-scaling). No change for a plant whose
     /// channels are within 2^10 of each other. Plants whose channels differ by orders of
     /// magnitude (AC10) need the scaled searches, others (BDT2) do better unscaled.
-    #[arg(long, value_name = "MODE", default_value = "alternate", num_args = 0..=1,
+    #[arg(long, value_name = "MODE", default_value = default().variable_scaling.name(), num_args = 0..=1,
           default_missing_value = "always", value_parser = VariableScaling::parse)]
     pub variable_scaling: VariableScaling,
     /// Reduced-order central-controller starts: factors f > 1, comma-separated; for each, the
     /// full-order H∞ central controller at f·gamma_opt, reduced to --order by balanced
     /// truncation, is one more first start (plants with ≤ 100 states). "none": no such starts.
-    #[arg(long, value_name = "F,F,...", default_value = "1.1,2", allow_hyphen_values = true)]
+    #[arg(long, value_name = "F,F,...", default_value_t = list_text(&default().central_gammas), allow_hyphen_values = true)]
     pub central_gammas: String,
     /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
     #[arg(long)]
@@ -144,29 +159,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         Some(path) => Some(Controller::load(path)?),
         None => None,
     };
-    let opts = DesignOptions {
-        order: a.order,
-        eps: a.eps,
-        seed: a.seed,
-        cpumax: a.cpumax,
-        maxevals: a.maxevals.map(|n| n as usize),
-        nrand: a.nrand,
-        stall_starts: a.stall_starts,
-        stall_rtol: a.stall_rtol,
-        spend_budget: !a.stop_on_stall,
-        continue_at_maxit: !a.no_continue_at_maxit,
-        continued_maxit: a.continued_maxit,
-        return_gs_reserve: !a.keep_gs_reserve,
-        refine_rtol: a.refine_rtol,
-        max_starts: a.max_starts.map(|n| n as usize),
-        hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
-        central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,
-        random_scales: parse_scales(&a.random_scales, "--random-scales")?,
-        open_loop_start: !a.no_open_loop_start,
-        variable_scaling: a.variable_scaling,
-        objective: if a.no_strong { ObjectiveKind::Plain } else { ObjectiveKind::Strong },
-        ..Default::default()
-    };
+    let opts = options(&a)?;
     // Bad options and an unusable --out are errors before any work (and before any file is made).
     crate::design::validate(&plant, &opts, init.as_ref())
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
@@ -202,6 +195,35 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         DesignStatus::Interrupted => ExitCode::from(signals::exit_code()),
         DesignStatus::NotStabilised { .. } => ExitCode::from(EXIT_NOT_STABILISED),
         _ => ExitCode::SUCCESS,
+    })
+}
+
+/// The design options the flags ask for: each one the flag's value, a switch the non-default
+/// side of its option.
+fn options(a: &DesignArgs) -> anyhow::Result<DesignOptions> {
+    let d = DesignOptions::default();
+    Ok(DesignOptions {
+        order: a.order,
+        eps: a.eps,
+        seed: a.seed,
+        cpumax: a.cpumax,
+        maxevals: a.maxevals.map(|n| n as usize),
+        nrand: a.nrand,
+        stall_starts: a.stall_starts,
+        stall_rtol: a.stall_rtol,
+        spend_budget: if a.stop_on_stall { false } else { d.spend_budget },
+        continue_at_maxit: if a.no_continue_at_maxit { false } else { d.continue_at_maxit },
+        continued_maxit: a.continued_maxit,
+        return_gs_reserve: if a.keep_gs_reserve { false } else { d.return_gs_reserve },
+        refine_rtol: a.refine_rtol,
+        max_starts: a.max_starts.map(|n| n as usize),
+        hop_scales: parse_scales(&a.hop_scales, "--hop-scales")?,
+        central_gammas: parse_scales(&a.central_gammas, "--central-gammas")?,
+        random_scales: parse_scales(&a.random_scales, "--random-scales")?,
+        open_loop_start: if a.no_open_loop_start { false } else { d.open_loop_start },
+        variable_scaling: a.variable_scaling,
+        objective: if a.no_strong { ObjectiveKind::Plain } else { d.objective },
+        ..d
     })
 }
 
@@ -295,4 +317,39 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
     }
     s += &format!("controller written to {}\n", out.display());
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    use super::*;
+
+    /// `campaign design` with only the required flags designs with the options' defaults.
+    #[test]
+    fn the_flags_default_to_the_options_defaults() {
+        use clap::Parser;
+        let cli = crate::cli::Cli::try_parse_from([
+            "campaign", "design", "--plant", "HE1", "--order", "2", "--out", "K.json",
+        ])
+        .unwrap();
+        let a = cli.design_args().expect("a design command");
+        assert_eq!(options(a).unwrap(), DesignOptions { order: 2, ..DesignOptions::default() });
+    }
+
+    /// Every flag the option table names is a flag of `campaign design`.
+    #[test]
+    fn the_option_tables_flags_exist() {
+        let cmd = crate::cli::Cli::command();
+        let design = cmd.find_subcommand("design").unwrap();
+        let flags: Vec<String> =
+            design.get_arguments().filter_map(|a| a.get_long()).map(|l| format!("--{l}")).collect();
+        for row in DesignOptions::table() {
+            assert!(
+                row.flag.is_empty() || flags.iter().any(|f| f == row.flag),
+                "{} is not a flag: {flags:?}",
+                row.flag
+            );
+        }
+    }
 }

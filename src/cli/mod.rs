@@ -2,8 +2,8 @@
 //! subcommand lives in its own file; errors become `anyhow` only here, at the edge, and map to
 //! documented exit codes. It sits on top of every layer and nothing in the library uses it; it is
 //! in the library (not in src/main.rs) so that the machinery tests' binary with the fake runner
-//! (examples/fake_campaign.rs, [`main_with`]) is the same command line without a second build of
-//! the crate.
+//! (examples/fake_campaign.rs, `main_with`, with the `test-support` feature) is the same command
+//! line.
 //!
 //! Exit codes: 0 success, 1 error, 2 usage error (clap), 3 some campaign jobs failed,
 //! 4 not stabilised (`design` found no (strongly) stabilising controller; `check`: the closed
@@ -13,7 +13,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::campaign::fake::FakeRunner;
+#[cfg(feature = "test-support")]
+use crate::campaign::FakeRunner;
+use crate::campaign::JobRunner;
 
 mod campaign;
 mod check;
@@ -29,6 +31,17 @@ mod signals;
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+#[cfg(test)]
+impl Cli {
+    /// The arguments of a `design` command line.
+    fn design_args(&self) -> Option<&design::DesignArgs> {
+        match &self.command {
+            Command::Design(a) => Some(a),
+            _ => None,
+        }
+    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -75,16 +88,24 @@ pub(crate) fn fmt_num(x: f64, prec: usize) -> String {
 
 /// Parses the command line and runs it: the `campaign` binary.
 pub fn main() -> ExitCode {
-    main_with(None)
+    run_command_line(None)
 }
 
 /// [`main`], with the campaign jobs run by `fake` instead of the design when it is given: the
 /// test-only binary examples/fake_campaign.rs, which the machinery tests (scheduling, journal,
 /// kill -9, resume) run so that a campaign takes seconds. Its jobs carry
 /// [`RunnerTag::Fake`](crate::campaign::RunnerTag::Fake) in their ids and `"runner": "fake"` in
-/// their records, so they never pass for real ones. The `campaign` binary always passes `None`:
-/// no environment variable or option switches it to fake results.
+/// their records, so they never pass for real ones. Only with the `test-support` feature, which
+/// `cargo build` and `cargo install` leave off: the `campaign` binary has no way to fake
+/// results.
+#[cfg(feature = "test-support")]
 pub fn main_with(fake: Option<FakeRunner>) -> ExitCode {
+    run_command_line(fake.map(|f| Box::new(f) as Box<dyn JobRunner>))
+}
+
+/// [`main`], with the campaign jobs run by `fake` (with [`RunnerTag::Fake`](crate::campaign::RunnerTag::Fake)
+/// ids) when it is given.
+fn run_command_line(fake: Option<Box<dyn JobRunner>>) -> ExitCode {
     crate::malloc_tuning::keep_freed_memory();
     let cli = Cli::parse();
     if !matches!(cli.command, Command::Run(_) | Command::Design(_) | Command::Plot(_)) {
@@ -105,7 +126,7 @@ pub fn main_with(fake: Option<FakeRunner>) -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", crate::campaign::sanitise::for_terminal(&error_text(&e)));
+            eprintln!("error: {}", crate::campaign::for_terminal(&error_text(&e)));
             ExitCode::FAILURE
         }
     }

@@ -1,9 +1,7 @@
 //! `campaign plants` (the library, one line each) and `campaign plant NAME` (one in detail).
 use std::process::ExitCode;
 
-use crate::campaign::report::FULL_ORDER_MAX_N;
-use crate::campaign::sanitise::for_terminal as term;
-use crate::campaign::{load_default_reference, RefMethod};
+use crate::campaign::{for_terminal as term, load_default_reference, RefMethod, FULL_ORDER_MAX_N};
 use crate::lti::{self, Plant};
 use anyhow::Context;
 use serde_json::{json, Value};

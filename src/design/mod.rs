@@ -31,9 +31,11 @@ pub use objective::{
     ComponentCache, Components, DesignObjective, ObjectivePhase, ObserverAdapter, COMPONENT_CACHE_LEN,
     MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
 };
+pub(crate) use options::design_option_table;
 pub use options::{
-    DesignOptions, ObjectiveKind, VariableScaling, DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES,
-    DEFAULT_RANDOM_SCALES, DEFAULT_REFINE_RTOL, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
+    options_markdown, DesignOptions, ObjectiveKind, OptionRow, OptionValue, UnknownVariableScaling, VariableScaling,
+    DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES, DEFAULT_REFINE_RTOL,
+    DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
     Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError,

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
     abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_interruptible, is_stable,
-    spectral_abscissa, Controller, Interrupt, Plant, MIN_HINF_TOL,
+    spectral_abscissa, Controller, Interrupt, Plant,
 };
 use crate::optim::RunControl;
 
@@ -17,7 +17,7 @@ use super::central_start::central_starts;
 use super::objective::{
     ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
 };
-use super::options::{DesignOptions, ObjectiveKind, VariableScaling, MAX_ITERATIONS, MAX_NRAND};
+use super::options::{DesignOptions, ObjectiveKind, VariableScaling};
 use super::outcome::{
     Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
 };
@@ -76,42 +76,8 @@ fn opt_err(field: &'static str, problem: impl Into<String>) -> DesignError {
 /// of design options: `campaign design` calls it through [`run`], and a campaign file calls it
 /// for every problem before any job starts.
 pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) -> Result<(), DesignError> {
-    if !(opts.eps.is_finite() && opts.eps > 0.0) {
-        return Err(opt_err("eps", format!("ε must be finite and positive (> 0), got {}", opts.eps)));
-    }
-    if !(opts.cpumax > 0.0) {
-        return Err(opt_err("cpumax", format!("must be > 0 CPU seconds (may be infinite), got {}", opts.cpumax)));
-    }
-    if !(1..=MAX_NRAND).contains(&opts.nrand) {
-        return Err(opt_err("nrand", format!("must be in 1..={MAX_NRAND}, got {}", opts.nrand)));
-    }
-    if opts.maxevals == Some(0) {
-        return Err(opt_err("maxevals", "must be at least 1 (omit it for no limit)"));
-    }
-    if opts.max_starts == Some(0) {
-        return Err(opt_err("max_starts", "must be at least 1 (omit it for no limit)"));
-    }
-    if !(opts.stall_rtol.is_finite() && opts.stall_rtol >= 0.0) {
-        return Err(opt_err("stall_rtol", format!("must be finite and >= 0, got {}", opts.stall_rtol)));
-    }
-    if !(opts.refine_rtol.is_finite() && opts.refine_rtol >= 0.0) {
-        return Err(opt_err("refine_rtol", format!("must be finite and >= 0 (0: none), got {}", opts.refine_rtol)));
-    }
-    if let Some(bad) = opts.hop_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
-        return Err(opt_err("hop_scales", format!("every scale must be finite and > 0, got {bad}")));
-    }
-    if opts.random_scales.is_empty() {
-        return Err(opt_err(
-            "random_scales",
-            "must have at least one scale (e.g. [1] for standard-normal starts only)",
-        ));
-    }
-    if let Some(bad) = opts.random_scales.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
-        return Err(opt_err("random_scales", format!("every scale must be finite and > 0, got {bad}")));
-    }
-    if let Some(bad) = opts.central_gammas.iter().find(|f| !(f.is_finite() && **f > 1.0)) {
-        return Err(opt_err("central_gammas", format!("every factor of gamma_opt must be finite and > 1, got {bad}")));
-    }
+    // each option on its own: the option table's checks (design/options.rs)
+    opts.check_each().map_err(|(field, problem)| opt_err(field, problem))?;
     if opts.stall_starts > 0
         && !opts.cpumax.is_finite()
         && opts.maxevals.is_none()
@@ -128,29 +94,6 @@ pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) 
             "order",
             format!("{} exceeds the plant order n = {} of {} (HIFOO's limit)", opts.order, plant.dims.n, plant.name),
         ));
-    }
-    if !(opts.hinf_tol.is_finite() && opts.hinf_tol >= MIN_HINF_TOL && opts.hinf_tol < 1.0) {
-        return Err(opt_err("hinf_tol", format!("must be in [{MIN_HINF_TOL:e}, 1), got {}", opts.hinf_tol)));
-    }
-    if !(1..=MAX_ITERATIONS).contains(&opts.maxit) {
-        return Err(opt_err("maxit", format!("must be in 1..={MAX_ITERATIONS}, got {}", opts.maxit)));
-    }
-    if opts.continued_maxit > MAX_ITERATIONS {
-        return Err(opt_err(
-            "continued_maxit",
-            format!("must be at most {MAX_ITERATIONS} (0: maxit), got {}", opts.continued_maxit),
-        ));
-    }
-    if opts.gradsamp_maxit > MAX_ITERATIONS {
-        return Err(opt_err(
-            "gradsamp_maxit",
-            format!("must be at most {MAX_ITERATIONS}, got {}", opts.gradsamp_maxit),
-        ));
-    }
-    for (field, v) in [("normtol", opts.normtol), ("evaldist", opts.evaldist)] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(opt_err(field, format!("must be finite and >= 0, got {v}")));
-        }
     }
     if let Some(k) = init {
         k.check_fits(plant).map_err(|e| DesignError::Init(InitError::Shape(e)))?;

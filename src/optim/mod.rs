@@ -31,6 +31,7 @@ mod options;
 mod qp;
 mod solver;
 mod termination;
+#[cfg(any(test, feature = "test-support"))]
 pub mod test_problems;
 
 pub use bfgs::{bfgs, BfgsState};
