@@ -38,7 +38,7 @@ pub use journal::{
 };
 pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
 pub use provenance::Provenance;
-pub use record::{JobRecord, JobResult, JobStatus, SCHEMA_VERSION};
+pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
 pub use reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow,
@@ -48,7 +48,7 @@ pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportEr
 pub use run::{campaign_dir, journal_path, run_jobs, RunError, RunOutcome};
 pub use scheduler::{
     execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, DesignRunner, ExecuteError, ExecuteOptions,
-    JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Solo,
+    JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Scheduler, Solo,
 };
 pub use spec::{
     Campaign, Location, Problem, SpecError, DEFAULT_THREADS, MAX_JOBS, MAX_NAME_CHARS, MAX_ORDER, MAX_SEEDS,
