@@ -289,7 +289,7 @@ pub fn verify_outcome(out: DesignOutcome) -> Result<DesignOutcome, JobFailure> {
 
 impl JobRecord {
     /// The record of `job` after its run; `None` when the run was interrupted (not journaled).
-    /// A result that fails [`verify_outcome`] is journaled as that failure.
+    /// A result that fails `verify_outcome` is journaled as that failure.
     pub fn from_run(
         campaign: &str,
         job: &Job,

@@ -365,7 +365,7 @@ enum ClaimStep {
 /// One `execute` call: the campaign's jobs, what runs and observes them, the coordinator of the
 /// claims, the event callback (the journal is one of its consumers) and the state of the queue.
 /// Built once ([`Scheduler::new`]); [`Scheduler::run`] runs it on the calling thread, each job
-/// on a worker with a [`WorkerContext`] (module docs).
+/// on a worker with a `WorkerContext` (module docs).
 pub struct Scheduler<'a, E, F> {
     jobs: &'a [Job],
     runner: &'a dyn JobRunner,
