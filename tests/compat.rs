@@ -112,7 +112,7 @@ fn journal_of_8ee3691_reads_every_status_to_the_same_values() {
             None => {
                 assert_eq!(kind, "failed");
                 assert!(r.failed() && r.controller().is_none());
-                let JobStatus::Failed { error } = r.status() else { panic!("{line}") };
+                let JobStatus::Failed { error, .. } = r.status() else { panic!("{line}") };
                 assert_eq!(error, want["status"]["error"].as_str().unwrap());
             }
             Some(o) => {

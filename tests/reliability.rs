@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use hinfix::campaign::FAKE_RUNNER_ENV;
 use hinfix::campaign::{best_per_order, expand, Campaign, PlantMap, RunnerTag};
 use hinfix::campaign::{parse_journal, read_journal, JournalError};
-use hinfix::campaign::{JobRecord, JobStatus};
+use hinfix::campaign::{JobFailure, JobRecord, JobStatus};
 use hinfix::design::{
     run, Certificate, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats,
 };
@@ -63,7 +63,7 @@ fn campaign(text: &str) -> Result<Campaign, hinfix::campaign::SpecError> {
 }
 
 /// A record of an HE1 job with the given outcome.
-fn record(out: Result<DesignOutcome, String>) -> JobRecord {
+fn record(out: Result<DesignOutcome, JobFailure>) -> JobRecord {
     let c = campaign("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\n").unwrap();
     let job = &expand(&c, RunnerTag::Design)[0];
     JobRecord::from_run("t", job, false, out, 1.0, 2.0).unwrap()
@@ -511,7 +511,7 @@ fn failed_means_one_thing_in_best_csv() {
     let plants: PlantMap = [(plant.fingerprint(), plant)].into_iter().collect();
     let not_stab = record(Ok(outcome(DesignStatus::NotStabilised { best_alpha: 0.5 }, f64::INFINITY)));
     // another job of the same (plant, order): records of one job id count once
-    let mut failed = record(Err("boom".into()));
+    let mut failed = record(Err(JobFailure::RunnerError("boom".into())));
     failed.job_id.0 = format!("{}-other", failed.job_id.0);
     let rows = best_per_order(&[not_stab.clone(), failed.clone()], &plants);
     assert_eq!((rows[0].runs, rows[0].verified, rows[0].failed, rows[0].unverified), (2, 0, 1, 1));

@@ -43,7 +43,7 @@ pub use journal::{
 pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
 pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
-pub use record::{JobRecord, JobResult, JobStatus, SCHEMA_VERSION};
+pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};
 pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
 pub use reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
@@ -54,7 +54,7 @@ pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, 
 pub use sanitise::for_terminal;
 pub use scheduler::{
     execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, DesignRunner, ExecuteError, ExecuteOptions,
-    JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Solo,
+    JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Scheduler, Solo,
 };
 pub use shard::{select as shard_jobs, Shard};
 pub use spec::{

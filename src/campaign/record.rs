@@ -14,6 +14,82 @@ use serde::ser::SerializeMap;
 /// zeros). Lines of schema 1 and 2 are read.
 pub const SCHEMA_VERSION: u32 = 2;
 
+/// Why a job failed, as the scheduler found it and the journal carries it. Its `Display` is the
+/// message journal lines have always held in `status.error`; [`FailureKind`] is written next to
+/// it. Lines of older builds, which recorded only the message, read as [`JobFailure::Unrecorded`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum JobFailure {
+    /// The runner panicked (the scheduler caught it); the panic's message.
+    #[error("panic: {0}")]
+    Panicked(String),
+    /// The runner returned an error (for `design::run`, a `DesignError`); its message.
+    #[error("{0}")]
+    RunnerError(String),
+    /// The runner's result failed the check before journaling.
+    #[error("{0}")]
+    Verification(Unverifiable),
+    /// Read from a journal line that did not record the kind; its message.
+    #[error("{0}")]
+    Unrecorded(String),
+}
+
+/// Why a design run's result cannot be journaled as one ([`JobFailure::Verification`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Unverifiable {
+    /// The controller has a NaN or infinite entry: a journal line must read back, and a
+    /// controller is read only if it is finite.
+    #[error("the design run returned a controller with a non-finite entry")]
+    NonFiniteController,
+}
+
+/// The kind of a [`JobFailure`], as the journal names it (`status.failure_kind`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureKind {
+    /// [`JobFailure::Panicked`].
+    Panicked,
+    /// [`JobFailure::RunnerError`].
+    RunnerError,
+    /// [`JobFailure::Verification`].
+    Verification,
+}
+
+impl JobFailure {
+    /// Its kind; `None` for a failure read from a line that did not record it.
+    pub fn kind(&self) -> Option<FailureKind> {
+        match self {
+            JobFailure::Panicked(_) => Some(FailureKind::Panicked),
+            JobFailure::RunnerError(_) => Some(FailureKind::RunnerError),
+            JobFailure::Verification(_) => Some(FailureKind::Verification),
+            JobFailure::Unrecorded(_) => None,
+        }
+    }
+
+    /// The failure a journal line's `status` describes: its message and, if recorded, its kind.
+    /// A verification failure whose message this build does not know reads as
+    /// [`JobFailure::Unrecorded`], so its message is kept.
+    pub fn from_journal(error: String, kind: Option<FailureKind>) -> JobFailure {
+        match kind {
+            Some(FailureKind::Panicked) => match error.strip_prefix("panic: ") {
+                Some(m) => JobFailure::Panicked(m.to_string()),
+                None => JobFailure::Unrecorded(error),
+            },
+            Some(FailureKind::RunnerError) => JobFailure::RunnerError(error),
+            Some(FailureKind::Verification) if error == Unverifiable::NonFiniteController.to_string() => {
+                JobFailure::Verification(Unverifiable::NonFiniteController)
+            }
+            Some(FailureKind::Verification) | None => JobFailure::Unrecorded(error),
+        }
+    }
+
+    /// Its journal `status`.
+    pub fn status(&self) -> JobStatus {
+        JobStatus::Failed { error: self.to_string(), failure_kind: self.kind() }
+    }
+}
+
 /// How a journaled job ended: the design run's own [`DesignStatus`] (one definition of the
 /// statuses, their meaning and their journal names), or a failure. Never
 /// `DesignStatus::Interrupted`: interrupted runs are not journaled (resume reruns them), and a
@@ -22,14 +98,20 @@ pub const SCHEMA_VERSION: u32 = 2;
 /// Journal form, as it always was: `{"kind": "converged"}`, `{"kind": "stopped"}`,
 /// `{"kind": "stabilised_only"}`, `{"kind": "not_stabilised", "best_alpha": …}`,
 /// `{"kind": "budget_exhausted"}`, `{"kind": "failed", "error": "…"}`; the kind "optimised" of
-/// older builds reads as `stopped` (an alias of [`DesignStatus::Stopped`]).
+/// older builds reads as `stopped` (an alias of [`DesignStatus::Stopped`]). A failure written by
+/// this build also names its [`FailureKind`] (`"failure_kind": "panicked"`), a key older readers
+/// ignore and older lines lack.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", try_from = "StatusLine")]
 pub enum JobStatus {
-    /// `design::run` returned an error (or panicked): no trustworthy result.
+    /// `design::run` returned an error (or panicked), or its result failed the check before
+    /// journaling: no trustworthy result.
     Failed {
-        /// The error.
+        /// The failure's message ([`JobFailure`]'s `Display`).
         error: String,
+        /// What kind of failure; `None` in lines of builds that did not record it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        failure_kind: Option<FailureKind>,
     },
     /// The design run ended with this status (serialised as the status itself).
     #[serde(untagged)]
@@ -42,6 +124,8 @@ pub enum JobStatus {
 enum StatusLine {
     Failed {
         error: String,
+        #[serde(default)]
+        failure_kind: Option<FailureKind>,
     },
     #[serde(untagged)]
     Design(DesignStatus),
@@ -51,7 +135,7 @@ impl TryFrom<StatusLine> for JobStatus {
     type Error = &'static str;
     fn try_from(s: StatusLine) -> Result<JobStatus, Self::Error> {
         match s {
-            StatusLine::Failed { error } => Ok(JobStatus::Failed { error }),
+            StatusLine::Failed { error, failure_kind } => Ok(JobStatus::Failed { error, failure_kind }),
             StatusLine::Design(DesignStatus::Interrupted) => {
                 Err("status \"interrupted\": interrupted runs are never journaled")
             }
@@ -148,11 +232,9 @@ pub enum JobResult {
     /// `design::run` finished (never with [`DesignStatus::Interrupted`]: interrupted runs are not
     /// journaled) and returned this.
     Designed(Box<DesignOutcome>),
-    /// `design::run` returned an error (or panicked): no trustworthy result.
-    Failed {
-        /// The error.
-        error: String,
-    },
+    /// `design::run` returned an error (or panicked), or its result failed the check before
+    /// journaling: no trustworthy result.
+    Failed(JobFailure),
 }
 
 /// A designed job: the outcome's fields. A failed job: `{"status": {"kind": "failed", …}}`.
@@ -160,9 +242,9 @@ impl Serialize for JobResult {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
             JobResult::Designed(outcome) => outcome.serialize(s),
-            JobResult::Failed { error } => {
+            JobResult::Failed(failure) => {
                 let mut m = s.serialize_map(Some(1))?;
-                m.serialize_entry("status", &JobStatus::Failed { error: error.clone() })?;
+                m.serialize_entry("status", &failure.status())?;
                 m.end()
             }
         }
@@ -180,7 +262,9 @@ impl<'de> Deserialize<'de> for JobResult {
         let fields = serde_json::Map::<String, serde_json::Value>::deserialize(d)?;
         let status = fields.get("status").ok_or_else(|| D::Error::missing_field("status"))?;
         match JobStatus::deserialize(status).map_err(|e| D::Error::custom(format_args!("status: {e}")))? {
-            JobStatus::Failed { error } => Ok(JobResult::Failed { error }),
+            JobStatus::Failed { error, failure_kind } => {
+                Ok(JobResult::Failed(JobFailure::from_journal(error, failure_kind)))
+            }
             JobStatus::Design(_) => DesignOutcome::deserialize(serde_json::Value::Object(fields))
                 .map(|o| JobResult::Designed(Box::new(o)))
                 .map_err(D::Error::custom),
@@ -193,24 +277,33 @@ pub const TIMING_KEYS: &[&str] = &["design_cpu_s", "cpu_s", "wall_s", "finished_
 /// Keys that say where a job ran, not what it computed.
 pub const WHERE_KEYS: &[&str] = &["provenance"];
 
+/// The check a design run's result passes before it is journaled as one: a journal line must
+/// read back, and a controller is read only if it is finite.
+pub fn verify_outcome(out: DesignOutcome) -> Result<DesignOutcome, JobFailure> {
+    if out.controller.is_finite() {
+        Ok(out)
+    } else {
+        Err(JobFailure::Verification(Unverifiable::NonFiniteController))
+    }
+}
+
 impl JobRecord {
     /// The record of `job` after its run; `None` when the run was interrupted (not journaled).
+    /// A result that fails `verify_outcome` is journaled as that failure.
     pub fn from_run(
         campaign: &str,
         job: &Job,
         warm_started: bool,
-        result: Result<DesignOutcome, String>,
+        result: Result<DesignOutcome, JobFailure>,
         cpu_s: f64,
         wall_s: f64,
     ) -> Option<JobRecord> {
         let result = match result {
-            Err(error) => JobResult::Failed { error },
             Ok(out) if out.status == DesignStatus::Interrupted => return None,
-            // A journal line must read back, and a controller is read only if it is finite.
-            Ok(out) if !out.controller.is_finite() => {
-                JobResult::Failed { error: "the design run returned a controller with a non-finite entry".into() }
-            }
-            Ok(out) => JobResult::Designed(Box::new(out)),
+            r => match r.and_then(verify_outcome) {
+                Ok(out) => JobResult::Designed(Box::new(out)),
+                Err(failure) => JobResult::Failed(failure),
+            },
         };
         let o = &job.options;
         Some(JobRecord {
@@ -263,7 +356,15 @@ impl JobRecord {
     pub fn outcome(&self) -> Option<&DesignOutcome> {
         match &self.result {
             JobResult::Designed(o) => Some(o),
-            JobResult::Failed { .. } => None,
+            JobResult::Failed(_) => None,
+        }
+    }
+
+    /// Why the job failed; `None` when it did not.
+    pub fn failure(&self) -> Option<&JobFailure> {
+        match &self.result {
+            JobResult::Designed(_) => None,
+            JobResult::Failed(f) => Some(f),
         }
     }
 
@@ -276,13 +377,13 @@ impl JobRecord {
     pub fn status(&self) -> JobStatus {
         match &self.result {
             JobResult::Designed(o) => JobStatus::Design(o.status.clone()),
-            JobResult::Failed { error } => JobStatus::Failed { error: error.clone() },
+            JobResult::Failed(failure) => failure.status(),
         }
     }
 
     /// Whether the job failed (no trustworthy result).
     pub fn failed(&self) -> bool {
-        matches!(self.result, JobResult::Failed { .. })
+        matches!(self.result, JobResult::Failed(_))
     }
 }
 
@@ -306,7 +407,11 @@ mod tests {
                 r#"{"kind":"not_stabilised","best_alpha":"inf"}"#,
             ),
             (JobStatus::Design(DesignStatus::BudgetExhausted), r#"{"kind":"budget_exhausted"}"#),
-            (JobStatus::Failed { error: "boom".into() }, r#"{"kind":"failed","error":"boom"}"#),
+            (JobStatus::Failed { error: "boom".into(), failure_kind: None }, r#"{"kind":"failed","error":"boom"}"#),
+            (
+                JobFailure::Panicked("boom".into()).status(),
+                r#"{"kind":"failed","error":"panic: boom","failure_kind":"panicked"}"#,
+            ),
         ];
         for (status, line) in cases {
             assert_eq!(serde_json::to_string(&status).unwrap(), line);
@@ -319,5 +424,28 @@ mod tests {
             assert!(serde_json::from_str::<JobStatus>(bad).is_err(), "{bad} was accepted");
         }
         assert_eq!(JobStatus::of_design(DesignStatus::Interrupted), None);
+    }
+
+    /// Each failure writes the message older builds wrote, plus its kind, and reads back to
+    /// itself; a line without the kind (older builds) reads as `Unrecorded` with its message.
+    #[test]
+    fn failures_keep_their_message_and_read_back() {
+        let cases = [
+            (JobFailure::Panicked("index out of bounds".into()), "panic: index out of bounds"),
+            (JobFailure::RunnerError("numerical failure: x".into()), "numerical failure: x"),
+            (
+                JobFailure::Verification(Unverifiable::NonFiniteController),
+                "the design run returned a controller with a non-finite entry",
+            ),
+        ];
+        for (failure, message) in cases {
+            assert_eq!(failure.to_string(), message);
+            let JobStatus::Failed { error, failure_kind } = failure.status() else { unreachable!() };
+            assert_eq!((error.as_str(), failure_kind), (message, failure.kind()));
+            assert_eq!(JobFailure::from_journal(error.clone(), failure_kind), failure);
+            assert_eq!(JobFailure::from_journal(error, None), JobFailure::Unrecorded(message.into()));
+        }
+        let odd = JobFailure::from_journal("no prefix".into(), Some(FailureKind::Panicked));
+        assert_eq!((odd.to_string(), odd.kind()), ("no prefix".to_string(), None));
     }
 }

@@ -13,6 +13,13 @@
 //!   status `Interrupted`; such jobs produce [`CampaignEvent::JobInterrupted`] and no record, so a
 //!   resumed run reruns them.
 //! * Workers send events over one `std::sync::mpsc` channel; the calling thread owns the callback.
+//! * Structure: a [`Scheduler`] is built once from the jobs, the journals' records, the runner,
+//!   the observer factory (trace settings), the coordinator (claims) and the callback (the
+//!   journal); on the calling thread it polls, claims, starts and releases jobs in named steps.
+//!   Each job runs on a worker as `run_one(context, job)`: make the observer, run (under
+//!   `catch_unwind`), make the record (verified, `record::verify_outcome`), hand the record or the
+//!   interruption to the calling thread. A job that fails is journaled with its typed
+//!   [`JobFailure`] (panic, runner error, verification).
 //! * Other processes on the same jobs: an injected [`Coordinator`] is asked to claim each job
 //!   before it starts (a job claimed elsewhere is skipped for [`BUSY_RETRY`] and tried again),
 //!   told when it ended, and polled every `poll_interval` for records journaled elsewhere (those
@@ -30,7 +37,7 @@ use std::time::{Duration, Instant};
 
 use super::jobs::{Job, JobId};
 use super::provenance::Provenance;
-use super::record::JobRecord;
+use super::record::{JobFailure, JobRecord};
 use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, Phase};
 use crate::lti::Controller;
 use crate::optim::thread_cpu_time;
@@ -332,194 +339,331 @@ enum WorkerMsg {
 /// Runs every job of `jobs` that is not in `done` (the journals), respecting warm-start chains
 /// and `coord`'s claims, and reports events to `on_event` on the calling thread. Returns the
 /// counts, or the first callback or coordinator error (after cancelling and draining in-flight
-/// jobs).
-pub fn execute<E>(
-    jobs: &[Job],
+/// jobs). The same as [`Scheduler::new`] followed by [`Scheduler::run`].
+pub fn execute<'a, E>(
+    jobs: &'a [Job],
     done: &HashMap<JobId, JobRecord>,
-    runner: &dyn JobRunner,
-    observers: &ObserverFactory<'_>,
-    coord: &mut dyn Coordinator<E>,
-    opts: &ExecuteOptions,
-    mut on_event: impl FnMut(CampaignEvent) -> Result<(), E>,
+    runner: &'a dyn JobRunner,
+    observers: &'a ObserverFactory<'_>,
+    coord: &'a mut dyn Coordinator<E>,
+    opts: &'a ExecuteOptions,
+    on_event: impl FnMut(CampaignEvent) -> Result<(), E>,
 ) -> Result<RunStats, ExecuteError<E>> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .thread_name(|i| format!("campaign-worker-{i}"))
-        .build()?;
-    let index_of: HashMap<&JobId, usize> = jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
-    // Controllers of finished jobs (journals + this run), for warm starts.
-    let mut finished: HashMap<JobId, Option<Controller>> =
-        done.iter().map(|(id, r)| (id.clone(), r.controller().cloned())).collect();
-    let mut pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
-    let mut stats = RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() };
-    let mut first_err: Option<E> = None;
-    // Hands an event to the callback (Ok) or takes a coordinator error (Err); the first error
-    // of either kind cancels the run.
-    let mut emit = |ev: Result<CampaignEvent, E>, first_err: &mut Option<E>, stats: &mut RunStats| {
-        if let Err(e) = ev.and_then(&mut on_event) {
-            if first_err.is_none() {
-                *first_err = Some(e);
-                opts.cancel.store(true, Ordering::SeqCst);
-                if stats.cancel.is_none() {
-                    stats.cancel = Some(CancelReason::CallbackError);
-                    let _ = on_event(CampaignEvent::CancelRequested { reason: CancelReason::CallbackError });
+    Scheduler::new(jobs, done, runner, observers, coord, opts, on_event).run()
+}
+
+/// What the claim of a ready job decided ([`Scheduler::claim`]).
+enum ClaimStep {
+    /// Ours: start it.
+    Start,
+    /// Claimed or finished elsewhere: left alone for [`BUSY_RETRY`], look further down the queue.
+    Skip,
+    /// The coordinator failed (the run is being cancelled): start nothing more now.
+    Stop,
+}
+
+/// One `execute` call: the campaign's jobs, what runs and observes them, the coordinator of the
+/// claims, the event callback (the journal is one of its consumers) and the state of the queue.
+/// Built once ([`Scheduler::new`]); [`Scheduler::run`] runs it on the calling thread, each job
+/// on a worker with a `WorkerContext` (module docs).
+pub struct Scheduler<'a, E, F> {
+    jobs: &'a [Job],
+    runner: &'a dyn JobRunner,
+    observers: &'a ObserverFactory<'a>,
+    coord: &'a mut dyn Coordinator<E>,
+    opts: &'a ExecuteOptions,
+    on_event: F,
+    index_of: HashMap<&'a JobId, usize>,
+    /// Controllers of finished jobs (journals + this run), for warm starts.
+    finished: HashMap<JobId, Option<Controller>>,
+    /// Jobs still to run here, in campaign order.
+    pending: VecDeque<usize>,
+    /// Jobs found claimed elsewhere, with when to try them again.
+    busy_until: HashMap<usize, Instant>,
+    /// Free worker slots.
+    free: Vec<usize>,
+    /// Jobs in flight here.
+    running: usize,
+    last_poll: Instant,
+    force_poll: bool,
+    /// Set when nothing ran here and every claimable job was just retried: the next idle pass
+    /// ends.
+    idle_sweep: bool,
+    stats: RunStats,
+    /// The first callback or coordinator error.
+    first_err: Option<E>,
+}
+
+impl<'a, E, F> Scheduler<'a, E, F>
+where
+    F: FnMut(CampaignEvent) -> Result<(), E>,
+{
+    /// The scheduler of `jobs`, of which those in `done` (the journals) are skipped; see
+    /// [`execute`] for the other arguments.
+    pub fn new(
+        jobs: &'a [Job],
+        done: &HashMap<JobId, JobRecord>,
+        runner: &'a dyn JobRunner,
+        observers: &'a ObserverFactory<'_>,
+        coord: &'a mut dyn Coordinator<E>,
+        opts: &'a ExecuteOptions,
+        on_event: F,
+    ) -> Self {
+        let pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
+        Scheduler {
+            jobs,
+            runner,
+            observers,
+            coord,
+            opts,
+            on_event,
+            index_of: jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect(),
+            finished: done.iter().map(|(id, r)| (id.clone(), r.controller().cloned())).collect(),
+            stats: RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() },
+            pending,
+            busy_until: HashMap::new(),
+            free: (0..opts.threads).rev().collect(),
+            running: 0,
+            last_poll: Instant::now(),
+            force_poll: false,
+            idle_sweep: false,
+            first_err: None,
+        }
+    }
+
+    /// Runs the jobs (module docs): returns the counts, or the first callback or coordinator
+    /// error after cancelling and draining in-flight jobs.
+    pub fn run(mut self) -> Result<RunStats, ExecuteError<E>> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.opts.threads)
+            .thread_name(|i| format!("campaign-worker-{i}"))
+            .build()?;
+        self.emit(Ok(CampaignEvent::Started {
+            total: self.stats.total,
+            already_done: self.stats.already_done,
+            to_run: self.pending.len(),
+            threads: self.opts.threads,
+        }));
+        let (tx, rx) = mpsc::channel::<WorkerMsg>();
+        pool.in_place_scope(|scope| loop {
+            self.notice_cancel();
+            if self.stats.cancel.is_none() && (self.force_poll || self.last_poll.elapsed() >= self.opts.poll_interval) {
+                self.poll();
+            }
+            if self.stats.cancel.is_none() {
+                self.start_ready(scope, &tx);
+            }
+            if self.running == 0 {
+                // Nothing in flight here. Unless stopped or done, retry every job at once (claims
+                // may have been dropped by processes that died, records may have arrived); if
+                // that pass starts nothing either, the rest belongs to other processes.
+                if self.stats.cancel.is_some() || self.pending.is_empty() || (self.idle_sweep && !self.force_poll) {
+                    break;
+                }
+                self.idle_sweep = true;
+                self.busy_until.clear();
+                self.force_poll = true;
+                continue;
+            }
+            match rx.recv_timeout(Duration::from_millis(100)) {
+                Ok(msg) => self.handle(msg),
+                Err(mpsc::RecvTimeoutError::Timeout) => continue,
+                Err(mpsc::RecvTimeoutError::Disconnected) => unreachable!("the scheduler holds a sender"),
+            }
+        });
+        drop(tx);
+        self.stats.not_started = self.pending.len();
+        let final_stats = self.stats.clone();
+        self.emit(Ok(CampaignEvent::Finished { stats: final_stats }));
+        match self.first_err {
+            Some(e) => Err(ExecuteError::Callback(e)),
+            None => Ok(self.stats),
+        }
+    }
+
+    /// Hands an event to the callback (Ok) or takes a coordinator error (Err); the first error of
+    /// either kind cancels the run.
+    fn emit(&mut self, ev: Result<CampaignEvent, E>) {
+        if let Err(e) = ev.and_then(&mut self.on_event) {
+            if self.first_err.is_none() {
+                self.first_err = Some(e);
+                self.opts.cancel.store(true, Ordering::SeqCst);
+                if self.stats.cancel.is_none() {
+                    self.stats.cancel = Some(CancelReason::CallbackError);
+                    let _ = (self.on_event)(CampaignEvent::CancelRequested { reason: CancelReason::CallbackError });
                 }
             }
         }
-    };
-    emit(
-        Ok(CampaignEvent::Started {
-            total: stats.total,
-            already_done: stats.already_done,
-            to_run: pending.len(),
-            threads: opts.threads,
-        }),
-        &mut first_err,
-        &mut stats,
-    );
+    }
 
-    let (tx, rx) = mpsc::channel::<WorkerMsg>();
-    let mut free: Vec<usize> = (0..opts.threads).rev().collect();
-    let mut running = 0usize;
-    let campaign = opts.campaign.as_str();
-    let cancel = &opts.cancel;
-    let interval = opts.progress_interval;
-    let provenance = &opts.provenance;
-    // Jobs found claimed elsewhere, with when to try them again.
-    let mut busy_until: HashMap<usize, Instant> = HashMap::new();
-    let mut last_poll = Instant::now();
-    let mut force_poll = false;
-    // Set when nothing ran here and every claimable job was just retried: the next idle pass ends.
-    let mut idle_sweep = false;
+    /// A cancel flag set from outside (Ctrl-C) stops the scheduling, once.
+    fn notice_cancel(&mut self) {
+        if self.opts.cancel.load(Ordering::SeqCst) && self.stats.cancel.is_none() {
+            self.stats.cancel = Some(CancelReason::Interrupt);
+            self.emit(Ok(CampaignEvent::CancelRequested { reason: CancelReason::Interrupt }));
+        }
+    }
 
-    pool.in_place_scope(|scope| loop {
-        if cancel.load(Ordering::SeqCst) && stats.cancel.is_none() {
-            stats.cancel = Some(CancelReason::Interrupt);
-            emit(Ok(CampaignEvent::CancelRequested { reason: CancelReason::Interrupt }), &mut first_err, &mut stats);
-        }
-        if stats.cancel.is_none() && (force_poll || last_poll.elapsed() >= opts.poll_interval) {
-            force_poll = false;
-            last_poll = Instant::now();
-            match coord.poll() {
-                Ok(records) => {
-                    for r in records {
-                        if finished.contains_key(&r.job_id) {
-                            continue;
-                        }
-                        let queued = index_of.get(&r.job_id).and_then(|i| pending.iter().position(|p| p == i));
-                        finished.insert(r.job_id.clone(), r.controller().cloned());
-                        if let Some(pos) = queued {
-                            let index = pending.remove(pos).expect("position is in range");
-                            stats.done_elsewhere += 1;
-                            emit(Ok(CampaignEvent::JobDoneElsewhere { index }), &mut first_err, &mut stats);
-                        }
-                    }
-                }
-                Err(e) => emit(Err(e), &mut first_err, &mut stats),
-            }
-        }
-        if stats.cancel.is_none() {
-            let now = Instant::now();
-            let mut skip = 0usize;
-            while !free.is_empty() && stats.cancel.is_none() {
-                let ready = pending.iter().skip(skip).position(|&i| {
-                    busy_until.get(&i).is_none_or(|t| *t <= now)
-                        && match &jobs[i].warm_from {
-                            None => true,
-                            Some(p) => finished.contains_key(p),
-                        }
-                });
-                let Some(pos) = ready.map(|p| p + skip) else { break };
-                let index = pending[pos];
-                let job = &jobs[index];
-                match coord.claim(job) {
-                    Ok(Claim::Mine) => {}
-                    Ok(Claim::Busy) => {
-                        busy_until.insert(index, now + BUSY_RETRY);
-                        skip = pos + 1;
+    /// Takes the records journaled elsewhere since the last poll: their jobs leave the queue,
+    /// their controllers serve warm starts.
+    fn poll(&mut self) {
+        self.force_poll = false;
+        self.last_poll = Instant::now();
+        match self.coord.poll() {
+            Ok(records) => {
+                for r in records {
+                    if self.finished.contains_key(&r.job_id) {
                         continue;
                     }
-                    Ok(Claim::Done) => {
-                        // its record arrives with the poll at the top of the next pass
-                        busy_until.insert(index, now + BUSY_RETRY);
-                        force_poll = true;
-                        skip = pos + 1;
-                        continue;
-                    }
-                    Err(e) => {
-                        emit(Err(e), &mut first_err, &mut stats);
-                        break;
+                    let queued = self.index_of.get(&r.job_id).and_then(|i| self.pending.iter().position(|p| p == i));
+                    self.finished.insert(r.job_id.clone(), r.controller().cloned());
+                    if let Some(pos) = queued {
+                        let index = self.pending.remove(pos).expect("position is in range");
+                        self.stats.done_elsewhere += 1;
+                        self.emit(Ok(CampaignEvent::JobDoneElsewhere { index }));
                     }
                 }
-                pending.remove(pos);
-                busy_until.remove(&index);
-                idle_sweep = false;
-                let worker = free.pop().expect("a free worker");
-                let init = job.warm_from.as_ref().and_then(|p| finished.get(p)).cloned().flatten();
-                running += 1;
-                emit(Ok(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }), &mut first_err, &mut stats);
-                let tx = tx.clone();
-                scope.spawn(move |_| {
-                    run_one(campaign, provenance, job, index, worker, init, runner, observers, cancel, interval, tx)
-                });
+            }
+            Err(e) => self.emit(Err(e)),
+        }
+    }
+
+    /// Starts ready jobs (not left alone after a busy claim, predecessor finished) on the free
+    /// workers, each after its claim.
+    fn start_ready<'s>(&mut self, scope: &rayon::Scope<'s>, tx: &mpsc::Sender<WorkerMsg>)
+    where
+        'a: 's,
+    {
+        let now = Instant::now();
+        let mut skip = 0usize;
+        while !self.free.is_empty() && self.stats.cancel.is_none() {
+            let ready = self.pending.iter().skip(skip).position(|&i| {
+                self.busy_until.get(&i).is_none_or(|t| *t <= now)
+                    && match &self.jobs[i].warm_from {
+                        None => true,
+                        Some(p) => self.finished.contains_key(p),
+                    }
+            });
+            let Some(pos) = ready.map(|p| p + skip) else { break };
+            match self.claim(self.pending[pos], now) {
+                ClaimStep::Start => self.start(scope, tx, pos),
+                ClaimStep::Skip => skip = pos + 1,
+                ClaimStep::Stop => break,
             }
         }
-        if running == 0 {
-            // Nothing in flight here. Unless stopped or done, retry every job at once (claims
-            // may have been dropped by processes that died, records may have arrived); if that
-            // pass starts nothing either, the rest belongs to other processes.
-            if stats.cancel.is_some() || pending.is_empty() || (idle_sweep && !force_poll) {
-                break;
+    }
+
+    /// Claims job `index` through the coordinator before it starts.
+    fn claim(&mut self, index: usize, now: Instant) -> ClaimStep {
+        match self.coord.claim(&self.jobs[index]) {
+            Ok(Claim::Mine) => ClaimStep::Start,
+            Ok(Claim::Busy) => {
+                self.busy_until.insert(index, now + BUSY_RETRY);
+                ClaimStep::Skip
             }
-            idle_sweep = true;
-            busy_until.clear();
-            force_poll = true;
-            continue;
+            Ok(Claim::Done) => {
+                // its record arrives with the poll at the top of the next pass
+                self.busy_until.insert(index, now + BUSY_RETRY);
+                self.force_poll = true;
+                ClaimStep::Skip
+            }
+            Err(e) => {
+                self.emit(Err(e));
+                ClaimStep::Stop
+            }
         }
-        let msg = match rx.recv_timeout(Duration::from_millis(100)) {
-            Ok(m) => m,
-            Err(mpsc::RecvTimeoutError::Timeout) => continue,
-            Err(mpsc::RecvTimeoutError::Disconnected) => unreachable!("the scheduler holds a sender"),
+    }
+
+    /// Starts the claimed job at queue position `pos` on a free worker, from its predecessor's
+    /// controller if it has one.
+    fn start<'s>(&mut self, scope: &rayon::Scope<'s>, tx: &mpsc::Sender<WorkerMsg>, pos: usize)
+    where
+        'a: 's,
+    {
+        let index = self.pending.remove(pos).expect("position is in range");
+        self.busy_until.remove(&index);
+        self.idle_sweep = false;
+        let worker = self.free.pop().expect("a free worker");
+        let job: &'a Job = &self.jobs[index];
+        let init = job.warm_from.as_ref().and_then(|p| self.finished.get(p)).cloned().flatten();
+        self.running += 1;
+        self.emit(Ok(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }));
+        let ctx = WorkerContext {
+            campaign: &self.opts.campaign,
+            provenance: &self.opts.provenance,
+            runner: self.runner,
+            observers: self.observers,
+            cancel: &self.opts.cancel,
+            progress_interval: self.opts.progress_interval,
+            worker,
+            tx: tx.clone(),
         };
+        scope.spawn(move |_| run_one(ctx, StartedJob { index, job, init }));
+    }
+
+    /// Handles one message of a worker.
+    fn handle(&mut self, msg: WorkerMsg) {
         match msg {
-            WorkerMsg::Progress { index, worker, phase, iter, f, gamma } => emit(
-                Ok(CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma }),
-                &mut first_err,
-                &mut stats,
-            ),
+            WorkerMsg::Progress { index, worker, phase, iter, f, gamma } => {
+                self.emit(Ok(CampaignEvent::JobProgress { index, worker, phase, iter, f, gamma }))
+            }
             WorkerMsg::Warning { index, message } => {
-                stats.warnings += 1;
-                emit(Ok(CampaignEvent::Warning { index: Some(index), message }), &mut first_err, &mut stats)
+                self.stats.warnings += 1;
+                self.emit(Ok(CampaignEvent::Warning { index: Some(index), message }))
             }
             WorkerMsg::Finished { index, worker, record } => {
-                running -= 1;
-                free.push(worker);
-                stats.finished += 1;
+                self.running -= 1;
+                self.free.push(worker);
+                self.stats.finished += 1;
                 if record.failed() {
-                    stats.failed += 1;
+                    self.stats.failed += 1;
                 }
-                finished.insert(record.job_id.clone(), record.controller().cloned());
-                emit(Ok(CampaignEvent::JobFinished { index, worker, record }), &mut first_err, &mut stats);
+                self.finished.insert(record.job_id.clone(), record.controller().cloned());
+                // the callback journals the record
+                self.emit(Ok(CampaignEvent::JobFinished { index, worker, record }));
                 // journaled (or the journal failed and the run stops): the claim can go
-                coord.release(&jobs[index]);
+                self.release(index);
             }
             WorkerMsg::Interrupted { index, worker } => {
-                running -= 1;
-                free.push(worker);
-                stats.interrupted += 1;
-                emit(Ok(CampaignEvent::JobInterrupted { index, worker }), &mut first_err, &mut stats);
-                coord.release(&jobs[index]);
+                self.running -= 1;
+                self.free.push(worker);
+                self.stats.interrupted += 1;
+                self.emit(Ok(CampaignEvent::JobInterrupted { index, worker }));
+                self.release(index);
             }
         }
-    });
-    drop(tx);
-    stats.not_started = pending.len();
-    let final_stats = stats.clone();
-    emit(Ok(CampaignEvent::Finished { stats: final_stats }), &mut first_err, &mut stats);
-    match first_err {
-        Some(e) => Err(ExecuteError::Callback(e)),
-        None => Ok(stats),
     }
+
+    /// Job `index` ended here (its record, if any, handed to the callback): its claim goes.
+    fn release(&mut self, index: usize) {
+        self.coord.release(&self.jobs[index]);
+    }
+}
+
+/// What a worker needs to run one job, besides the job: where its record and events go, what
+/// runs and observes it, the cancel flag.
+struct WorkerContext<'a> {
+    /// Campaign name (written into the record).
+    campaign: &'a str,
+    /// Written into the record.
+    provenance: &'a Provenance,
+    runner: &'a dyn JobRunner,
+    observers: &'a ObserverFactory<'a>,
+    cancel: &'a Arc<AtomicBool>,
+    /// Minimum time between two progress events.
+    progress_interval: Duration,
+    /// The worker slot.
+    worker: usize,
+    tx: mpsc::Sender<WorkerMsg>,
+}
+
+/// A claimed job on its way to a worker.
+struct StartedJob<'a> {
+    /// Its index in the campaign's jobs.
+    index: usize,
+    job: &'a Job,
+    /// Its predecessor's controller (warm start).
+    init: Option<Controller>,
 }
 
 /// The observer a job actually runs with: the user's (trace), progress events, cancellation.
@@ -561,59 +705,93 @@ impl DesignObserver for WorkerObserver<'_> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn run_one(
-    campaign: &str,
-    provenance: &Provenance,
-    job: &Job,
-    index: usize,
-    worker: usize,
-    init: Option<Controller>,
-    runner: &dyn JobRunner,
-    observers: &ObserverFactory<'_>,
-    cancel: &Arc<AtomicBool>,
-    interval: Duration,
-    tx: mpsc::Sender<WorkerMsg>,
-) {
+/// Runs one job on its worker: observer, run, record (verified), then the record or the
+/// interruption goes to the scheduler thread, which journals it and releases the claim.
+fn run_one(ctx: WorkerContext<'_>, job: StartedJob<'_>) {
     let cpu0 = thread_cpu_time();
     let t0 = Instant::now();
-    let made = catch_unwind(AssertUnwindSafe(|| observers(job)))
-        .unwrap_or_else(|panic| Err(ObserverError::FactoryPanicked(panic_message(&panic))));
-    let user = match made {
-        Ok(o) => Some(o),
-        Err(e) => {
-            let _ = tx.send(WorkerMsg::Warning { index, message: e.to_string() });
-            None
-        }
-    };
-    let mut obs = WorkerObserver { user, cancel, tx: &tx, index, worker, interval, last_sent: None };
-    let warm = init.is_some();
-    let result = match catch_unwind(AssertUnwindSafe(|| runner.run(job, init.as_ref(), &mut obs))) {
-        Ok(Ok(out)) => Ok(out),
-        Ok(Err(e)) => Err(e.to_string()),
-        Err(panic) => Err(format!("panic: {}", panic_message(&panic))),
-    };
+    let user = ctx.make_observer(&job);
+    let (result, user) = ctx.run(&job, user);
     let cpu = thread_cpu_time() - cpu0;
     let wall = t0.elapsed().as_secs_f64();
-    let user = obs.user.take();
-    match JobRecord::from_run(campaign, job, warm, result, cpu, wall).map(|mut r| {
-        r.provenance = Some(provenance.clone());
-        r
-    }) {
-        None => {
-            if let Some(u) = user {
-                u.abandon();
+    match ctx.record(&job, result, cpu, wall) {
+        None => ctx.abandon(&job, user),
+        Some(record) => ctx.finish(&job, user, record),
+    }
+}
+
+impl WorkerContext<'_> {
+    /// The job's observer from the factory; an error or a panic of the factory is a warning, and
+    /// the job runs unobserved.
+    fn make_observer(&self, job: &StartedJob<'_>) -> Option<Box<dyn JobObserver>> {
+        let made = catch_unwind(AssertUnwindSafe(|| (self.observers)(job.job)))
+            .unwrap_or_else(|panic| Err(ObserverError::FactoryPanicked(panic_message(&panic))));
+        match made {
+            Ok(o) => Some(o),
+            Err(e) => {
+                let _ = self.tx.send(WorkerMsg::Warning { index: job.index, message: e.to_string() });
+                None
             }
-            let _ = tx.send(WorkerMsg::Interrupted { index, worker });
         }
-        Some(record) => {
-            if let Some(u) = user {
-                if let Err(e) = u.finish(&record) {
-                    let _ = tx.send(WorkerMsg::Warning { index, message: e.to_string() });
-                }
+    }
+
+    /// Runs the job under `catch_unwind` (a panic is a failed job, not a dead worker); returns
+    /// its result and the user's observer.
+    fn run(
+        &self,
+        job: &StartedJob<'_>,
+        user: Option<Box<dyn JobObserver>>,
+    ) -> (Result<DesignOutcome, JobFailure>, Option<Box<dyn JobObserver>>) {
+        let mut obs = WorkerObserver {
+            user,
+            cancel: self.cancel,
+            tx: &self.tx,
+            index: job.index,
+            worker: self.worker,
+            interval: self.progress_interval,
+            last_sent: None,
+        };
+        let result = match catch_unwind(AssertUnwindSafe(|| self.runner.run(job.job, job.init.as_ref(), &mut obs))) {
+            Ok(Ok(out)) => Ok(out),
+            Ok(Err(e)) => Err(JobFailure::RunnerError(e.to_string())),
+            Err(panic) => Err(JobFailure::Panicked(panic_message(&panic))),
+        };
+        (result, obs.user.take())
+    }
+
+    /// The job's record, its result verified ([`super::record::verify_outcome`]: a result that fails
+    /// is journaled as a failure); `None` for an interrupted run (not journaled).
+    fn record(
+        &self,
+        job: &StartedJob<'_>,
+        result: Result<DesignOutcome, JobFailure>,
+        cpu: f64,
+        wall: f64,
+    ) -> Option<JobRecord> {
+        let warm = job.init.is_some();
+        JobRecord::from_run(self.campaign, job.job, warm, result, cpu, wall).map(|mut r| {
+            r.provenance = Some(self.provenance.clone());
+            r
+        })
+    }
+
+    /// An interrupted job: its observer drops what it wrote; the scheduler releases the claim.
+    fn abandon(&self, job: &StartedJob<'_>, user: Option<Box<dyn JobObserver>>) {
+        if let Some(u) = user {
+            u.abandon();
+        }
+        let _ = self.tx.send(WorkerMsg::Interrupted { index: job.index, worker: self.worker });
+    }
+
+    /// A finished job: its observer completes (the trace gets the record), then the record goes
+    /// to the scheduler thread to be journaled.
+    fn finish(&self, job: &StartedJob<'_>, user: Option<Box<dyn JobObserver>>, record: JobRecord) {
+        if let Some(u) = user {
+            if let Err(e) = u.finish(&record) {
+                let _ = self.tx.send(WorkerMsg::Warning { index: job.index, message: e.to_string() });
             }
-            let _ = tx.send(WorkerMsg::Finished { index, worker, record: Box::new(record) });
         }
+        let _ = self.tx.send(WorkerMsg::Finished { index: job.index, worker: self.worker, record: Box::new(record) });
     }
 }
 

@@ -50,8 +50,8 @@ pub const COMPONENT_CACHE_LEN: usize = 32;
 
 /// Closed-loop order from which line-search trials are first screened by a cheap lower bound
 /// ([`Objective::eval_below`]): on small plants the bound costs too large a share of a full
-/// evaluation (HE1, n + nK = 5: 0.11–0.18 ms/eval with screening against 0.08–0.12 without, issue
-/// 13), on large ones it saves the eigenvalue and Hamiltonian work of rejected trials.
+/// evaluation (HE1, n + nK = 5: 0.11–0.18 ms/eval with screening against 0.08–0.12 without), on
+/// large ones it saves the eigenvalue and Hamiltonian work of rejected trials.
 pub const MIN_ORDER_FOR_REJECTION: usize = 30;
 
 /// Closed-loop order (n + nK) from which an objective with a stop hook polls it inside an
@@ -422,9 +422,10 @@ impl Objective for DesignObjective<'_> {
     /// In the performance phase, a trial point whose cheap lower bound
     /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and up the last peak, ε‖K‖∞) already
     /// reaches `threshold` is rejected
-    /// without the closed loop's eigenvalues, Hamiltonian or gradient (issue 13); one that
-    /// passes is evaluated by `eval_unless`, whose norm still stops once it reaches
-    /// `threshold`.
+    /// without the closed loop's eigenvalues, Hamiltonian or gradient: the line search only
+    /// needs to know that the trial fails its Armijo test, and the bound is attained, so the
+    /// value returned is exact (docs/ALGORITHMS.md §8.4, "Line-search screen"); one that passes
+    /// is evaluated by `eval_unless`, whose norm still stops once it reaches `threshold`.
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
         if self.phase == ObjectivePhase::Performance && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION {
             let lb = self.performance_lower_bound(&self.controller(x), threshold);

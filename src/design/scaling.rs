@@ -25,7 +25,8 @@
 //! differ by more than three orders of magnitude (AC10: 2·10⁵ between its measurements; BDT2:
 //! 10⁴ between its controls) change. Measured on AC8 (measurement norms 128× apart), scaling all
 //! plants would hurt: n_K = 1 at 20 000 evaluations, seeds 1 and 2, reached γ 2.016 and 2.020
-//! scaled against 1.650 and 1.651 unscaled (issue 12a's note).
+//! scaled against 1.650 and 1.651 unscaled: with channels that close, the identity is already a
+//! good first inverse Hessian, and rescaling them only changes which basins BFGS reaches.
 //!
 //! The objective is the same function of the controller in either coordinates; only the
 //! optimiser's view changes: its steps, its initial inverse Hessian (the identity), the basin

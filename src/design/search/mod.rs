@@ -1,0 +1,423 @@
+//! The multi-start search of a design run (docs/ALGORITHMS.md §8.3–§8.6): local searches
+//! until a budget or the stall rule ends it, then gradient sampling from the best point. The
+//! measurements behind its rules are in docs/ALGORITHMS.md §8, not here.
+//!
+//! Three parts, one module each:
+//! * [`plan`]: where the local searches start — HIFOO's first starts (`nrand` random points, or
+//!   an initial controller and `nrand` perturbations of it), the open-loop start, the central
+//!   starts (twice on a scaled plant under `Alternate`), then the continued search's cycles of
+//!   basin hops and fresh random starts at alternating scales, in the coordinates (x or x̃) each
+//!   cycle is given, and the resumption of a local search cut by `maxit`;
+//! * [`local`]: one local search — BFGS on f_s until stable, BFGS on f_h, the certificate, and
+//!   the optional gradient sampling (HIFOO's stabilisation fallback, refining near-misses, the
+//!   incumbent's);
+//! * [`budget`]: what ends the search and what each part may spend — `cpumax`, `maxevals`,
+//!   `max_starts`, the stall rule, and the gradient-sampling reserve.
+//!
+//! [`Search::run`] joins them: it asks the plan for the next start, runs the local search from
+//! it under the budget's control, offers the end point to the incumbents ([`State`]) and counts
+//! the stall, until the budget ends the search; then the incumbent's gradient sampling.
+//!
+//! # Reproducibility
+//! All randomness comes from the run's ChaCha8 generator, drawn in a fixed order. With
+//! `maxevals`, `max_starts` or the stall rule ending the run, and the CPU budget not binding, the
+//! run's path — and the returned controller, bit for bit — does not depend on timing, threads or
+//! load. A run ended by `cpumax` depends on the machine's speed.
+
+mod budget;
+mod local;
+mod plan;
+
+use std::rc::Rc;
+
+use rand::RngCore;
+
+use crate::optim::{OptimResult, RunControl, Termination};
+
+use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
+use super::options::DesignOptions;
+use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
+use super::scaling::{from_scaled, to_scaled};
+use budget::{ctl_stop, improves, stop_of, GsRounds};
+
+pub use budget::{GS_RESERVE, GS_RESERVE_FACTOR};
+pub use plan::ALTERNATE_PERIOD;
+
+/// Relative tolerance of "first reached" for [`SearchSummary::cpu_to_best_s`].
+pub const TIME_TO_BEST_RTOL: f64 = 1e-6;
+
+/// The best point of one objective, with where it came from.
+#[derive(Debug, Clone)]
+pub(crate) struct Best {
+    /// The point.
+    pub x: Vec<f64>,
+    /// Its objective value.
+    pub f: f64,
+    /// Its certificate (f_h only).
+    pub dnorm: f64,
+    /// See `dnorm`.
+    pub evaldist: f64,
+    /// The local search that produced it.
+    pub start: usize,
+    /// The stable point its f_h local search started from (to tell whether it moved).
+    pub from: Vec<f64>,
+    /// The coordinates of the local search that produced it.
+    pub coords: Coords,
+}
+
+/// The coordinates of one local search (docs/ALGORITHMS.md §8.6): the controller's parameters x,
+/// or the plant-scaled variables x̃ (x = d ∘ x̃). Points outside a local search (the incumbents)
+/// are always kept in x; x ↔ x̃ is exact (d holds powers of two).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Coords {
+    /// x.
+    Raw,
+    /// x̃.
+    Scaled,
+}
+
+/// The objectives in plant-scaled variables (`DesignObjective::with_scaling(Some(d))`) and d.
+pub(crate) struct ScaledObjectives<'r, 'o> {
+    pub stab_obj: &'r mut DesignObjective<'o>,
+    pub perf_obj: &'r mut DesignObjective<'o>,
+    pub d: Rc<[f64]>,
+}
+
+/// What the search produced.
+#[derive(Debug, Clone)]
+pub(crate) struct SearchResult {
+    /// Best stable point by f_h (None if none was stabilised or f_h was never finite).
+    pub perf: Option<Best>,
+    /// Best point by f_s.
+    pub stab: Best,
+    /// Whether any stable point was found.
+    pub stabilised: bool,
+    /// Per-phase counters: stabilisation, optimisation (if a stable point was found), gradient
+    /// sampling (if it ran).
+    pub phases: Vec<PhaseStats>,
+    /// The search summary (time to best filled in by the caller's adapter).
+    pub summary: SearchSummary,
+    /// True if a budget ended the run before HIFOO's first starts (the `nrand` random or init
+    /// starts, not the open-loop or central-controller ones) were all made.
+    pub truncated: bool,
+}
+
+/// Mutable state of the search.
+struct State<'s> {
+    opts: &'s DesignOptions,
+    stats: [PhaseStats; 3],
+    perf: Option<Best>,
+    stab: Option<Best>,
+    stabilised: bool,
+    stall: usize,
+    /// The f_h local search that produced `perf` ended on `maxit` or a budget (not at a
+    /// minimiser): the next continued start resumes it (`continue_at_maxit`).
+    perf_cut: bool,
+    /// The continued search has begun: its f_h local searches use `continued_maxit`.
+    continued: bool,
+    /// Near-misses refined by gradient sampling so far (`refine_rtol`).
+    refinements: usize,
+}
+
+impl State<'_> {
+    fn evals(&self) -> usize {
+        self.stats.iter().map(|s| s.evals).sum()
+    }
+
+    fn add(&mut self, which: usize, r: &OptimResult, cpu0: f64, cpu1: f64) {
+        let s = &mut self.stats[which];
+        s.iters += r.iters;
+        s.evals += r.evals;
+        s.cpu_s += cpu1 - cpu0;
+    }
+
+    /// Records an f_s end point; returns whether it improved the best f_s (stall sense).
+    fn offer_stab(&mut self, x: Vec<f64>, f: f64, start: usize, coords: Coords) -> bool {
+        let f = if f.is_nan() { f64::INFINITY } else { f };
+        let old = self.stab.as_ref().map_or(f64::INFINITY, |b| b.f);
+        let better = improves(f, old, self.opts.stall_rtol, 1.0);
+        if self.stab.is_none() || f < old {
+            self.stab = Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, coords });
+        }
+        better
+    }
+
+    /// Records an f_h end point; returns whether it improved the best f_h (stall sense).
+    fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize, coords: Coords) -> bool {
+        let old = self.perf.as_ref().map_or(f64::INFINITY, |b| b.f);
+        let better = improves(r.f, old, self.opts.stall_rtol, 0.0);
+        if r.f.is_finite() && r.f < old {
+            let (x, from) = (r.x.clone(), from.to_vec());
+            self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from, coords });
+            // Cut by `maxit`, or by the search's share of a budget (`return_gs_reserve` may give
+            // the search more).
+            self.perf_cut =
+                matches!(r.termination, Termination::MaxIters | Termination::CpuBudget | Termination::EvalBudget);
+        }
+        better
+    }
+
+    /// Whether the f_h local search that ended at `r` is a near-miss to refine (module docs,
+    /// "Refining near-misses"): a local search of the continued search, not certified
+    /// (dnorm > normtol), not cut by a budget, and within a relative `refine_rtol` above the
+    /// incumbent (a point below it becomes the incumbent and has its gradient sampling anyway).
+    fn refines(&self, r: &OptimResult) -> bool {
+        let o = self.opts;
+        let Some(inc) = self.perf.as_ref().map(|b| b.f) else { return false };
+        self.continued
+            && o.gradient_sampling
+            && o.refine_rtol > 0.0
+            && r.dnorm > o.normtol
+            && stop_of(r.termination).is_none()
+            && r.f >= inc
+            && r.f <= inc + o.refine_rtol * inc.abs()
+    }
+
+    /// The start that resumes the incumbent's local search if `maxit` cut it (and
+    /// `continue_at_maxit`): the incumbent itself, once, in its local search's coordinates.
+    fn take_continuation(&mut self) -> Option<(Vec<f64>, Coords)> {
+        if !(self.opts.continue_at_maxit && self.perf_cut) {
+            return None;
+        }
+        self.perf_cut = false;
+        self.perf.as_ref().map(|b| (b.x.clone(), b.coords))
+    }
+}
+
+/// Everything one search needs besides its state.
+pub(crate) struct Search<'r, 'o, 'a> {
+    pub stab_obj: &'r mut DesignObjective<'o>,
+    pub perf_obj: &'r mut DesignObjective<'o>,
+    pub adapter: &'r mut ObserverAdapter<'a, 'o>,
+    pub rng: &'r mut dyn RngCore,
+    /// The whole run's control.
+    pub ctl: &'r RunControl,
+    /// The objectives in plant-scaled variables, if the plant is scaled (`design::scaling`) and
+    /// the run's [`VariableScaling`] mode is not off.
+    pub scaled: Option<ScaledObjectives<'r, 'o>>,
+}
+
+/// The objective of `phase` (stabilisation, or performance if `perf`) in coordinates `c`.
+fn pick<'s, 'o>(
+    raw: &'s mut DesignObjective<'o>,
+    scaled: &'s mut Option<ScaledObjectives<'_, 'o>>,
+    perf: bool,
+    c: Coords,
+) -> &'s mut DesignObjective<'o> {
+    match (c, scaled) {
+        (Coords::Scaled, Some(s)) => {
+            if perf {
+                s.perf_obj
+            } else {
+                s.stab_obj
+            }
+        }
+        _ => raw,
+    }
+}
+
+impl Search<'_, '_, '_> {
+    /// `x` (controller parameters) in coordinates `c`.
+    fn to_coords(&self, x: &[f64], c: Coords) -> Vec<f64> {
+        match (c, &self.scaled) {
+            (Coords::Scaled, Some(s)) => to_scaled(x, Some(&s.d)),
+            _ => x.to_vec(),
+        }
+    }
+
+    /// The controller parameters of `x` given in coordinates `c`.
+    fn to_raw(&self, x: &[f64], c: Coords) -> Vec<f64> {
+        match (c, &self.scaled) {
+            (Coords::Scaled, Some(s)) => from_scaled(x, Some(&s.d)),
+            _ => x.to_vec(),
+        }
+    }
+
+    /// Runs the whole search from the first starts `first` (module docs).
+    pub(crate) fn run(
+        &mut self,
+        opts: &DesignOptions,
+        first: &[Vec<f64>],
+        first_kinds: &[StartKind],
+        nvar: usize,
+    ) -> Result<SearchResult, DesignError> {
+        let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
+        let mut search_ctl = self.ctl.sub_budget(reserve, reserve);
+        let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
+        let mut st = State {
+            opts,
+            stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
+            perf: None,
+            stab: None,
+            stabilised: false,
+            stall: 0,
+            perf_cut: false,
+            continued: false,
+            refinements: 0,
+        };
+        let mut k = 0usize; // local searches made
+        let mut cycle = 0usize; // continued starts drawn from the hop / random cycle
+        let mut gs_fallback_done = false;
+        let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
+        let mut coords: Vec<Coords> = Vec::new(); // its coordinates
+        let mut cycle_coords = Coords::Raw; // coordinates of the current hop cycle
+        let mut stop = None;
+        let full_ctl = self.ctl;
+        let returning = opts.return_gs_reserve && opts.gradient_sampling;
+        let first_reserve = (
+            GS_RESERVE * full_ctl.cpumax(),
+            full_ctl.maxevals().map_or(usize::MAX, |m| m - search_ctl.maxevals().unwrap_or(m)),
+        );
+        let mut rounds = GsRounds { first: first_reserve, ..Default::default() };
+        let plan = self.first_plan(opts.variable_scaling, first_kinds, first.len());
+        // HIFOO's own first starts (random or init): the extra open-loop and central starts are
+        // like the continued search, a budget may end the run before them without truncating it.
+        let hifoo_starts = first_kinds
+            .iter()
+            .take(first.len())
+            .filter(|k| !matches!(k, StartKind::Central | StartKind::OpenLoop))
+            .count();
+        while stop.is_none() {
+            let share_spent = ctl_stop(&search_ctl).is_some() && ctl_stop(full_ctl).is_none();
+            // Gradient sampling where HIFOO's search makes it (after its first starts, with the
+            // generator in the same state), and whenever the search's share is spent.
+            let hifoo_done = k == hifoo_starts && !rounds.after_first;
+            if returning && st.stabilised && !rounds.done && (share_spent || hifoo_done) {
+                rounds.after_first |= hifoo_done;
+                match self.return_reserve(&mut st, &mut rounds, share_spent)? {
+                    Some(c) => search_ctl = c,
+                    None => rounds.done = share_spent,
+                }
+            }
+            // The gradient-sampling reserve is kept only once there is a stable point to refine.
+            let search_ctl = if st.stabilised { &search_ctl } else { full_ctl };
+            if let Some(s) = ctl_stop(search_ctl) {
+                stop = Some(s);
+                break;
+            }
+            if opts.max_starts.is_some_and(|m| k >= m) {
+                stop = Some(SearchStop::Starts);
+                break;
+            }
+            let (s, better) = if let Some(&(i, c)) = plan.get(k) {
+                kinds.push(first_kinds.get(i).copied().unwrap_or(StartKind::Random));
+                coords.push(c);
+                let x0 = self.to_coords(&first[i], c);
+                self.local(&mut st, &x0, k, c, search_ctl)?
+            } else if !st.stabilised && opts.gradient_sampling && !gs_fallback_done {
+                gs_fallback_done = true;
+                kinds.push(StartKind::GradientSampling);
+                coords.push(st.stab.as_ref().map_or(Coords::Raw, |b| b.coords));
+                self.gs_stabilise(&mut st, k, search_ctl)?
+            } else {
+                if let Some(s) = budget::continued_stop(&st, search_ctl) {
+                    stop = Some(s);
+                    break;
+                }
+                let (x0, kind, c) = self.continued_start(&mut st, &mut cycle, &mut cycle_coords, nvar);
+                kinds.push(kind);
+                st.continued = true;
+                coords.push(c);
+                self.local(&mut st, &x0, k, c, search_ctl)?
+            };
+            k += 1;
+            st.stall = if better { 0 } else { st.stall + 1 };
+            // The search's share of a budget is spent but the budget is not: the next turn may
+            // give the search back what gradient sampling does not need (`return_gs_reserve`).
+            let share_only =
+                matches!(s, Some(SearchStop::Budget | SearchStop::Maxevals)) && ctl_stop(full_ctl).is_none();
+            stop = s.filter(|_| !(returning && st.stabilised && share_only && !rounds.done));
+        }
+        let stop = stop.unwrap_or(SearchStop::Starts);
+        let truncated = k < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
+
+        // Gradient sampling from the best stable point, under the whole budget (unless it already
+        // ran from it).
+        if opts.gradient_sampling
+            && stop != SearchStop::Interrupted
+            && st.perf.as_ref().map(|b| &b.x) != rounds.at.as_ref()
+        {
+            rounds.ran |= self.gs_incumbent(&mut st, full_ctl)?;
+        }
+        let [s0, s1, s2] = st.stats;
+        let mut phases = vec![s0];
+        if st.stabilised {
+            phases.push(s1);
+        }
+        if rounds.ran || st.refinements > 0 {
+            phases.push(s2);
+        }
+        let stab = st.stab.unwrap_or_else(|| Best {
+            x: first[0].clone(),
+            f: f64::INFINITY,
+            dnorm: f64::NAN,
+            evaldist: f64::NAN,
+            start: 0,
+            from: first[0].clone(),
+            coords: Coords::Raw,
+        });
+        let best_start = st.perf.as_ref().map_or(stab.start, |b| b.start);
+        let (phase, f) = match &st.perf {
+            Some(b) => (ObjectivePhase::Performance, b.f),
+            None => (ObjectivePhase::Stabilisation, stab.f),
+        };
+        let reached = self.adapter.first_reached(phase, f, TIME_TO_BEST_RTOL);
+        let summary = SearchSummary {
+            starts: k,
+            best_start,
+            best_start_kind: kinds.get(best_start).copied(),
+            best_start_scaled: coords.get(best_start) == Some(&Coords::Scaled),
+            cpu_to_best_s: reached.map_or(0.0, |r| r.cpu_s),
+            evals_to_best: reached.map_or(0, |r| r.evals),
+            stop,
+        };
+        Ok(SearchResult { perf: st.perf, stab, stabilised: st.stabilised, phases, summary, truncated })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn end(f: f64, dnorm: f64, termination: Termination) -> OptimResult {
+        OptimResult { x: vec![0.0], f, g: vec![0.0], dnorm, evaldist: 0.0, termination, iters: 1, evals: 1, cpu_s: 0.0 }
+    }
+
+    /// `refines`: only uncertified continued local searches that end within `refine_rtol` above
+    /// the incumbent and were not cut by a budget.
+    #[test]
+    fn near_misses_are_refined_only_within_the_tolerance() {
+        let opts = DesignOptions { refine_rtol: 0.03, ..Default::default() };
+        let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
+        let best =
+            |f| Best { x: vec![1.0], f, dnorm: 0.0, evaldist: 0.0, start: 0, from: vec![1.0], coords: Coords::Raw };
+        let mut st = State {
+            opts: &opts,
+            stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
+            perf: Some(best(1.0)),
+            stab: None,
+            stabilised: true,
+            stall: 0,
+            perf_cut: false,
+            continued: true,
+            refinements: 0,
+        };
+        let stalled = Termination::LineSearchFailed;
+        assert!(st.refines(&end(1.02, 0.1, stalled)));
+        assert!(st.refines(&end(1.0, 0.1, Termination::MaxIters)));
+        assert!(!st.refines(&end(1.04, 0.1, stalled)), "beyond refine_rtol");
+        assert!(!st.refines(&end(0.99, 0.1, stalled)), "below the incumbent: it becomes the incumbent");
+        assert!(!st.refines(&end(1.02, 1e-4, stalled)), "certified");
+        assert!(!st.refines(&end(1.02, 0.1, Termination::CpuBudget)), "cut by a budget");
+        assert!(!st.refines(&end(f64::INFINITY, 0.1, stalled)));
+        st.continued = false;
+        assert!(!st.refines(&end(1.02, 0.1, stalled)), "HIFOO's first starts are not refined");
+        st.continued = true;
+        st.perf = None;
+        assert!(!st.refines(&end(1.02, 0.1, stalled)), "no incumbent");
+        let off = DesignOptions { refine_rtol: 0.0, ..Default::default() };
+        st.opts = &off;
+        st.perf = Some(best(1.0));
+        assert!(!st.refines(&end(1.0, 0.1, stalled)), "refine_rtol = 0: off");
+    }
+}
