@@ -8,9 +8,9 @@ use std::cell::RefCell;
 
 use faer::{c64, MatRef};
 
-use super::freq_response;
-use super::hessenberg_qr::hessenberg_eigenvalues;
-use super::square_reduced::{self, hamiltonian_squared_w};
+use super::kernels::freq_response;
+use super::kernels::hessenberg_qr::hessenberg_eigenvalues;
+use super::kernels::square_reduced::{self, hamiltonian_squared_w};
 use super::StateSpace;
 
 /// The eigenvalues of the n×n upper Hessenberg `h` (column-major, overwritten) as the H∞ norm

@@ -78,14 +78,14 @@
 
 use faer::{c64, Mat};
 
-use super::freq_response::{FreqResponse, ResponseSlot};
-use super::hessenberg_qr::HESSENBERG_QR_FROM;
-use super::interrupt::{Interrupt, Interrupted};
-use super::level_set_pencil::pencil_crossings;
-use super::spectral::eigenvalues;
-use super::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
-use super::step_stats::{count, for_order, timed, Step};
-use super::StateSpace;
+use crate::lti::interrupt::{Interrupt, Interrupted};
+use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
+use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
+use crate::lti::kernels::level_set_pencil::pencil_crossings;
+use crate::lti::kernels::spectral::eigenvalues;
+use crate::lti::kernels::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
+use crate::lti::kernels::step_stats::{count, for_order, timed, Step};
+use crate::lti::system::state_space::StateSpace;
 
 /// Default relative tolerance of [`hinf_norm`].
 pub const DEFAULT_HINF_TOL: f64 = 1e-10;
@@ -225,7 +225,7 @@ pub(crate) fn hinf_norm_keeping_response(
         timed(Step::Norm, || {
             let mut fr = kept;
             let poles = if sys.order() >= HESSENBERG_QR_FROM {
-                super::kernel_bench::note_norm(sys, tol, hints);
+                crate::lti::kernel_bench::note_norm(sys, tol, hints);
                 fr.get_or_insert_with(|| FreqResponse::new(sys)).poles()
             } else {
                 timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
@@ -320,7 +320,7 @@ fn hinf_norm_from(
     if poles.iter().any(|l| !(l.re < 0.0) || !l.im.is_finite()) {
         return Ok(HinfNorm::UNSTABLE);
     }
-    let sigma_d = super::freq_response::sigma_max_c(complexify(sys.d.as_ref()).as_ref());
+    let sigma_d = crate::lti::kernels::freq_response::sigma_max_c(complexify(sys.d.as_ref()).as_ref());
     if sys.order() == 0 {
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }

@@ -18,7 +18,7 @@ use faer::{c64, Conj, Mat, MatRef, Par};
 use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
 use super::hessenberg_solve::ShiftedHessenbergSolve;
 use super::step_stats::{timed, Step};
-use super::StateSpace;
+use crate::lti::system::state_space::StateSpace;
 
 /// G(iω) evaluator for one system (reusable buffers).
 pub(crate) struct FreqResponse {
@@ -330,7 +330,7 @@ fn split_solution((xr, xi): (&[f64], &[f64]), n: usize, conj: bool) -> Option<Ve
 }
 
 /// One frequency-response evaluator kept for the next H∞ computation on the same system: the
-/// line-search screen ([`hinf_lower_bound_sharing`](super::hinf::hinf_lower_bound_sharing)) leaves
+/// line-search screen ([`hinf_lower_bound_sharing`](crate::lti::norms::hinf::hinf_lower_bound_sharing)) leaves
 /// the closed loop's Hessenberg form here, and the norm of a trial that passes the screen
 /// ([`closed_loop_hinf_grad_sharing`](super::closed_loop_hinf_grad_sharing)) takes it instead of
 /// reducing A again (issue 13). Taken only for a bitwise identical system, and the evaluator's

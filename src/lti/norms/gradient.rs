@@ -26,14 +26,17 @@
 use faer::linalg::solvers::Solve;
 use faer::{c64, Mat, MatRef};
 
-use super::closed_loop::ClosedLoop;
-use super::freq_response::{FreqResponse, ResponseSlot};
-use super::hessenberg_qr::HESSENBERG_QR_FROM;
 use super::hinf::{hinf_norm_keeping_response, HinfNorm};
-use super::interrupt::Interrupt;
-use super::spectral::rightmost_eigen;
-use super::step_stats::{for_order, timed, Step};
-use super::{Controller, LtiError, Plant, StateSpace};
+use crate::lti::error::LtiError;
+use crate::lti::interrupt::Interrupt;
+use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
+use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
+use crate::lti::kernels::spectral::rightmost_eigen;
+use crate::lti::kernels::step_stats::{for_order, timed, Step};
+use crate::lti::system::closed_loop::ClosedLoop;
+use crate::lti::system::controller::Controller;
+use crate::lti::system::plant::Plant;
+use crate::lti::system::state_space::StateSpace;
 
 /// Gradient with respect to (Ak, Bk, Ck, Dk), same shapes as the controller.
 pub type ControllerGradient = Controller;

@@ -637,7 +637,7 @@ mod tests {
             let a = random(n, seed);
             let sys =
                 crate::lti::StateSpace { a: a.clone(), b: Mat::zeros(n, 1), c: Mat::zeros(1, n), d: Mat::zeros(1, 1) };
-            let got = crate::lti::freq_response::FreqResponse::new(&sys).poles().unwrap();
+            let got = crate::lti::kernels::freq_response::FreqResponse::new(&sys).poles().unwrap();
             let d = spectrum_distance(&got, &reference(&a));
             assert!(d <= 1e-10 * a.norm_l2(), "n = {n}: {d:e}");
         }

@@ -50,7 +50,7 @@ use faer::{Mat, MatRef};
 
 use super::square_reduced::skew_hamiltonian_eigenvalues;
 use super::step_stats::{timed, Step};
-use super::StateSpace;
+use crate::lti::system::state_space::StateSpace;
 
 /// Distance to the image [−2/s, 0] of the imaginary axis accepted as a crossing, in units of
 /// √ε·‖W‖_F.
@@ -305,7 +305,7 @@ fn cayley_crossings(t: MatRef<'_, f64>, s: f64) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lti::freq_response::FreqResponse;
+    use crate::lti::kernels::freq_response::FreqResponse;
     use faer::linalg::solvers::DenseSolveCore;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -343,7 +343,7 @@ mod tests {
             panic!("no inverse")
         };
         let h = t.partial_piv_lu().inverse() + Mat::<f64>::identity(2 * n, 2 * n) * faer::Scale(1.3);
-        let ev = crate::lti::spectral::eigenvalues(h.as_ref()).unwrap();
+        let ev = crate::lti::kernels::spectral::eigenvalues(h.as_ref()).unwrap();
         let real = ev.iter().filter(|l| l.im == 0.0 && l.re > 0.0).map(|l| l.re).next().expect("a real eigenvalue");
         for (s, expect_rejected) in [(real, true), (1.3, false), (0.7 * real, false)] {
             let mat = shifted_pencil(&sys, gamma, s);
