@@ -1,8 +1,9 @@
-//! Entry points of the per-call microbenchmarks of `benches/lti.rs` (issue 13): `--qr`, the
+//! Entry points of the per-call microbenchmarks of `benches/lti.rs`: `--qr`, the
 //! matrices the H∞ norm hands to the Hessenberg QR (the closed loop's Hessenberg form, the
 //! square-reduced method's W) and the QR itself; `--pvl`, the PVL reduction; `--record` and
 //! `--replay`, the H∞ norms of a design run replayed on their recorded closed loops. Not a stable
-//! API.
+//! API: built only with the `test-support` feature (`cargo bench --bench lti --features
+//! test-support`).
 
 use std::cell::RefCell;
 

@@ -17,6 +17,7 @@
 mod error;
 mod interrupt;
 mod io;
+#[cfg(feature = "test-support")]
 #[doc(hidden)]
 pub mod kernel_bench;
 mod kernels;
@@ -47,15 +48,13 @@ pub use kernels::spectral::{
     STABILITY_MARGIN_RTOL,
 };
 pub use norms::gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, closed_loop_hinf_grad_near,
-    closed_loop_hinf_grad_near_interruptible, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
-    controller_hinf_grad, ControllerGradient,
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
+    ControllerGradient,
 };
-pub(crate) use norms::hinf::hinf_norm_with_poles_interruptible;
+pub(crate) use norms::hinf::hinf_norm_with_poles;
 pub use norms::hinf::{
-    hinf_lower_bound, hinf_lower_bound_sharing, hinf_norm, hinf_norm_interruptible, hinf_norm_near,
-    hinf_norm_near_interruptible, HinfNorm, DEFAULT_HINF_TOL, MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS,
-    MIN_HINF_TOL,
+    hinf_lower_bound, hinf_lower_bound_sharing, hinf_norm, HinfNorm, HinfParams, DEFAULT_HINF_TOL,
+    MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use synthesis::balanced_truncation::{
     balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values,

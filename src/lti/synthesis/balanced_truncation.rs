@@ -206,7 +206,7 @@ pub fn dc_gain(sys: &StateSpace) -> Option<Mat<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lti::hinf_norm;
+    use crate::lti::{hinf_norm, HinfParams};
 
     fn diag_sys(poles: &[f64], b: &[f64], c: &[f64]) -> StateSpace {
         let n = poles.len();
@@ -243,7 +243,7 @@ mod tests {
                 c: Mat::from_fn(1, 4 + r, |_, j| if j < 4 { s.c[(0, j)] } else { -red.sys.c[(0, j - 4)] }),
                 d: Mat::zeros(1, 1),
             };
-            let e = hinf_norm(&err, 1e-10).value;
+            let e = hinf_norm(&err, &HinfParams::new(1e-10)).unwrap().value;
             let tail: f64 = h[r..].iter().sum();
             assert!(e <= 2.0 * tail * (1.0 + 1e-8), "r = {r}: error {e} > 2·tail {}", 2.0 * tail);
             assert!(e >= h[r] * (1.0 - 1e-8), "r = {r}: error {e} below σ_(r+1) {}", h[r]);

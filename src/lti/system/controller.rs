@@ -293,7 +293,7 @@ mod tests {
 
     #[test]
     fn flat_dk_is_named_as_such() {
-        // issue 15: `DK: [1.0, 2.0]` was reported as "has 0 rows".
+        // a flat list `DK: [1.0, 2.0]` was once reported as "has 0 rows", which misled.
         let e =
             Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [[]], "DK": [1.0, 2.0]}"#, "k.json").unwrap_err();
         let s = e.to_string();
