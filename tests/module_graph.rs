@@ -203,6 +203,11 @@ fn lti_parts_import_only_downwards() {
     }
     for (m, edges) in &g {
         for t in edges {
+            // The one exception: the H∞ norm's recording hook for `benches/lti.rs --record`,
+            // compiled only with the `test-support` feature.
+            if m == "norms::hinf" && t == "kernel_bench" {
+                continue;
+            }
             assert!(
                 lti_rank(t) <= lti_rank(m) || m.split("::").next() == t.split("::").next(),
                 "src/lti/{m} imports lti::{t}, a part above its own (order: {LTI_PARTS:?})"

@@ -123,6 +123,7 @@ fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
 /// The W (n×n upper Hessenberg, column-major) of the PVL reduction of H² for the Hamiltonian
 /// H = [F G; K −Fᵀ], as [`hamiltonian_squared_eigenvalues`] computes it (for the QR
 /// microbenchmark, `lti::kernel_bench`); `None` if not finite.
+#[cfg(feature = "test-support")]
 pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
     let id = Mat::<f64>::identity(f.nrows(), f.nrows());
     let dense = |x| LowRank { left: x, right: id.as_ref() };
@@ -132,6 +133,7 @@ pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: M
 
 /// The W (n×n upper Hessenberg, column-major) of the PVL reduction of [A G; Q Aᵀ], as
 /// [`skew_hamiltonian_eigenvalues`] computes it (for the microbenchmarks, `lti::kernel_bench`).
+#[cfg(feature = "test-support")]
 pub(crate) fn pvl_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
     skew_hamiltonian_w(a, g, q).data
 }
