@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
 use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver};
-use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
+use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, HinfParams, Plant};
 
 struct Args {
     seeds: u64,
@@ -83,7 +83,7 @@ fn check(p: &Plant, o: &DesignOutcome) -> (bool, bool, f64) {
     let k = &o.controller;
     let cl = closed_loop(p, k).expect("well-posed loop");
     let a = spectral_abscissa(cl.a.as_ref());
-    let g = hinf_norm(&cl, DEFAULT_HINF_TOL).value;
+    let g = hinf_norm(&cl, &HinfParams::default()).unwrap().value;
     let ks = k.order() == 0 || spectral_abscissa(k.ak.as_ref()) < 0.0;
     (a < 0.0, ks, g)
 }

@@ -1,19 +1,20 @@
-//! Benchmark of the LTI numerics (issue 3): H∞-norm time on 2×2 systems of order
+//! Benchmark of the LTI numerics: H∞-norm time on 2×2 systems of order
 //! n = 10, 50, 100, 250, 500 (random stable, and lightly damped modal), and objective+gradient evaluations per second of the design
 //! objective for HE1 (nK = 2) and CM4 (nK = 4). Times are thread CPU time, one thread (faer is
 //! built without its rayon feature), medians over repeated runs.
 //!
-//! Run: `cargo bench --bench lti`. Options:
+//! Run: `cargo bench --bench lti --features test-support` (the feature builds the library's
+//! `lti::kernel_bench` entry points this bench calls). Options:
 //! * `--dump DIR`: also write the random systems as JSON (`random_n{n}.json`, `damped_n{n}.json`, keys A, B, C, D) so
 //!   that `scripts/ab13dd_bench.py DIR` can time SLICOT's AB13DD on exactly the same data;
 //! * `--quick`: fewer repetitions;
 //! * `--only N`: just the H∞ norm at order N, 200 times (for a profiler);
 //! * `--design-cpumax S`: CPU budget of each design run of the last table (default 20, as in
-//!   issue 13's `campaign design --order 1 --eps 1e-3 --seed 1 --cpumax 20`); `--no-design`
+//!   the large-plant timings `campaign design --order 1 --eps 1e-3 --seed 1 --cpumax 20`); `--no-design`
 //!   skips that table;
 //! * `--design-only [NAMES]`: just the last table, optionally only the plants in the
 //!   comma-separated NAMES (e.g. `BDT2,CM4`; for a profiler);
-//! * `--qr`: just the Hessenberg QR microbenchmark (issue 13): per-call thread-CPU time of the
+//! * `--qr`: just the Hessenberg QR microbenchmark: per-call thread-CPU time of the
 //!   eigenvalues of random Hessenberg matrices (n = 40, 83, 166, 241) and of the two matrices the
 //!   H∞ norm hands to the QR for the BDT2 and CM4 closed loops with the designed controllers of
 //!   `--pvl` (the Hessenberg form of A, the W of the square-reduced method), our QR (`lti::kernel_bench`) against faer's dense `evd_real` (values
@@ -52,7 +53,8 @@ use hinfix::design::{
 use hinfix::lti::kernel_bench;
 use hinfix::lti::step_stats::{self, Step};
 use hinfix::lti::{
-    hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL,
+    hinf_norm, matrix_to_json, resolve_plant, spectral_abscissa, Controller, HinfParams, Plant, StateSpace,
+    DEFAULT_HINF_TOL,
 };
 use hinfix::optim::{thread_cpu_time, Objective};
 use rand::SeedableRng;
@@ -77,7 +79,7 @@ fn random_stable(n: usize, m: usize, p: usize, seed: u64) -> StateSpace {
     }
     let (b, c, d) = (randn(&mut rng, n, m, 1.0), randn(&mut rng, p, n, 1.0), randn(&mut rng, p, m, 0.3));
     let sys = StateSpace::new(a, b, c, d).unwrap();
-    assert!(hinf_norm(&sys, DEFAULT_HINF_TOL).value.is_finite(), "random system n={n} not stable");
+    assert!(hinf_norm(&sys, &HinfParams::default()).unwrap().value.is_finite(), "random system n={n} not stable");
     sys
 }
 
@@ -325,7 +327,7 @@ fn replay(path: &PathBuf, rounds: usize, steps: bool, compare: Option<&PathBuf>)
         step_stats::set_timing(steps && round + 1 == rounds);
         let t0 = thread_cpu_time();
         for r in &norms {
-            let h = hinfix::lti::hinf_norm_near(&r.sys, r.tol, &r.hints);
+            let h = hinf_norm(&r.sys, &HinfParams::new(r.tol).with_hints(&r.hints)).unwrap();
             if round == 0 {
                 values.push(h.value);
             }
@@ -443,7 +445,7 @@ fn main() {
                 (101..=250, _) => 9,
                 _ => 5,
             };
-            let (t, h) = time(reps, || hinf_norm(&sys, DEFAULT_HINF_TOL));
+            let (t, h) = time(reps, || hinf_norm(&sys, &HinfParams::default()).unwrap());
             let (t_poles, _) = time(reps, || spectral_abscissa(sys.a.as_ref()));
             println!("{n:>5} {t:>12.6} {:>14.10} {:>12.6} {reps:>5} {t_poles:>12.6}", h.value, h.peak_freq);
         }
@@ -512,7 +514,7 @@ fn pvl_table() {
         .collect();
     for name in ["BDT2", "CM4"] {
         let sys = designed_closed_loop(name);
-        let norm = hinf_norm(&sys, DEFAULT_HINF_TOL).value;
+        let norm = hinf_norm(&sys, &HinfParams::default()).unwrap().value;
         assert!(norm.is_finite(), "{name}: closed loop not stable");
         cases.push((format!("{name} H² n={}", sys.a.nrows()), squared_hamiltonian(&sys, 1.01 * norm)));
     }
@@ -598,7 +600,7 @@ fn qr_table(quick: bool) {
             kernel_bench::hessenberg_form(cl.a.as_ref()),
         ));
         // The Hamiltonian [A, BBᵀ/γ; −CᵀC/γ, −Aᵀ] (the D = 0 form) at twice the norm.
-        let gamma = 2.0 * hinf_norm(&cl, DEFAULT_HINF_TOL).value.max(1.0);
+        let gamma = 2.0 * hinf_norm(&cl, &HinfParams::default()).unwrap().value.max(1.0);
         let g = &cl.b * cl.b.transpose() * faer::Scale(1.0 / gamma);
         let kk = cl.c.transpose() * &cl.c * faer::Scale(-1.0 / gamma);
         let w = kernel_bench::hamiltonian_w(cl.a.as_ref(), g.as_ref(), kk.as_ref()).expect("finite W");

@@ -45,7 +45,7 @@ use std::time::Instant;
 
 use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
 use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, VariableScaling};
-use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Plant, DEFAULT_HINF_TOL};
+use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, HinfParams, Plant};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -118,7 +118,7 @@ fn verified_gamma(p: &Plant, o: &DesignOutcome) -> Option<f64> {
     let k = &o.controller;
     let cl = closed_loop(p, k).ok()?;
     let k_stable = k.order() == 0 || spectral_abscissa(k.ak.as_ref()) < 0.0;
-    (spectral_abscissa(cl.a.as_ref()) < 0.0 && k_stable).then(|| hinf_norm(&cl, DEFAULT_HINF_TOL).value)
+    (spectral_abscissa(cl.a.as_ref()) < 0.0 && k_stable).then(|| hinf_norm(&cl, &HinfParams::default()).unwrap().value)
 }
 
 /// One design job of the bench.

@@ -6,7 +6,7 @@ use faer::Mat;
 use hinfix::design::{central_starts, reduce_controller as reduce};
 use hinfix::lti::{
     closed_loop, hankel_singular_values, hinf_norm, lyapunov_residual, resolve_plant, solve_lyapunov,
-    spectral_abscissa, CentralProblem, Plant, StateSpace,
+    spectral_abscissa, CentralProblem, HinfParams, Plant, StateSpace,
 };
 
 fn plant(name: &str) -> Plant {
@@ -57,7 +57,7 @@ fn gramians_satisfy_their_lyapunov_equations_and_hsv_match_scipy() {
 fn closed_loop_gamma(p: &Plant, k: &hinfix::lti::Controller) -> f64 {
     let cl = closed_loop(p, k).unwrap();
     if spectral_abscissa(cl.a.as_ref()) < 0.0 {
-        hinf_norm(&cl, 1e-10).value
+        hinf_norm(&cl, &HinfParams::new(1e-10)).unwrap().value
     } else {
         f64::INFINITY
     }

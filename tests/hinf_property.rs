@@ -8,7 +8,7 @@
 //! logarithmic sweep (plus points packed around every mode at its damping's scale, ω = 0 and
 //! ω = ∞), and the best local maxima of the sweep are refined by golden-section search.
 //!
-//! Asserted for every system, for `hinf_norm` and for `hinf_norm_near` warm-started at a
+//! Asserted for every system, for `hinf_norm` and for `hinf_norm` with `HinfParams::hints` warm-started at a
 //! frequency unrelated to the peak: the norm is never below the truth by more than [`REL_TOL`], and
 //! the returned frequency attains the returned value (no over-estimate).
 //!
@@ -23,7 +23,7 @@
 //! `HINF_LARGE_SEEDS=a..b` picks seeds, `HINF_NMAX=80` raises the largest order.
 
 use faer::{c64, Mat};
-use hinfix::lti::{hinf_norm, hinf_norm_near, StateSpace, DEFAULT_HINF_TOL};
+use hinfix::lti::{hinf_norm, HinfParams, StateSpace, DEFAULT_HINF_TOL};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -403,7 +403,7 @@ fn check(family: Family, seeds: impl IntoIterator<Item = u64>) -> Tally {
     for seed in seeds {
         let (mb, shape) = family(seed);
         let Truth { value: want, freq: want_w, runner_up } = truth(&mb);
-        let got = hinf_norm(&mb.sys, DEFAULT_HINF_TOL);
+        let got = hinf_norm(&mb.sys, &HinfParams::default()).unwrap();
         if let Ok(dir) = std::env::var("HINF_DUMP") {
             let j = |m: &Mat<f64>| hinfix::lti::matrix_to_json(m.as_ref());
             let doc = serde_json::json!({"A": j(&mb.sys.a), "B": j(&mb.sys.b), "C": j(&mb.sys.c), "D": j(&mb.sys.d),
@@ -415,7 +415,7 @@ fn check(family: Family, seeds: impl IntoIterator<Item = u64>) -> Tally {
         // hint on the best lower local peak, as a warm start from a nearby system gives it.
         let unrelated = 10f64.powf(-2.0 + 4.0 * ((seed * 7919) % 1000) as f64 / 1000.0);
         let hint = if shape.is_empty() { unrelated } else { runner_up.unwrap_or(unrelated) };
-        let hinted = hinf_norm_near(&mb.sys, DEFAULT_HINF_TOL, &[hint]);
+        let hinted = hinf_norm(&mb.sys, &HinfParams::default().with_hints(&[hint])).unwrap();
         t.count += 1;
         t.square += mb.square as usize;
         t.non_square += !mb.square as usize;

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use hinfix::lti::{
-    closed_loop, closed_loop_hinf_grad, hinf_norm, hinf_norm_near, matrix_from_json, Controller, HinfNorm, Plant,
+    closed_loop, closed_loop_hinf_grad, hinf_norm, matrix_from_json, Controller, HinfNorm, HinfParams, Plant,
     StateSpace, DEFAULT_HINF_TOL,
 };
 
@@ -59,7 +59,7 @@ fn assert_closed_loop_reaches_peak(
     let cl = closed_loop(&plant, &k).unwrap();
     // The reference is an attained value.
     assert!((sigma_direct(&cl, peak_freq) - peak).abs() <= ref_tol * peak, "{name}: reference not attained");
-    let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
+    let h = hinf_norm(&cl, &HinfParams::default()).unwrap();
     assert!(
         h.value >= peak * (1.0 - 2.0 * DEFAULT_HINF_TOL),
         "{name}: ‖Tzw‖∞ = {} at ω = {}, below the peak {peak}",
@@ -71,7 +71,7 @@ fn assert_closed_loop_reaches_peak(
         (sigma_direct(&cl, h.peak_freq) - h.value).abs() <= tol * h.value,
         "{name}: not attained at the returned frequency"
     );
-    let (h2, _) = closed_loop_hinf_grad(&plant, &k, DEFAULT_HINF_TOL).unwrap();
+    let (h2, _) = closed_loop_hinf_grad(&plant, &k, &HinfParams::default()).unwrap();
     assert!((h2.value - h.value).abs() <= 1e-12 * h.value, "{name}: the objective's path differs");
     (cl, h)
 }
@@ -129,7 +129,10 @@ fn assert_cases_reach_reference(file: &str, count: usize, old_gap: f64) {
         let attained = sigma_direct(&cl, c["reference_freq"].as_f64().unwrap());
         assert!((attained - peak).abs() <= tol * peak, "case {i}: σ at the reference frequency {attained} vs {peak}");
         assert!(old < peak * (1.0 - (10.0 * tol).max(old_gap)), "case {i} must be one the old norm got wrong");
-        for h in [hinf_norm_near(&cl, DEFAULT_HINF_TOL, &hints), hinf_norm(&cl, DEFAULT_HINF_TOL)] {
+        for h in [
+            hinf_norm(&cl, &HinfParams::default().with_hints(&hints)).unwrap(),
+            hinf_norm(&cl, &HinfParams::default()).unwrap(),
+        ] {
             assert!(
                 h.value >= peak * (1.0 - tol.max(1e-9)),
                 "case {i}: ‖T‖∞ = {} at ω = {}, below the reference {peak}",

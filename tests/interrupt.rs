@@ -13,8 +13,8 @@ use faer::Mat;
 use hinfix::design::{ComponentCache, MIN_ORDER_FOR_INTERRUPT};
 use hinfix::design::{ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase, SearchStop};
 use hinfix::lti::{
-    closed_loop, closed_loop_hinf_grad, closed_loop_hinf_grad_interruptible, hinf_norm, hinf_norm_interruptible,
-    Controller, Dims, Interrupt, Interrupted, LtiError, Plant, StateSpace, DEFAULT_HINF_TOL,
+    closed_loop, closed_loop_hinf_grad, hinf_norm, Controller, Dims, HinfParams, Interrupt, Interrupted, LtiError,
+    Plant, StateSpace, DEFAULT_HINF_TOL,
 };
 use hinfix::optim::{bfgs, BfgsOptions, NoObserver, Objective, OptimError, RunControl, Termination};
 use rand::{Rng, SeedableRng};
@@ -62,11 +62,11 @@ fn after(k: usize, polls: &Cell<usize>) -> impl Fn() -> bool + '_ {
 fn hinf_norm_is_interrupted_at_every_poll_or_exact() {
     let p = random_plant(40, 1);
     let sys = StateSpace { a: p.a.clone(), b: p.b1.clone(), c: p.c1.clone(), d: p.d11.clone() };
-    let exact = hinf_norm(&sys, DEFAULT_HINF_TOL);
+    let exact = hinf_norm(&sys, &HinfParams::default()).unwrap();
     assert!(exact.value.is_finite() && exact.value > 0.0);
     let polls = Cell::new(0);
     let count = after(usize::MAX, &polls);
-    let counted = hinf_norm_interruptible(&sys, DEFAULT_HINF_TOL, Interrupt::new(&count)).unwrap();
+    let counted = hinf_norm(&sys, &HinfParams::default().with_stop(Interrupt::new(&count))).unwrap();
     assert_eq!(counted.value.to_bits(), exact.value.to_bits(), "polling changes nothing");
     let total = polls.get();
     assert!(total >= 3, "the norm polls between its steps ({total} polls)");
@@ -74,7 +74,7 @@ fn hinf_norm_is_interrupted_at_every_poll_or_exact() {
         let polls = Cell::new(0);
         let hook = after(k, &polls);
         assert_eq!(
-            hinf_norm_interruptible(&sys, DEFAULT_HINF_TOL, Interrupt::new(&hook)),
+            hinf_norm(&sys, &HinfParams::default().with_stop(Interrupt::new(&hook))),
             Err(Interrupted),
             "hook firing at poll {} of {total} must interrupt",
             k + 1
@@ -83,22 +83,22 @@ fn hinf_norm_is_interrupted_at_every_poll_or_exact() {
     }
     let polls = Cell::new(0);
     let hook = after(total, &polls);
-    assert_eq!(hinf_norm_interruptible(&sys, DEFAULT_HINF_TOL, Interrupt::new(&hook)), Ok(exact));
+    assert_eq!(hinf_norm(&sys, &HinfParams::default().with_stop(Interrupt::new(&hook))), Ok(exact));
 }
 
 #[test]
 fn closed_loop_gradient_is_interrupted() {
     let plant = random_plant(30, 2);
     let k = Controller::zeros(0, 2, 2);
-    let exact = closed_loop_hinf_grad(&plant, &k, DEFAULT_HINF_TOL).unwrap();
+    let exact = closed_loop_hinf_grad(&plant, &k, &HinfParams::default()).unwrap();
     let never = || false;
-    let same = closed_loop_hinf_grad_interruptible(&plant, &k, DEFAULT_HINF_TOL, Interrupt::new(&never)).unwrap();
+    let same = closed_loop_hinf_grad(&plant, &k, &HinfParams::default().with_stop(Interrupt::new(&never))).unwrap();
     assert_eq!(exact.0, same.0);
     let polls = Cell::new(0);
     let late = after(0, &polls);
     let hook = Interrupt::new(&late);
     assert!(matches!(
-        closed_loop_hinf_grad_interruptible(&plant, &k, DEFAULT_HINF_TOL, hook),
+        closed_loop_hinf_grad(&plant, &k, &HinfParams::default().with_stop(hook)),
         Err(LtiError::Interrupted(Interrupted))
     ));
 }
@@ -204,7 +204,7 @@ fn cancelled_design_reports_recomputed_figures_or_none() {
         assert_eq!(out.search.stop, SearchStop::Interrupted);
         let k = &out.controller;
         let cl = closed_loop(&plant, k).unwrap();
-        let gamma = hinf_norm(&cl, opts.hinf_tol).value;
+        let gamma = hinf_norm(&cl, &HinfParams::new(opts.hinf_tol)).unwrap().value;
         if recomputed {
             assert_eq!(out.gamma.to_bits(), gamma.to_bits(), "n = {n}: γ {} vs recomputed {gamma}", out.gamma);
         } else {

@@ -68,8 +68,8 @@ fn lower_bound_rejection_is_exact_and_used() {
 fn screened_evaluator_reuse_is_exact() {
     use hinfix::lti::step_stats::{self, Step};
     use hinfix::lti::{
-        closed_loop, closed_loop_hinf_grad_near, closed_loop_hinf_grad_sharing, hinf_lower_bound_sharing,
-        resolve_plant, Controller, Interrupt, Plant, ResponseSlot, DEFAULT_HINF_TOL,
+        closed_loop, closed_loop_hinf_grad, hinf_lower_bound_sharing, resolve_plant, Controller, HinfParams, Plant,
+        ResponseSlot,
     };
     let plant = resolve_plant("CM4").and_then(Plant::load).unwrap();
     let d = plant.dims;
@@ -79,24 +79,16 @@ fn screened_evaluator_reuse_is_exact() {
     let mut other = k.clone();
     other.ak[(0, 0)] = -3.0;
     let hint = [0.7];
-    let fresh = closed_loop_hinf_grad_near(&plant, &k, DEFAULT_HINF_TOL, &hint).unwrap();
+    let fresh = closed_loop_hinf_grad(&plant, &k, &HinfParams::default().with_hints(&hint)).unwrap();
     assert!(fresh.0.value.is_finite(), "the test loop must be stable");
     for screened in [&k, &other] {
-        let mut slot = ResponseSlot::default();
+        let slot = ResponseSlot::default();
         let cl = closed_loop(&plant, screened).unwrap();
         assert!(cl.order() >= 30, "the large-order path");
-        let lb = hinf_lower_bound_sharing(&cl, &hint, f64::INFINITY, &mut slot);
+        let lb = hinf_lower_bound_sharing(&cl, &hint, f64::INFINITY, &slot);
         step_stats::reset();
-        let shared = closed_loop_hinf_grad_sharing(
-            &plant,
-            &k,
-            DEFAULT_HINF_TOL,
-            &hint,
-            Interrupt::NEVER,
-            &mut slot,
-            f64::INFINITY,
-        )
-        .unwrap();
+        let shared =
+            closed_loop_hinf_grad(&plant, &k, &HinfParams::default().with_hints(&hint).with_reuse(&slot)).unwrap();
         let reductions = step_stats::snapshot().calls(Step::Hessenberg, true);
         assert_eq!(reductions, u64::from(!std::ptr::eq(screened, &k)), "Hessenberg reductions of the norm");
         assert_eq!(shared.0.value.to_bits(), fresh.0.value.to_bits());
@@ -108,28 +100,30 @@ fn screened_evaluator_reuse_is_exact() {
     }
 }
 
-/// `closed_loop_hinf_grad_sharing` with a level (the norm of a trial point that passed the screen): with the
+/// `closed_loop_hinf_grad` with a level, `HinfParams::enough` (the norm of a trial point that passed the screen): with the
 /// level above the norm it gives bit for bit the full norm and gradient; with a level below the
 /// norm it stops at an attained value that reaches the level, at most the norm, with no gradient
 /// and (the level being below the scan's best) no level-set test.
 #[test]
 fn norm_stopping_at_a_level_is_exact_or_a_bound() {
     use hinfix::lti::step_stats::{self, Step};
-    use hinfix::lti::{
-        closed_loop_hinf_grad_near, closed_loop_hinf_grad_sharing, resolve_plant, Controller, Interrupt, Plant,
-        ResponseSlot, DEFAULT_HINF_TOL,
-    };
+    use hinfix::lti::{closed_loop_hinf_grad, resolve_plant, Controller, HinfParams, Plant, ResponseSlot};
     let plant = resolve_plant("CM4").and_then(Plant::load).unwrap();
     let d = plant.dims;
     let mut k = Controller::zeros(1, d.m2, d.p2);
     k.ak[(0, 0)] = -2.0;
     k.bk[(0, 0)] = 0.01;
     let hint = [0.7];
-    let (norm, grad) = closed_loop_hinf_grad_near(&plant, &k, DEFAULT_HINF_TOL, &hint).unwrap();
+    let (norm, grad) = closed_loop_hinf_grad(&plant, &k, &HinfParams::default().with_hints(&hint)).unwrap();
     assert!(norm.value.is_finite(), "the test loop must be stable");
     let unless = |enough: f64| {
-        let mut slot = ResponseSlot::default();
-        closed_loop_hinf_grad_sharing(&plant, &k, DEFAULT_HINF_TOL, &hint, Interrupt::NEVER, &mut slot, enough).unwrap()
+        let slot = ResponseSlot::default();
+        closed_loop_hinf_grad(
+            &plant,
+            &k,
+            &HinfParams::default().with_hints(&hint).with_enough(enough).with_reuse(&slot),
+        )
+        .unwrap()
     };
     let above = unless(norm.value * (1.0 + 1e-9));
     assert_eq!(above.0.value.to_bits(), norm.value.to_bits());

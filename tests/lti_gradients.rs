@@ -4,7 +4,7 @@
 use faer::Mat;
 use hinfix::lti::{
     closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    hinf_norm, spectral_abscissa, Controller, Dims, LtiError, Plant,
+    hinf_norm, spectral_abscissa, Controller, Dims, HinfParams, LtiError, Plant,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -114,14 +114,14 @@ fn gradients_match_finite_differences() {
         });
         // ‖Tzw‖∞ (only where the loop is stable)
         if alpha < 0.0 {
-            let (h, g) = closed_loop_hinf_grad(&plant, &k, FD_HINF_TOL).unwrap();
+            let (h, g) = closed_loop_hinf_grad(&plant, &k, &HinfParams::new(FD_HINF_TOL)).unwrap();
             assert!(h.value.is_finite());
             check_fd(&format!("{label} ‖Tzw‖∞ (peak ω = {})", h.peak_freq), &k, &g, |kk| {
-                hinf_norm(&closed_loop(&plant, kk).unwrap(), FD_HINF_TOL).value
+                hinf_norm(&closed_loop(&plant, kk).unwrap(), &HinfParams::new(FD_HINF_TOL)).unwrap().value
             });
             checked_hinf += 1;
         } else {
-            let (h, g) = closed_loop_hinf_grad(&plant, &k, FD_HINF_TOL).unwrap();
+            let (h, g) = closed_loop_hinf_grad(&plant, &k, &HinfParams::new(FD_HINF_TOL)).unwrap();
             assert_eq!(h.value, f64::INFINITY);
             assert!(g.dk[(0, 0)].is_nan());
         }
@@ -152,12 +152,14 @@ fn large_order_hinf_gradient_matches_finite_differences() {
         let d22 = case >= 2;
         let plant = random_plant(&mut rng, n, 2, 2, 3, 2, d22);
         let k = random_controller(&mut rng, nk, 2, 2);
-        let (h, g) = closed_loop_hinf_grad(&plant, &k, FD_HINF_TOL).unwrap();
+        let (h, g) = closed_loop_hinf_grad(&plant, &k, &HinfParams::new(FD_HINF_TOL)).unwrap();
         if !h.value.is_finite() {
             continue;
         }
         let label = format!("case {case} (n={n}, nk={nk}, D22≠0: {d22}) ‖Tzw‖∞ (peak ω = {})", h.peak_freq);
-        check_fd(&label, &k, &g, |kk| hinf_norm(&closed_loop(&plant, kk).unwrap(), FD_HINF_TOL).value);
+        check_fd(&label, &k, &g, |kk| {
+            hinf_norm(&closed_loop(&plant, kk).unwrap(), &HinfParams::new(FD_HINF_TOL)).unwrap().value
+        });
         checked += 1;
     }
     assert!(checked >= 3, "too few stable random loops ({checked})");
@@ -171,7 +173,7 @@ fn ill_posed_loop_is_an_error() {
     let mut k = random_controller(&mut rng, 1, 1, 1);
     k.dk[(0, 0)] = 0.5; // 1 − Dk·D22 = 0
     assert!(matches!(closed_loop(&plant, &k), Err(LtiError::IllPosed { .. })));
-    assert!(matches!(closed_loop_hinf_grad(&plant, &k, 1e-10), Err(LtiError::IllPosed { .. })));
+    assert!(matches!(closed_loop_hinf_grad(&plant, &k, &HinfParams::new(1e-10)), Err(LtiError::IllPosed { .. })));
     assert!(matches!(closed_loop_abscissa_grad(&plant, &k), Err(LtiError::IllPosed { .. })));
     k.dk[(0, 0)] = f64::NAN;
     assert!(matches!(closed_loop(&plant, &k), Err(LtiError::IllPosed { .. })));

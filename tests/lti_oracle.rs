@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use faer::Mat;
 use hinfix::lti::{
     closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    hinf_norm, spectral_abscissa, Controller, Plant, StateSpace, DEFAULT_HINF_TOL,
+    hinf_norm, spectral_abscissa, Controller, HinfParams, Plant, StateSpace, DEFAULT_HINF_TOL,
 };
 use serde_json::Value;
 
@@ -116,7 +116,7 @@ fn check_hinfnorm_cases(dir: &str, attained_tol: f64) {
             failures.push(format!("{name}: alpha {alpha} vs {want_alpha}"));
         }
         let t0 = std::time::Instant::now();
-        let got = hinf_norm(&sys, DEFAULT_HINF_TOL);
+        let got = hinf_norm(&sys, &HinfParams::default()).unwrap();
         let dt = t0.elapsed();
         if want.is_infinite() != got.value.is_infinite() {
             failures.push(format!("{name}: stability decision differs: {} vs {want}", got.value));
@@ -178,14 +178,14 @@ fn closed_loop_cases_match_slicot() {
             }
         }
 
-        let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
+        let h = hinf_norm(&cl, &HinfParams::default()).unwrap();
         let want = num(&exp["closed_loop_hinf"]).unwrap();
         if want.is_infinite() != h.value.is_infinite() || want.is_finite() != (a_cl < 0.0) {
             failures.push(format!("{name}: stability decision {} vs {want}", h.value));
         } else if !close(h.value, want, 0.0) {
             failures.push(format!("{name}: hinf {} vs {want} (rel {:.2e})", h.value, (h.value - want).abs() / want));
         }
-        let (h2, g) = closed_loop_hinf_grad(&plant, &k, DEFAULT_HINF_TOL).unwrap();
+        let (h2, g) = closed_loop_hinf_grad(&plant, &k, &HinfParams::default()).unwrap();
         assert_eq!(h2.value.is_finite(), h.value.is_finite(), "{name}");
         if h.value.is_finite() {
             assert!((h2.value - h.value).abs() <= 1e-12 * h.value, "{name}");

@@ -177,3 +177,49 @@ fn layers_import_only_downwards() {
         }
     }
 }
+
+/// The parts of `lti`, bottom up (docs/ARCHITECTURE.md §1): a module may import its own part
+/// and the parts below it, never one above. `error` and `interrupt` are shared by all parts and
+/// import none; `kernel_bench` (bench scaffolding behind the `test-support` feature) sits on top.
+const LTI_PARTS: &[&str] = &["error", "interrupt", "io", "system", "kernels", "norms", "synthesis", "kernel_bench"];
+
+/// Rank of the part holding an lti module (`kernels::spectral` → that of `kernels`).
+fn lti_rank(module: &str) -> usize {
+    let part = module.split("::").next().unwrap();
+    match part {
+        "error" | "interrupt" => 0,
+        _ => LTI_PARTS
+            .iter()
+            .position(|p| *p == part)
+            .unwrap_or_else(|| panic!("src/lti/{module}: in no part of lti; add its folder to LTI_PARTS")),
+    }
+}
+
+#[test]
+fn lti_parts_import_only_downwards() {
+    let g = graph("lti");
+    for part in &LTI_PARTS[2..] {
+        assert!(g.keys().any(|m| m.split("::").next() == Some(part)), "src/lti/{part}: not found");
+    }
+    for (m, edges) in &g {
+        for t in edges {
+            // The one exception: the H∞ norm's recording hook for `benches/lti.rs --record`,
+            // compiled only with the `test-support` feature.
+            if m == "norms::hinf" && t == "kernel_bench" {
+                continue;
+            }
+            assert!(
+                lti_rank(t) <= lti_rank(m) || m.split("::").next() == t.split("::").next(),
+                "src/lti/{m} imports lti::{t}, a part above its own (order: {LTI_PARTS:?})"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_lti_part_order_is_checked() {
+    assert!(lti_rank("kernels::spectral") > lti_rank("system::state_space"));
+    assert!(lti_rank("io::mat_file") < lti_rank("system::plant"));
+    assert!(lti_rank("norms::hinf") < lti_rank("synthesis::full_order::gamma_test"));
+    assert_eq!(lti_rank("error"), lti_rank("interrupt"));
+}

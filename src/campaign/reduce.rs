@@ -18,8 +18,8 @@ use std::sync::Arc;
 
 use super::record::JobRecord;
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, is_stable_with_margin, spectral_abscissa, stability_margin, Plant,
-    DEFAULT_HINF_TOL,
+    closed_loop, controller_hinf_grad, hinf_norm, is_stable_with_margin, spectral_abscissa, stability_margin,
+    HinfParams, Plant, DEFAULT_HINF_TOL,
 };
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
@@ -90,7 +90,7 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
             return Verdict::Rejected(format!("controller not stable (α_K = {a}, must be below −{margin:.1e})"));
         }
     }
-    let gamma = hinf_norm(&cl, DEFAULT_HINF_TOL).value;
+    let gamma = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set").value;
     if !gamma.is_finite() {
         return Verdict::Rejected(format!("γ not finite ({gamma})"));
     }

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, stability_margin, Controller, Plant,
+    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, stability_margin, Controller, HinfParams, Plant,
     DEFAULT_HINF_TOL,
 };
 use anyhow::Context;
@@ -83,7 +83,7 @@ pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
 fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let cl = closed_loop(plant, k).context("forming the closed loop")?;
     let alpha_cl = spectral_abscissa(cl.a.as_ref());
-    let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
+    let h = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set");
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
     let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));

@@ -36,9 +36,9 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad_sharing, controller_abscissa_grad,
-    controller_hinf_grad, hinf_lower_bound_sharing, spectral_abscissa, Controller, ControllerGradient, Interrupt,
-    LtiError, Plant, ResponseSlot,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
+    hinf_lower_bound_sharing, spectral_abscissa, Controller, ControllerGradient, HinfParams, Interrupt, LtiError,
+    Plant, ResponseSlot,
 };
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
@@ -139,13 +139,13 @@ pub struct DesignObjective<'p> {
     other_peak: Cell<f64>,
     /// The closed loop's frequency-response evaluator left by the last screened trial
     /// ([`Objective::eval_below`]), for its norm if it passes the screen (`lti::ResponseSlot`).
-    screened: RefCell<ResponseSlot>,
+    screened: ResponseSlot,
     /// Polled inside long evaluations (module docs).
     stop: Option<StopHook>,
     /// Whether the last evaluation was abandoned because `stop` fired.
     abandoned: Cell<bool>,
     /// While [`Objective::eval_below`] evaluates a trial point that passed the screen: its
-    /// threshold, at which the closed-loop norm stops early (`lti::closed_loop_hinf_grad_sharing`);
+    /// threshold, at which the closed-loop norm stops early (`lti::HinfParams::enough`);
     /// +∞ otherwise.
     reject_at: Cell<f64>,
     /// Told the CPU seconds of every complete closed-loop evaluation where `stop` applies (large
@@ -178,7 +178,7 @@ impl<'p> DesignObjective<'p> {
             cache,
             peak_hint: Cell::new(f64::NAN),
             other_peak: Cell::new(f64::NAN),
-            screened: RefCell::new(ResponseSlot::default()),
+            screened: ResponseSlot::default(),
             stop: None,
             abandoned: Cell::new(false),
             reject_at: Cell::new(f64::INFINITY),
@@ -290,40 +290,43 @@ impl<'p> DesignObjective<'p> {
         let hook = self.stop.as_deref().filter(|_| self.plant.dims.n + k.order() >= MIN_ORDER_FOR_INTERRUPT);
         let stop = hook.map_or(Interrupt::NEVER, Interrupt::new);
         // Warm start at the last peak (Benner & Mitchell 2018), in addition to the mode-based test
-        // frequencies (`lti::hinf_norm_near`); the level-set certification is unchanged.
+        // frequencies (`lti::HinfParams::hints`); the level-set certification is unchanged.
         let hint = [self.peak_hint.get()];
         let cpu0 = hook.map(|_| thread_cpu_time());
-        let slot = &mut self.screened.borrow_mut();
         let reject_at = self.reject_at.get();
-        let (gamma, g_cl) =
-            match closed_loop_hinf_grad_sharing(self.plant, k, self.hinf_tol, &hint, stop, slot, reject_at) {
-                Ok((norm, _)) if norm.value >= reject_at => {
-                    // A lower bound that fails the line search's test: no gradient, no new peak.
-                    c.gamma = norm.value;
-                    c.f = norm.value.max(k_term.0);
-                    return (c, None);
+        let params = HinfParams::new(self.hinf_tol)
+            .with_hints(&hint)
+            .with_stop(stop)
+            .with_enough(reject_at)
+            .with_reuse(&self.screened);
+        let (gamma, g_cl) = match closed_loop_hinf_grad(self.plant, k, &params) {
+            Ok((norm, _)) if norm.value >= reject_at => {
+                // A lower bound that fails the line search's test: no gradient, no new peak.
+                c.gamma = norm.value;
+                c.f = norm.value.max(k_term.0);
+                return (c, None);
+            }
+            Ok((norm, g)) => {
+                if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
+                    report(thread_cpu_time() - t0);
                 }
-                Ok((norm, g)) => {
-                    if let (Some(t0), Some(report)) = (cpu0, &self.on_eval_cpu) {
-                        report(thread_cpu_time() - t0);
+                if norm.value.is_finite() {
+                    let last = self.peak_hint.replace(norm.peak_freq);
+                    if other_peak(last, norm.peak_freq) {
+                        self.other_peak.set(last);
                     }
-                    if norm.value.is_finite() {
-                        let last = self.peak_hint.replace(norm.peak_freq);
-                        if other_peak(last, norm.peak_freq) {
-                            self.other_peak.set(last);
-                        }
-                    }
-                    (norm.value, Some(g))
                 }
-                Err(LtiError::Interrupted(_)) => {
-                    // Abandoned: no value (module docs).
-                    self.abandoned.set(true);
-                    c.f = f64::NAN;
-                    c.k_hinf = f64::NAN;
-                    return (c, None);
-                }
-                Err(_) => (f64::INFINITY, None),
-            };
+                (norm.value, Some(g))
+            }
+            Err(LtiError::Interrupted(_)) => {
+                // Abandoned: no value (module docs).
+                self.abandoned.set(true);
+                c.f = f64::NAN;
+                c.k_hinf = f64::NAN;
+                return (c, None);
+            }
+            Err(_) => (f64::INFINITY, None),
+        };
         c.gamma = gamma;
         if !gamma.is_finite() {
             c.f = f64::INFINITY;
@@ -341,7 +344,7 @@ impl<'p> DesignObjective<'p> {
 
 impl DesignObjective<'_> {
     /// [`Objective::eval`], with the closed-loop norm stopping once it reaches `reject_at`
-    /// (`lti::closed_loop_hinf_grad_sharing`): a value f ≥ `reject_at` may then be a lower bound,
+    /// (`lti::HinfParams::enough`): a value f ≥ `reject_at` may then be a lower bound,
     /// comes with a NaN gradient and is not cached (the line search only needs to know that f
     /// fails its test there).
     fn eval_unless(&mut self, x: &[f64], g: &mut [f64], reject_at: f64) -> f64 {
@@ -382,7 +385,7 @@ impl DesignObjective<'_> {
                 &cl,
                 &[self.peak_hint.get(), self.other_peak.get()],
                 threshold,
-                &mut self.screened.borrow_mut(),
+                &self.screened,
             )),
             Err(_) => f64::INFINITY,
         }

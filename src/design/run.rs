@@ -8,8 +8,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_interruptible, is_stable,
-    spectral_abscissa, Controller, Interrupt, Plant,
+    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles, is_stable, spectral_abscissa,
+    Controller, HinfParams, Interrupt, Plant,
 };
 use crate::optim::RunControl;
 
@@ -148,7 +148,8 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
             Some(poles) => {
                 let a = abscissa_of(&poles);
                 let g = if is_stable(a) && cl.is_finite() {
-                    hinf_norm_with_poles_interruptible(&cl, &poles, opts.hinf_tol, stop).map_or(f64::NAN, |h| h.value)
+                    hinf_norm_with_poles(&cl, &poles, &HinfParams::new(opts.hinf_tol).with_stop(stop))
+                        .map_or(f64::NAN, |h| h.value)
                 } else {
                     f64::INFINITY
                 };

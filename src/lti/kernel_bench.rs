@@ -1,16 +1,17 @@
-//! Entry points of the per-call microbenchmarks of `benches/lti.rs` (issue 13): `--qr`, the
+//! Entry points of the per-call microbenchmarks of `benches/lti.rs`: `--qr`, the
 //! matrices the H∞ norm hands to the Hessenberg QR (the closed loop's Hessenberg form, the
 //! square-reduced method's W) and the QR itself; `--pvl`, the PVL reduction; `--record` and
 //! `--replay`, the H∞ norms of a design run replayed on their recorded closed loops. Not a stable
-//! API.
+//! API: built only with the `test-support` feature (`cargo bench --bench lti --features
+//! test-support`).
 
 use std::cell::RefCell;
 
 use faer::{c64, MatRef};
 
-use super::freq_response;
-use super::hessenberg_qr::hessenberg_eigenvalues;
-use super::square_reduced::{self, hamiltonian_squared_w};
+use super::kernels::freq_response;
+use super::kernels::hessenberg_qr::hessenberg_eigenvalues;
+use super::kernels::square_reduced::{self, hamiltonian_squared_w};
 use super::StateSpace;
 
 /// The eigenvalues of the n×n upper Hessenberg `h` (column-major, overwritten) as the H∞ norm

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 
 use super::render::{colour, draw_legend, msg, tick, DrawError, Figure, FONT_FAMILY};
 use crate::lti::freq_response::FreqResponse;
-use crate::lti::{closed_loop, hinf_norm, Controller, LtiError, Plant, StateSpace, DEFAULT_HINF_TOL};
+use crate::lti::{closed_loop, hinf_norm, Controller, HinfParams, LtiError, Plant, StateSpace};
 
 /// Points of the frequency grid.
 pub const GRID_POINTS: usize = 600;
@@ -45,7 +45,7 @@ impl SigmaFigure {
     pub fn new(plant: &Plant, k: &Controller, title: String) -> Result<Self, LtiError> {
         let cl = closed_loop(plant, k)?;
         let ks = StateSpace::new(k.ak.clone(), k.bk.clone(), k.ck.clone(), k.dk.clone())?;
-        let h = hinf_norm(&cl, DEFAULT_HINF_TOL);
+        let h = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set");
         let mut mags = mode_magnitudes(cl.a.as_ref());
         mags.extend(mode_magnitudes(k.ak.as_ref()));
         let (mut lo, mut hi) = mags.iter().fold((f64::INFINITY, 0f64), |(l, h), &m| (l.min(m), h.max(m)));

@@ -26,14 +26,16 @@
 use faer::linalg::solvers::Solve;
 use faer::{c64, Mat, MatRef};
 
-use super::closed_loop::ClosedLoop;
-use super::freq_response::{FreqResponse, ResponseSlot};
-use super::hessenberg_qr::HESSENBERG_QR_FROM;
-use super::hinf::{hinf_norm_keeping_response, HinfNorm};
-use super::interrupt::Interrupt;
-use super::spectral::rightmost_eigen;
-use super::step_stats::{for_order, timed, Step};
-use super::{Controller, LtiError, Plant, StateSpace};
+use super::hinf::{hinf_norm_reusing, HinfNorm, HinfParams};
+use crate::lti::error::LtiError;
+use crate::lti::kernels::freq_response::FreqResponse;
+use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
+use crate::lti::kernels::spectral::rightmost_eigen;
+use crate::lti::kernels::step_stats::{for_order, timed, Step};
+use crate::lti::system::closed_loop::ClosedLoop;
+use crate::lti::system::controller::Controller;
+use crate::lti::system::plant::Plant;
+use crate::lti::system::state_space::StateSpace;
 
 /// Gradient with respect to (Ak, Bk, Ck, Dk), same shapes as the controller.
 pub type ControllerGradient = Controller;
@@ -64,67 +66,20 @@ pub fn controller_abscissa_grad(k: &Controller) -> (f64, ControllerGradient) {
     }
 }
 
-/// ‖Tzw‖∞ (+∞ if the loop is unstable, with a NaN gradient) and its gradient.
+/// ‖Tzw‖∞ (+∞ if the loop is unstable, with a NaN gradient) and its gradient, computed as
+/// `params` ask ([`HinfParams`]: tolerance, peak hints of a nearby controller, a stop hook —
+/// `Err(LtiError::Interrupted)` once it fires —, a level at which to stop early — a value at or
+/// above `params.enough` is then an attained σmax(Tzw(iω)), a lower bound of the norm, returned
+/// with a NaN gradient —, and a [`ResponseSlot`](crate::lti::ResponseSlot) whose evaluator of this very closed loop is
+/// reused). `Err(IllPosed)` for an ill-posed loop.
 pub fn closed_loop_hinf_grad(
     plant: &Plant,
     k: &Controller,
-    tol: f64,
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_near_interruptible(plant, k, tol, &[], Interrupt::NEVER)
-}
-
-/// [`closed_loop_hinf_grad`] polling `stop` between its heavy steps (`interrupt.rs`):
-/// `Err(LtiError::Interrupted)` once it fires.
-pub fn closed_loop_hinf_grad_interruptible(
-    plant: &Plant,
-    k: &Controller,
-    tol: f64,
-    stop: Interrupt<'_>,
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_near_interruptible(plant, k, tol, &[], stop)
-}
-
-/// [`closed_loop_hinf_grad`] with the norm warm-started at `hints` (see
-/// [`hinf_norm_near`](super::hinf_norm_near)): the peak frequencies of a nearby controller.
-pub fn closed_loop_hinf_grad_near(
-    plant: &Plant,
-    k: &Controller,
-    tol: f64,
-    hints: &[f64],
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_near_interruptible(plant, k, tol, hints, Interrupt::NEVER)
-}
-
-/// [`closed_loop_hinf_grad_near`] and [`closed_loop_hinf_grad_interruptible`] in one.
-pub fn closed_loop_hinf_grad_near_interruptible(
-    plant: &Plant,
-    k: &Controller,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
-) -> Result<(HinfNorm, ControllerGradient), LtiError> {
-    closed_loop_hinf_grad_sharing(plant, k, tol, hints, stop, &mut ResponseSlot::default(), f64::INFINITY)
-}
-
-/// [`closed_loop_hinf_grad_near_interruptible`] taking the closed loop's frequency-response
-/// evaluator from `slot` if it holds that of this very closed loop (left there by
-/// [`hinf_lower_bound_sharing`](super::hinf_lower_bound_sharing); the same result, one Hessenberg
-/// reduction fewer), and stopping as soon as ‖Tzw‖∞ is known to reach `enough` (+∞: never): a
-/// value at or above `enough` is then an attained σmax(Tzw(iω)) (a lower bound of the norm),
-/// returned with a NaN gradient, as for an unstable loop. For the line search's exact rejection of
-/// trial points (`design::objective`); below `enough` the result does not depend on it.
-pub fn closed_loop_hinf_grad_sharing(
-    plant: &Plant,
-    k: &Controller,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
-    slot: &mut ResponseSlot,
-    enough: f64,
+    params: &HinfParams<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let kept = slot.take_for(&cl.sys);
-    Ok(match hinf_with_vectors(&cl.sys, tol, hints, stop, kept, enough)? {
+    let kept = params.reuse.and_then(|slot| slot.take_for(&cl.sys));
+    Ok(match hinf_with_vectors(&cl.sys, params, kept)? {
         Some((norm, Some(pv))) => (norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))),
         Some((norm, None)) => (norm, nan_like(k)),
         None => (HinfNorm::UNSTABLE, nan_like(k)),
@@ -134,7 +89,7 @@ pub fn closed_loop_hinf_grad_sharing(
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Ok(Some((norm, Some(pv)))) = hinf_with_vectors(&sys, tol, &[], Interrupt::NEVER, None, f64::INFINITY) else {
+    let Ok(Some((norm, Some(pv)))) = hinf_with_vectors(&sys, &HinfParams::new(tol), None) else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
@@ -159,28 +114,26 @@ pub(crate) struct PeakVectors {
     pub b: Vec<c64>,
 }
 
-/// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `stop` fires.
-/// `kept`: the evaluator of `sys` if one was made already. A value at or above `enough` comes
-/// without vectors (`hinf_norm_keeping_response`: it may be a lower bound of the norm).
+/// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `params.stop`
+/// fires. `kept`: the evaluator of `sys` if one was made already. A value at or above
+/// `params.enough` comes without vectors (`hinf_norm_reusing`: it may be a lower bound of the
+/// norm).
 pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
+    params: &HinfParams<'_>,
     kept: Option<FreqResponse>,
-    enough: f64,
 ) -> Result<Option<(HinfNorm, Option<PeakVectors>)>, LtiError> {
     if !sys.is_finite() {
         return Ok(None);
     }
-    let (norm, fr) = hinf_norm_keeping_response(sys, tol, hints, stop, kept, enough)?;
+    let (norm, fr) = hinf_norm_reusing(sys, params, kept)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }
-    if norm.value >= enough {
+    if norm.value >= params.enough {
         return Ok(Some((norm, None)));
     }
-    stop.poll()?;
+    params.stop.poll()?;
     let w = norm.peak_freq;
     let vectors = || match fr {
         Some(mut fr) if sys.order() >= HESSENBERG_QR_FROM && w.is_finite() && sys.inputs().min(sys.outputs()) > 0 => {
@@ -193,7 +146,7 @@ pub(crate) fn hinf_with_vectors(
 
 /// u, v, a, b at the finite frequency w (module docs) through the Hessenberg form of `fr`
 /// (`FreqResponse::transfer_vectors`: O(n²) where [`peak_vectors`]' dense LU is O(n³)); `None`
-/// if the SVD fails or iωI − A is singular. From order [`HESSENBERG_QR_FROM`] on (issue 13: the
+/// if the SVD fails or iωI − A is singular. From order [`HESSENBERG_QR_FROM`] on (measured: the
 /// dense LU was 2–3 % of a BDT2 or CM4 design run).
 fn peak_vectors_hessenberg(fr: &mut FreqResponse, w: f64) -> Option<PeakVectors> {
     let (u, v) = leading_singular_pair(fr.eval(w))?;

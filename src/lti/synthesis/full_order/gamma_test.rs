@@ -27,8 +27,8 @@ use faer::Mat;
 
 use super::linalg::{concat_cols, concat_rows, feedthrough_bound, solve, sym_eig};
 use super::{Binding, FullOrderError};
-use crate::lti::plant::Plant;
-use crate::lti::riccati::solve_care;
+use crate::lti::kernels::riccati::solve_care;
+use crate::lti::system::plant::Plant;
 
 /// X ⪰ 0 test: λmin(X) ≥ −(PSD_RTOL·max|λ(X)| + PSD_ATOL).
 pub(crate) const PSD_RTOL: f64 = 1e-8;

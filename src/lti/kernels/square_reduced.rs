@@ -45,8 +45,8 @@ pub(crate) struct SquaredSpectrum {
 }
 
 /// From this size n on, the reduction reflects A by merged passes ([`reflect_general`]) and keeps
-/// G and Q by their strict lower triangles ([`SkewLower`]) (issue 13: before, faer's level-2
-/// kernels on full storage); below it full storage and the hand-written loops, whose rounding the
+/// G and Q by their strict lower triangles ([`SkewLower`]) (faster at large n than the
+/// faer level-2 kernels on full storage used before); below it full storage and the hand-written loops, whose rounding the
 /// small plants' design results (the smoke campaign's table) were obtained with.
 const FAST_KERNELS_FROM: usize = 30;
 
@@ -82,7 +82,7 @@ pub(crate) struct LowRank<'a> {
 /// [`hamiltonian_squared_eigenvalues`]) and ‖M‖_F; `None` if not finite.
 ///
 /// M = H² = [F² + GK, FG − GFᵀ; KF − FᵀK, (F² + GK)ᵀ], with GFᵀ = (FG)ᵀ and FᵀK = (KF)ᵀ. GK, FG
-/// and KF are formed from the factors, O(n²r), so that F² is the only O(n³) product (issue 13:
+/// and KF are formed from the factors, O(n²r), so that F² is the only O(n³) product (measured:
 /// four dense products were 4 % of a CM4 design run). The balancing scales G by 2⁻ᵗ and K by 2ᵗ:
 /// GK is unchanged, FG and KF are scaled after the product (exact, a power of two).
 fn balanced_square(f: MatRef<'_, f64>, g: LowRank<'_>, k: LowRank<'_>) -> Option<([Mat<f64>; 3], f64)> {
@@ -123,6 +123,7 @@ fn symplectic_balance_exponent(g_norm: f64, k_norm: f64) -> f64 {
 /// The W (n×n upper Hessenberg, column-major) of the PVL reduction of H² for the Hamiltonian
 /// H = [F G; K −Fᵀ], as [`hamiltonian_squared_eigenvalues`] computes it (for the QR
 /// microbenchmark, `lti::kernel_bench`); `None` if not finite.
+#[cfg(feature = "test-support")]
 pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: MatRef<'_, f64>) -> Option<Vec<f64>> {
     let id = Mat::<f64>::identity(f.nrows(), f.nrows());
     let dense = |x| LowRank { left: x, right: id.as_ref() };
@@ -132,6 +133,7 @@ pub(crate) fn hamiltonian_squared_w(f: MatRef<'_, f64>, g: MatRef<'_, f64>, k: M
 
 /// The W (n×n upper Hessenberg, column-major) of the PVL reduction of [A G; Q Aᵀ], as
 /// [`skew_hamiltonian_eigenvalues`] computes it (for the microbenchmarks, `lti::kernel_bench`).
+#[cfg(feature = "test-support")]
 pub(crate) fn pvl_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Vec<f64> {
     skew_hamiltonian_w(a, g, q).data
 }
@@ -163,7 +165,7 @@ fn skew_hamiltonian_w(a: MatRef<'_, f64>, g: MatRef<'_, f64>, q: MatRef<'_, f64>
 fn hessenberg_part_eigenvalues(w: &mut ColMajor) -> Option<Vec<c64>> {
     let n = w.n;
     if n >= HESSENBERG_QR_FROM {
-        // W's leading block is already Hessenberg: no second reduction (issue 13).
+        // W's leading block is already Hessenberg: no second reduction (a wasted O(n³) step otherwise).
         return hessenberg_eigenvalues(&mut w.data, n).ok();
     }
     let h = Mat::from_fn(n, n, |i, j| if i <= j + 1 { w.at(i, j) } else { 0.0 });
@@ -202,7 +204,7 @@ impl ColMajor {
     }
 
     /// X ← P X P by hand-written loops, for small n ([`FAST_KERNELS_FROM`]): the same
-    /// arithmetic as before issue 13's third pass, so that small plants' results (the smoke
+    /// arithmetic as before the merged passes of [`reflect_general`], so that small plants' results (the smoke
     /// campaign's) stay bit for bit what they were.
     fn reflect_two_sided_loops(
         &mut self,
@@ -236,8 +238,8 @@ impl ColMajor {
     /// X ← P X P for P = I − β v vᵀ acting on indices r..n (v.len() = n − r). Columns before
     /// `first_col` are zero in rows r.. and are skipped on the left; rows before `first_row` are
     /// zero in columns r.. and are skipped on the right. From n = [`FAST_KERNELS_FROM`] on by
-    /// [`reflect_general`] (two merged passes, issue 13; before it, four level-2 passes through
-    /// faer's kernels), below it by [`Self::reflect_two_sided_loops`].
+    /// [`reflect_general`] (two merged passes; before it, four level-2 passes through
+    /// faer's kernels, twice the memory traffic), below it by [`Self::reflect_two_sided_loops`].
     fn reflect_two_sided(
         &mut self,
         r: usize,
@@ -302,7 +304,7 @@ impl SkewBlock for SkewLower {
     fn reflect(&mut self, r: usize, v: &[f64], beta: f64, first: usize, buf: &mut [f64]) {
         self.reflect_two_sided(r, v, beta, first, buf)
     }
-    /// [`rotate_by_entries`] in one pass without work arrays (issue 13: its reads through `at`
+    /// [`rotate_by_entries`] in one pass without work arrays (measured: its reads through `at`
     /// were ~5 % of a BDT2 design run's norms). G(k, r) = −G(r, k) and Q(k, r) = −Q(r, k) are one
     /// stored entry each, and the two formulas that set it give exactly opposite values (negation
     /// and the commutativity of a sum are exact), so each is computed once: the same bits.

@@ -53,14 +53,14 @@
 //! still not that accurate (clusters of a narrow low-frequency peak, or noise): with such
 //! *doubtful* eigenvalues the squared spectrum gives no verdict and the pencil decides at that γ
 //! — except for the pair of μ that the local peak just below γ puts near −ω_p², which is expected
-//! (docs/ALGORITHMS.md §5.3, issue 13).
+//! (docs/ALGORITHMS.md §5.3).
 //!
 //! # Ill-conditioned γ²I − DᵀD (γ barely above σmax(D))
 //! R⁻¹ and S⁻¹ are applied through the SVD of D, exactly. But when κ = γ²/(γ² − σmax(D)²) is
 //! large (the peak is at or near ω = ∞, or a flat response peaks just above σmax(D), as converged
 //! designs often do), H has entries of size κ and the squared eigenvalues errors of size ε‖H‖²:
 //! at κ ≈ 1e6 the crossings of a real peak were lost and the norm came out 3.7e-6 too low
-//! (issue 13, `tests/hinf_regression.rs`). Above [`MAX_EXPLICIT_HAMILTONIAN_COND`] we therefore
+//! (a converged large-plant design, kept as `tests/hinf_regression.rs`). Above [`MAX_EXPLICIT_HAMILTONIAN_COND`] we therefore
 //! use the equivalent (2n+m+p) pencil, which needs no inverse, through a shift-and-invert
 //! transformation to a standard 2n×2n eigenproblem (`level_set_pencil.rs`, where the pencil and
 //! its imaginary-axis test are documented).
@@ -78,14 +78,14 @@
 
 use faer::{c64, Mat};
 
-use super::freq_response::{FreqResponse, ResponseSlot};
-use super::hessenberg_qr::HESSENBERG_QR_FROM;
-use super::interrupt::{Interrupt, Interrupted};
-use super::level_set_pencil::pencil_crossings;
-use super::spectral::eigenvalues;
-use super::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
-use super::step_stats::{count, for_order, timed, Step};
-use super::StateSpace;
+use crate::lti::interrupt::{Interrupt, Interrupted};
+use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
+use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
+use crate::lti::kernels::level_set_pencil::pencil_crossings;
+use crate::lti::kernels::spectral::eigenvalues;
+use crate::lti::kernels::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
+use crate::lti::kernels::step_stats::{count, for_order, timed, Step};
+use crate::lti::system::state_space::StateSpace;
 
 /// Default relative tolerance of [`hinf_norm`].
 pub const DEFAULT_HINF_TOL: f64 = 1e-10;
@@ -99,10 +99,10 @@ pub const MAX_LEVEL_SET_ITERS: usize = 30;
 /// of CM4's closed loops (order 241, a flexible beam with many resonances of nearly equal
 /// height), whose peaks the level-set test then found, at the cost of a second test: with 200 and
 /// [`EXTRA_REFINED_PEAKS`], 1.32 instead of 1.48 level-set tests per norm on a recorded CM4
-/// design's closed loops, for 8 % more σmax evaluations (issue 13).
+/// design's closed loops, for 8 % more σmax evaluations.
 pub(crate) const MAX_POLE_TEST_FREQS: usize = 200;
 /// Above this κ = γ²/(γ² − σmax(D)²) the explicit Hamiltonian is replaced by the pencil. The
-/// squared method's eigenvalue errors grow like κ²: 1e6 lost a real peak (issue 13); with 1e3 the
+/// squared method's eigenvalue errors grow like κ²: 1e6 lost a real peak (`tests/hinf_regression.rs`); with 1e3 the
 /// property family of `tests/hinf_property.rs` and the SLICOT fixtures pass.
 pub const MAX_EXPLICIT_HAMILTONIAN_COND: f64 = 1e3;
 /// Absolute tolerance of the refinement in log ω. Near a peak of relative half-width ζ (the
@@ -152,80 +152,102 @@ impl HinfNorm {
     pub const UNSTABLE: HinfNorm = HinfNorm { value: f64::INFINITY, peak_freq: f64::NAN };
 }
 
-/// ‖sys‖∞ to relative tolerance `tol` (use [`DEFAULT_HINF_TOL`]); +∞ if unstable.
-pub fn hinf_norm(sys: &StateSpace, tol: f64) -> HinfNorm {
-    match hinf_norm_interruptible(sys, tol, Interrupt::NEVER) {
-        Ok(h) => h,
-        Err(Interrupted) => unreachable!("Interrupt::NEVER never fires"),
+/// How [`hinf_norm`] (and [`closed_loop_hinf_grad`](crate::lti::closed_loop_hinf_grad)) are
+/// computed: the tolerance, peak hints, a stop hook, a level to stop at and a frequency-response
+/// evaluator to reuse. [`HinfParams::default`] is the plain computation at [`DEFAULT_HINF_TOL`];
+/// [`HinfParams::new`] sets the tolerance, the `with_…` methods the rest.
+#[derive(Debug, Clone, Copy)]
+pub struct HinfParams<'a> {
+    /// Relative tolerance (use [`DEFAULT_HINF_TOL`]); NaN means the default, values below
+    /// [`MIN_HINF_TOL`] are raised to it.
+    pub tol: f64,
+    /// Frequencies where the peak is expected (e.g. the peak of a nearby system, as in an
+    /// optimisation). They are evaluated in addition to the mode-based test frequencies, never
+    /// instead of them: started from a hinted local peak alone, the level-set test can miss a
+    /// slightly higher peak elsewhere (its crossings at that level are a near-tangent pair) and
+    /// the norm came out up to 6.6e-4 low.
+    pub hints: &'a [f64],
+    /// Polled between the heavy steps (before the eigenvalues of A, between frequency
+    /// evaluations, before each level-set eigenproblem; `interrupt.rs`): `Err(Interrupted)` as
+    /// soon as it fires, never a partial value. [`Interrupt::NEVER`] by default.
+    pub stop: Interrupt<'a>,
+    /// Stop as soon as the norm is known to reach this level (+∞, the default: never). A value
+    /// below it is the norm; one at or above it is an attained σmax(G(iω)), a lower bound of the
+    /// norm that already reaches `enough` (the gradient then comes NaN, as for an unstable
+    /// loop). For the line search's exact rejection of trial points (`design::objective`: on
+    /// BDT2 5.6 % of trial points failed the Armijo condition only after a full norm, whose
+    /// level-set test and gradient this saves); below `enough` the result does not depend on it.
+    pub enough: f64,
+    /// A slot that may hold the frequency-response evaluator of this very system, left there
+    /// by [`hinf_lower_bound_sharing`]: taken (the slot is emptied either way) if the system is
+    /// bitwise the same, for the same result with one Hessenberg reduction fewer.
+    pub reuse: Option<&'a ResponseSlot>,
+}
+
+impl Default for HinfParams<'_> {
+    fn default() -> Self {
+        HinfParams::new(DEFAULT_HINF_TOL)
     }
 }
 
-/// [`hinf_norm`] warm-started at `hints`, frequencies where the peak is expected (e.g. the peak
-/// of a nearby system, as in an optimisation). The hints are evaluated in addition to the
-/// mode-based test frequencies, never instead of them: started from a hinted local peak alone,
-/// the level-set test can miss a slightly higher peak elsewhere (its crossings at that level are a
-/// near-tangent pair) and the norm came out up to 6.6e-4 low.
-pub fn hinf_norm_near(sys: &StateSpace, tol: f64, hints: &[f64]) -> HinfNorm {
-    match hinf_norm_near_interruptible(sys, tol, hints, Interrupt::NEVER) {
-        Ok(h) => h,
-        Err(Interrupted) => unreachable!("Interrupt::NEVER never fires"),
+impl<'a> HinfParams<'a> {
+    /// The plain computation to relative tolerance `tol`: no hints, no stop, no early level, no
+    /// evaluator to reuse.
+    pub const fn new(tol: f64) -> Self {
+        HinfParams { tol, hints: &[], stop: Interrupt::NEVER, enough: f64::INFINITY, reuse: None }
+    }
+
+    /// With the peak expected at `hints` ([`HinfParams::hints`]).
+    pub const fn with_hints(self, hints: &'a [f64]) -> Self {
+        HinfParams { hints, ..self }
+    }
+
+    /// Polling `stop` ([`HinfParams::stop`]).
+    pub const fn with_stop(self, stop: Interrupt<'a>) -> Self {
+        HinfParams { stop, ..self }
+    }
+
+    /// Stopping once the norm reaches `enough` ([`HinfParams::enough`]).
+    pub const fn with_enough(self, enough: f64) -> Self {
+        HinfParams { enough, ..self }
+    }
+
+    /// Reusing the evaluator kept in `slot` ([`HinfParams::reuse`]).
+    pub const fn with_reuse(self, slot: &'a ResponseSlot) -> Self {
+        HinfParams { reuse: Some(slot), ..self }
     }
 }
 
-/// [`hinf_norm`] polling `stop` between its heavy steps (before the eigenvalues of A, between
-/// frequency evaluations, before each level-set eigenproblem; `interrupt.rs`):
-/// `Err(Interrupted)` as soon as it fires, never a partial value.
-pub fn hinf_norm_interruptible(sys: &StateSpace, tol: f64, stop: Interrupt<'_>) -> Result<HinfNorm, Interrupted> {
-    hinf_norm_near_interruptible(sys, tol, &[], stop)
-}
-
-/// [`hinf_norm_near`] and [`hinf_norm_interruptible`] in one.
-pub fn hinf_norm_near_interruptible(
-    sys: &StateSpace,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
-) -> Result<HinfNorm, Interrupted> {
+/// ‖sys‖∞ and a frequency attaining it, as `params` ask ([`HinfParams`]); +∞ if the system is
+/// unstable or its data are not finite. `Err(Interrupted)` only if `params.stop` fired.
+pub fn hinf_norm(sys: &StateSpace, params: &HinfParams<'_>) -> Result<HinfNorm, Interrupted> {
+    let kept = params.reuse.and_then(|slot| slot.take_for(sys));
     if !sys.is_finite() {
         return Ok(HinfNorm::UNSTABLE);
     }
-    hinf_norm_of_finite(sys, tol, hints, stop, None)
+    hinf_norm_reusing(sys, params, kept).map(|(norm, _)| norm)
 }
 
-/// [`hinf_norm_near_interruptible`] for finite data, with the poles computed here: from order
+/// [`hinf_norm`] for finite data, with the poles computed here: from order
 /// [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one Hessenberg
 /// reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver (the rounding
 /// the small plants' results were obtained with). An eigensolver failure counts as unstable.
-/// `kept`: the frequency-response evaluator of `sys` if one was already made (`ResponseSlot`).
-pub(crate) fn hinf_norm_of_finite(
+/// `kept`: the frequency-response evaluator of `sys` if one was already made (`ResponseSlot`);
+/// the one used is returned with the norm (for the gradient's vectors at the peak,
+/// `gradient.rs`). `params.reuse` is not looked at here.
+pub(crate) fn hinf_norm_reusing(
     sys: &StateSpace,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
+    params: &HinfParams<'_>,
     kept: Option<FreqResponse>,
-) -> Result<HinfNorm, Interrupted> {
-    hinf_norm_keeping_response(sys, tol, hints, stop, kept, f64::INFINITY).map(|(norm, _)| norm)
-}
-
-/// [`hinf_norm_of_finite`], also returning the frequency-response evaluator of `sys` if one was
-/// made (for the gradient's vectors at the peak, `gradient.rs`), and stopping early at a level:
-/// a returned value below `enough` is the norm; one at or above it is an attained σmax(G(iω)), a
-/// lower bound of the norm that already reaches `enough` (the computation stops once it
-/// does, `hinf_norm_from`).
-pub(crate) fn hinf_norm_keeping_response(
-    sys: &StateSpace,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
-    kept: Option<FreqResponse>,
-    enough: f64,
 ) -> Result<(HinfNorm, Option<FreqResponse>), Interrupted> {
+    let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
     stop.poll()?;
     for_order(sys.order(), || {
         timed(Step::Norm, || {
             let mut fr = kept;
             let poles = if sys.order() >= HESSENBERG_QR_FROM {
-                super::kernel_bench::note_norm(sys, tol, hints);
+                #[cfg(feature = "test-support")]
+                crate::lti::kernel_bench::note_norm(sys, tol, hints);
                 fr.get_or_insert_with(|| FreqResponse::new(sys)).poles()
             } else {
                 timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
@@ -244,7 +266,7 @@ pub(crate) fn hinf_norm_keeping_response(
 /// system is +∞); +∞ if the data are not finite. One Hessenberg reduction plus O(n²m) per
 /// frequency: the cheap test behind the exact rejection of line-search trial points.
 pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
-    hinf_lower_bound_sharing(sys, freqs, f64::NEG_INFINITY, &mut ResponseSlot::default())
+    hinf_lower_bound_sharing(sys, freqs, f64::NEG_INFINITY, &ResponseSlot::default())
 }
 
 /// [`hinf_lower_bound`], then, while the bound is below `wanted`, a climb of the peak next to the
@@ -258,7 +280,7 @@ pub fn hinf_lower_bound(sys: &StateSpace, freqs: &[f64]) -> f64 {
 /// the peak has moved a little off the last peak frequency; σmax at the old frequency then stays
 /// just below the threshold, and each such point cost a full norm. A few σmax evaluations up the
 /// moved peak reject them (every value is attained, so the bound stays exact).
-pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, slot: &mut ResponseSlot) -> f64 {
+pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, slot: &ResponseSlot) -> f64 {
     if !sys.is_finite() {
         return f64::INFINITY;
     }
@@ -285,17 +307,16 @@ pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, sl
     })
 }
 
-/// [`hinf_norm_interruptible`] when the poles (eigenvalues of A) are already known (shared with
-/// the stability test). The data must be finite.
-pub(crate) fn hinf_norm_with_poles_interruptible(
+/// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
+/// test). The data must be finite; `params.reuse` is not looked at, and unlike [`hinf_norm`]
+/// `params.stop` is first polled after the stability test.
+pub(crate) fn hinf_norm_with_poles(
     sys: &StateSpace,
     poles: &[c64],
-    tol: f64,
-    stop: Interrupt<'_>,
+    params: &HinfParams<'_>,
 ) -> Result<HinfNorm, Interrupted> {
-    for_order(sys.order(), || {
-        timed(Step::Norm, || hinf_norm_from(sys, poles, &mut None, tol, &[], stop, f64::INFINITY))
-    })
+    let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
+    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, &mut None, tol, hints, stop, enough)))
 }
 
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
@@ -320,7 +341,7 @@ fn hinf_norm_from(
     if poles.iter().any(|l| !(l.re < 0.0) || !l.im.is_finite()) {
         return Ok(HinfNorm::UNSTABLE);
     }
-    let sigma_d = super::freq_response::sigma_max_c(complexify(sys.d.as_ref()).as_ref());
+    let sigma_d = crate::lti::kernels::freq_response::sigma_max_c(complexify(sys.d.as_ref()).as_ref());
     if sys.order() == 0 {
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
@@ -878,7 +899,7 @@ fn imaginary_axis_threshold(max_abs: f64) -> f64 {
 /// (`tests/hinf_property.rs`, n = 30…80) clustered small μ were off by up to 140 e and lost their
 /// crossings. Before H was balanced (`square_reduced.rs`) 500 still missed one member (seed 1491,
 /// n ≤ 60) and 1e4 was used; balanced, the families (n ≤ 60 and n ≤ 80, 1500 each) pass with 1e2
-/// and fail with 10 (seeds 951, 1112), so 1e3 (issue 13).
+/// and fail with 10 (seeds 951, 1112), so 1e3, a factor of ten from both.
 const SQUARED_DOUBT_FACTOR: f64 = 1e3;
 /// Eigenvalues at most this many times [`imaginary_axis_threshold`] off the axis are probed
 /// (`LevelSet::probes`).
@@ -903,7 +924,7 @@ const SQUARED_SMALL_MU: f64 = 1e6;
 /// ω = 0). Van Loan's method loses about half the digits of small eigenvalues (the error in λ is
 /// ≈ ε‖H‖²/|λ|, not ε‖H‖), and the two μ of a narrow peak at a low frequency form an
 /// ill-conditioned cluster: such pairs left the real axis by up to 140 e, or, below e, landed at
-/// the wrong frequency, and the norm came out up to 7 % low (issue 13, large property family;
+/// the wrong frequency, and the norm came out up to 7 % low (the large property family of `tests/hinf_property.rs`;
 /// docs/ALGORITHMS.md §5.3).
 ///
 /// *The known peak.* The test runs at γ = (1 + tol)·γ_L, just above γ_L = σmax(G(iω_p)) attained

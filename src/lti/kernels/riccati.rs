@@ -30,7 +30,7 @@
 //!
 //! Before iterating, `H` is balanced by a *symplectic* diagonal similarity `T = diag(D, D⁻¹)`
 //! (powers of two, so exact): `A → D⁻¹AD`, `G → D⁻¹GD⁻¹`, `Q → DQD`, reducing ‖H‖_F. This matters
-//! for the δ-regularised H∞ problems of [`super::full_order`], whose `G` holds entries ~ 1/δ²:
+//! for the δ-regularised H∞ problems of [`crate::lti::synthesis::full_order`], whose `G` holds entries ~ 1/δ²:
 //! unbalanced, eigenvalues close to the imaginary axis lose accuracy like √(u‖H‖). The balanced
 //! solution is `X̃ = D X D`.
 //!

@@ -24,7 +24,7 @@ use faer::Mat;
 use super::bracketing::{gamma_opt, Bracket};
 use super::gamma_test::{Channels, Problem};
 use super::{FullOrderError, FullOrderOptions};
-use crate::lti::plant::Plant;
+use crate::lti::system::plant::Plant;
 
 /// Regularisation levels tried in order (absolute), for plants with singular D12 or D21.
 pub const REGULARISATION_DELTAS: [f64; 4] = [1e-5, 1e-6, 1e-7, 1e-8];

@@ -16,7 +16,7 @@
 
 use std::fmt;
 
-use super::plant::Plant;
+use crate::lti::system::plant::Plant;
 use crate::numeric::all_finite;
 
 mod bracketing;

@@ -33,7 +33,7 @@
 //!   back by K = (D12ᵀD12)^{−1/2} K̃ (D21D21ᵀ)^{−1/2}.
 //! * **D22 ≠ 0**: K is designed for y − D22 u and realised as Ak − Bk D22 Ck (Dk = 0).
 //!
-//! γ_opt of the regularised plant is computed by [`super::full_order_gamma_with`] (relative
+//! γ_opt of the regularised plant is computed by [`super::full_order::full_order_gamma_with`] (relative
 //! bracket [`GAMMA_OPT_RTOL`]); [`CentralProblem::controller`] then builds the controller at any
 //! γ above it. Just above γ_opt the central controller has large gains (Z is nearly singular), so
 //! starts use γ = f·γ_opt with f of order 1.1–2 (`DesignOptions::central_gammas`).
@@ -42,8 +42,9 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, Side};
 
 use super::full_order::{augment, full_order_gamma_with, FullOrderError, FullOrderOptions, Regularisation};
-use super::riccati::{abscissa, solve_care};
-use super::{Controller, Plant};
+use crate::lti::kernels::riccati::{abscissa, solve_care};
+use crate::lti::system::controller::Controller;
+use crate::lti::system::plant::Plant;
 use crate::numeric::all_finite;
 
 /// Default regularisation ε (absolute) of singular D12/D21 (module docs).

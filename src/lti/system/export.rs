@@ -16,7 +16,7 @@
 
 use faer::MatRef;
 
-use super::Controller;
+use super::controller::Controller;
 
 /// Target language of [`export_code`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

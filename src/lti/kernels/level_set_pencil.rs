@@ -17,7 +17,7 @@
 //! (M − sE)⁻¹[I₂ₙ; 0]. One LU with partial pivoting of M − sE (backward stable, no ill-conditioned
 //! elimination) and one standard 2n×2n eigenvalue problem (faer): no QZ. (faer 0.24's `gevd_real`
 //! was tried first and returned β = 0 for almost every eigenvalue on singular E, i.e. lost the
-//! crossings: issue 13.)
+//! crossings.)
 //!
 //! # Eigenvalues through a skew-Hamiltonian matrix (half the size)
 //! T₁₁ = (H − sI)⁻¹ for the Hamiltonian H(γ) (the explicit one of hinf.rs, never formed), and
@@ -40,7 +40,7 @@
 //! loose on purpose, since a spurious crossing costs one evaluation of σmax(G(iω)) whereas a
 //! missed one lowers the norm. (Before this, T₁₁'s 2n eigenvalues θ = 1/(λ − s) came from faer's
 //! dense solver and were tested against the image circle of the axis, at 4× the cost of the
-//! reduction: issue 13.)
+//! reduction.)
 //!
 //! The shift is chosen among the system's frequency scale times a few factors; a shift too close
 //! to an eigenvalue of the pencil shows as a large ‖T₁₁‖·‖M − sE‖ and the next one is tried.
@@ -50,7 +50,7 @@ use faer::{Mat, MatRef};
 
 use super::square_reduced::skew_hamiltonian_eigenvalues;
 use super::step_stats::{timed, Step};
-use super::StateSpace;
+use crate::lti::system::state_space::StateSpace;
 
 /// Distance to the image [−2/s, 0] of the imaginary axis accepted as a crossing, in units of
 /// √ε·‖W‖_F.
@@ -68,7 +68,7 @@ const SHIFT_FACTORS: [f64; 4] = [1.0, 3.7, 0.23, 17.0];
 /// crossings can be computed gives the result. If none is, the first ill-conditioned one (with
 /// finite T₁₁) whose crossings can be computed does. The crossings of an ill-conditioned shift are
 /// only computed when every shift has failed, and from order [`SCREEN_SHIFTS_FROM`] on a shift that
-/// [`shifted_inverse`] can reject from a lower bound of ‖T₁₁‖ is not even solved for in full (issue 13: on CM4's converged designs
+/// [`shifted_inverse`] can reject from a lower bound of ‖T₁₁‖ is not even solved for in full (measured on CM4's converged designs:
 /// the first shift failed in two tests of three, and each failure cost a full solve plus a PVL
 /// reduction and QR for a fallback that was then not used). The result is the same as computing
 /// every tried shift in full.
@@ -182,7 +182,7 @@ fn shifted_inverse(sys: &StateSpace, gamma: f64, s: f64, solve: Elimination) -> 
 const MAX_BLOCK_GROWTH: f64 = 10.0;
 
 /// T₁₁ by block elimination of the pencil's (m+p) rows and columns (from order
-/// [`SCREEN_SHIFTS_FROM`] on, issue 13): with M − sE = [P B̂; Ĉ R], P = diag(A − sI, −Aᵀ − sI),
+/// [`SCREEN_SHIFTS_FROM`] on, where it is cheaper than the full solve): with M − sE = [P B̂; Ĉ R], P = diag(A − sI, −Aᵀ − sI),
 /// B̂ = diag(B, −Cᵀ), Ĉ = diag(C, Bᵀ) and R the (m+p) block of the module docs,
 /// ```text
 /// T₁₁ = P⁻¹ + P⁻¹B̂ S⁻¹ ĈP⁻¹,   S = R − ĈP⁻¹B̂ = [D − C(A − sI)⁻¹B, −γI; −γI, Dᵀ − Bᵀ(A + sI)⁻ᵀCᵀ],
@@ -305,7 +305,7 @@ fn cayley_crossings(t: MatRef<'_, f64>, s: f64) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lti::freq_response::FreqResponse;
+    use crate::lti::kernels::freq_response::FreqResponse;
     use faer::linalg::solvers::DenseSolveCore;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -343,7 +343,7 @@ mod tests {
             panic!("no inverse")
         };
         let h = t.partial_piv_lu().inverse() + Mat::<f64>::identity(2 * n, 2 * n) * faer::Scale(1.3);
-        let ev = crate::lti::spectral::eigenvalues(h.as_ref()).unwrap();
+        let ev = crate::lti::kernels::spectral::eigenvalues(h.as_ref()).unwrap();
         let real = ev.iter().filter(|l| l.im == 0.0 && l.re > 0.0).map(|l| l.re).next().expect("a real eigenvalue");
         for (s, expect_rejected) in [(real, true), (1.3, false), (0.7 * real, false)] {
             let mat = shifted_pencil(&sys, gamma, s);

@@ -6,7 +6,7 @@
 //! *General block.* P X P is formed as the left update X(r.., :) ← P X(r.., :) followed by the
 //! right update X(:, r..) ← X(:, r..) P, in that order (no fused formula with the scalar vᵀXv: on
 //! badly scaled X its rounding spread over the block and lost a crossing of the SLICOT fixture
-//! `scaled_random_1`, issue 13). But the passes are merged: each column is reflected from the
+//! `scaled_random_1`). But the passes are merged: each column is reflected from the
 //! left and, while it is in cache, added into z = X(:, r..) v; a second pass subtracts β z vᵀ.
 //! Two passes over the matrix instead of four.
 //!

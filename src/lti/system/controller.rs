@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use faer::Mat;
 use serde_json::{Map, Value};
 
-use super::mat_file::{is_mat_path, read_mat_vars, var_to_json, write_mat, MatReadError};
-use super::matrix_json::{json_shape, json_type, matrix_from_json, matrix_to_json, MatrixJsonError};
+use crate::lti::io::mat_file::{is_mat_path, read_mat_vars, var_to_json, write_mat, MatReadError};
+use crate::lti::io::matrix_json::{json_shape, json_type, matrix_from_json, matrix_to_json, MatrixJsonError};
 
 /// Controller matrices (Ak, Bk, Ck, Dk).
 #[derive(Debug, Clone, PartialEq)]
@@ -120,7 +120,7 @@ impl Controller {
 
     /// Number of the controller's inputs: the plant's measurements y, p of them (columns of Dk).
     ///
-    /// Named from the controller's own point of view, like [`super::StateSpace::inputs`]: the
+    /// Named from the controller's own point of view, like [`super::state_space::StateSpace::inputs`]: the
     /// controller's inputs are the plant's outputs y and vice versa (u = K y).
     pub fn inputs(&self) -> usize {
         self.dk.ncols()
@@ -218,7 +218,7 @@ impl Controller {
     /// and its inputs the plant's p2 measurements (Dk is m2 × p2), and its four blocks agree on
     /// the order nk (Ak nk × nk, Bk nk × p2, Ck m2 × nk): the fields are public, so a controller
     /// need not come from a checked file.
-    pub fn check_fits(&self, plant: &super::Plant) -> Result<(), ControllerErrorKind> {
+    pub fn check_fits(&self, plant: &super::plant::Plant) -> Result<(), ControllerErrorKind> {
         let (m, p, nk) = (plant.dims.m2, plant.dims.p2, self.order());
         let blocks = [("AK", &self.ak, (nk, nk)), ("BK", &self.bk, (nk, p)), ("CK", &self.ck, (m, nk))];
         let mismatch = |problem| Err(ControllerErrorKind::Mismatch { plant: plant.name.clone(), problem });
@@ -235,7 +235,7 @@ impl Controller {
 
     /// [`Self::check_fits`], and the order is `order` (a journal record's controller must be of
     /// its job's order).
-    pub fn check_fits_order(&self, plant: &super::Plant, order: usize) -> Result<(), ControllerErrorKind> {
+    pub fn check_fits_order(&self, plant: &super::plant::Plant, order: usize) -> Result<(), ControllerErrorKind> {
         self.check_fits(plant)?;
         if self.order() != order {
             return Err(ControllerErrorKind::Mismatch {
@@ -293,7 +293,7 @@ mod tests {
 
     #[test]
     fn flat_dk_is_named_as_such() {
-        // issue 15: `DK: [1.0, 2.0]` was reported as "has 0 rows".
+        // a flat list `DK: [1.0, 2.0]` was once reported as "has 0 rows", which misled.
         let e =
             Controller::from_json_str(r#"{"AK": [], "BK": [], "CK": [[]], "DK": [1.0, 2.0]}"#, "k.json").unwrap_err();
         let s = e.to_string();

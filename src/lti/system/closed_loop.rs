@@ -34,7 +34,10 @@
 use faer::linalg::solvers::DenseSolveCore;
 use faer::{c64, Mat, MatRef};
 
-use super::{Controller, LtiError, Plant, StateSpace};
+use super::controller::Controller;
+use super::plant::Plant;
+use super::state_space::StateSpace;
+use crate::lti::error::LtiError;
 
 /// Largest acceptable 2-norm condition number of F = I − Dk·D22; beyond it the loop is treated as
 /// ill-posed. At 1e12 the closed-loop matrices still carry about 4 correct digits.

@@ -2,7 +2,7 @@
 //!
 //! # Stable systems (Moore 1981; square-root form: Tombs–Postlethwaite 1987, Laub et al. 1987)
 //!
-//! The Gramians `A P + P Aᵀ + B Bᵀ = 0`, `Aᵀ Q + Q A + Cᵀ C = 0` ([`super::lyapunov`]) are factored
+//! The Gramians `A P + P Aᵀ + B Bᵀ = 0`, `Aᵀ Q + Q A + Cᵀ C = 0` ([`crate::lti::kernels::lyapunov`]) are factored
 //! as P = L_c L_cᵀ, Q = L_o L_oᵀ (symmetric eigen-decompositions: semidefinite Gramians are fine).
 //! With the SVD `L_oᵀ L_c = U Σ Vᵀ` (Σ = the Hankel singular values σ₁ ≥ σ₂ ≥ …) and, for order r,
 //!
@@ -17,7 +17,7 @@
 //!
 //! # Unstable systems (as MATLAB `balred` and Safonov–Chiang–Limebeer 1987 do)
 //!
-//! G = G_s + G_u by the stable/antistable splitting of [`super::lyapunov::stable_antistable_basis`];
+//! G = G_s + G_u by the stable/antistable splitting of [`crate::lti::kernels::lyapunov::stable_antistable_basis`];
 //! the antistable part (n_u states) is kept exactly and the stable part is truncated to order
 //! r − n_u. If n_u > r there is no such reduction ([`ReductionError::TooManyUnstable`]).
 //! Eigenvalues on (numerically) the imaginary axis are refused.
@@ -25,8 +25,8 @@
 use faer::linalg::solvers::DenseSolveCore;
 use faer::{Mat, MatRef, Side};
 
-use super::lyapunov::{solve_lyapunov, stable_antistable_basis, LyapunovError};
-use super::StateSpace;
+use crate::lti::kernels::lyapunov::{solve_lyapunov, stable_antistable_basis, LyapunovError};
+use crate::lti::system::state_space::StateSpace;
 
 /// Hankel singular values below this times the largest are treated as zero.
 pub const HSV_RTOL: f64 = 1e-12;
@@ -165,7 +165,7 @@ pub fn coprime_factor_truncation(sys: &StateSpace, order: usize) -> Result<Reduc
         return Ok(Reduced { sys: sys.clone(), hsv: Vec::new(), n_unstable: 0 });
     }
     let (m, p) = (sys.b.ncols(), sys.c.nrows());
-    let z = super::solve_care(
+    let z = crate::lti::kernels::riccati::solve_care(
         sys.a.transpose(),
         (sys.c.transpose() * &sys.c).as_ref(),
         (&sys.b * sys.b.transpose()).as_ref(),
@@ -206,7 +206,7 @@ pub fn dc_gain(sys: &StateSpace) -> Option<Mat<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lti::hinf_norm;
+    use crate::lti::{hinf_norm, HinfParams};
 
     fn diag_sys(poles: &[f64], b: &[f64], c: &[f64]) -> StateSpace {
         let n = poles.len();
@@ -243,7 +243,7 @@ mod tests {
                 c: Mat::from_fn(1, 4 + r, |_, j| if j < 4 { s.c[(0, j)] } else { -red.sys.c[(0, j - 4)] }),
                 d: Mat::zeros(1, 1),
             };
-            let e = hinf_norm(&err, 1e-10).value;
+            let e = hinf_norm(&err, &HinfParams::new(1e-10)).unwrap().value;
             let tail: f64 = h[r..].iter().sum();
             assert!(e <= 2.0 * tail * (1.0 + 1e-8), "r = {r}: error {e} > 2·tail {}", 2.0 * tail);
             assert!(e >= h[r] * (1.0 - 1e-8), "r = {r}: error {e} below σ_(r+1) {}", h[r]);

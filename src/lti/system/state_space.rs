@@ -2,7 +2,7 @@
 
 use faer::Mat;
 
-use super::LtiError;
+use crate::lti::error::LtiError;
 use crate::numeric::all_finite;
 
 /// Real state-space realisation (A, B, C, D): A n×n, B n×m, C p×n, D p×m.

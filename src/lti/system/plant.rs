@@ -25,8 +25,10 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
-use super::mat_file::{json_number, read_char_var, read_mat_vars, var_to_json, write_mat, MatReadError, MatVar};
-use super::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
+use crate::lti::io::mat_file::{
+    json_number, read_char_var, read_mat_vars, var_to_json, write_mat, MatReadError, MatVar,
+};
+use crate::lti::io::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
 
 /// Sizes of a generalised plant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -208,7 +210,7 @@ impl Plant {
     /// goes through the same checks.
     pub fn load(path: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let path = path.as_ref();
-        if super::mat_file::is_mat_path(path) {
+        if crate::lti::io::mat_file::is_mat_path(path) {
             let err = |kind| PlantError { file: path.to_path_buf(), kind };
             let bytes = crate::input::read_capped(path, crate::input::MAX_PLANT_BYTES, "plant file")
                 .map_err(|e| err(PlantErrorKind::Io(e)))?;
@@ -303,7 +305,7 @@ impl Plant {
 
     /// The plant as a JSON document in the file format (provenance kept).
     pub fn to_json(&self) -> Value {
-        use super::matrix_json::matrix_to_json;
+        use crate::lti::io::matrix_json::matrix_to_json;
         let mut o = serde_json::Map::new();
         o.insert("name".into(), self.name.clone().into());
         o.insert("description".into(), self.description.clone().into());

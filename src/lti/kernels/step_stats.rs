@@ -1,4 +1,4 @@
-//! Per-thread counters of the H∞ computation's steps (issue 13), for the benches: how many
+//! Per-thread counters of the H∞ computation's steps, for the benches (`benches/lti.rs --steps`): how many
 //! evaluations take the explicit-Hamiltonian path or the pencil path, how many level-set
 //! eigenproblems each needs, and, when timing is switched on, the thread-CPU time of each step.
 //!

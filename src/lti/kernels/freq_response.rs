@@ -6,9 +6,11 @@
 //! pivoting (backward stable, as for any GEPP on a Hessenberg matrix). This is the classical
 //! Laub (1981) approach and what makes the many test frequencies of the level-set method cheap.
 //! From order [`HESSENBERG_QR_FROM`] on the solve runs on split real and imaginary parts
-//! (`hessenberg_solve.rs`: the elimination and the back substitution vectorise; issue 13). It
+//! (`hessenberg_solve.rs`: the elimination and the back substitution vectorise). It
 //! is the same elimination as the interleaved solve used below that order, with the back
 //! substitution's sums reassociated, so the two agree to rounding, not bit for bit.
+
+use std::cell::Cell;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg;
@@ -18,7 +20,7 @@ use faer::{c64, Conj, Mat, MatRef, Par};
 use super::hessenberg_qr::{hessenberg_eigenvalues, HESSENBERG_QR_FROM};
 use super::hessenberg_solve::ShiftedHessenbergSolve;
 use super::step_stats::{timed, Step};
-use super::StateSpace;
+use crate::lti::system::state_space::StateSpace;
 
 /// G(iω) evaluator for one system (reusable buffers).
 pub(crate) struct FreqResponse {
@@ -134,7 +136,7 @@ impl FreqResponse {
     /// The eigenvalues of A (the poles), from the Hessenberg form H by our Francis QR
     /// (`hessenberg_qr.rs`). H is an orthogonal similarity of A by the same backward-stable
     /// reduction that faer's eigensolver starts with, so they are as accurate as faer's, for one
-    /// Hessenberg reduction instead of two when the response is needed anyway (issue 13). `None`
+    /// Hessenberg reduction instead of two when the response is needed anyway. `None`
     /// if the QR does not converge.
     pub(crate) fn poles(&self) -> Option<Vec<c64>> {
         timed(Step::Poles, || self.poles_uncounted())
@@ -330,25 +332,33 @@ fn split_solution((xr, xi): (&[f64], &[f64]), n: usize, conj: bool) -> Option<Ve
 }
 
 /// One frequency-response evaluator kept for the next H∞ computation on the same system: the
-/// line-search screen ([`hinf_lower_bound_sharing`](super::hinf::hinf_lower_bound_sharing)) leaves
+/// line-search screen ([`hinf_lower_bound_sharing`](crate::lti::hinf_lower_bound_sharing)) leaves
 /// the closed loop's Hessenberg form here, and the norm of a trial that passes the screen
-/// ([`closed_loop_hinf_grad_sharing`](super::closed_loop_hinf_grad_sharing)) takes it instead of
-/// reducing A again (issue 13). Taken only for a bitwise identical system, and the evaluator's
-/// buffers are overwritten before they are read, so the results are exactly those of a fresh one.
+/// ([`closed_loop_hinf_grad`](crate::lti::closed_loop_hinf_grad) with
+/// [`HinfParams::reuse`](crate::lti::HinfParams::reuse)) takes it instead of reducing A again
+/// (the reduction is one of the largest steps of a norm at large order). Taken only for a bitwise
+/// identical system, and the evaluator's buffers are overwritten before they are read, so the
+/// results are exactly those of a fresh one.
 #[derive(Default)]
 pub struct ResponseSlot {
-    kept: Option<(StateSpace, FreqResponse)>,
+    kept: Cell<Option<(StateSpace, FreqResponse)>>,
 }
 
 impl ResponseSlot {
     /// The evaluator of `sys` if one is kept (and empties the slot either way).
-    pub(crate) fn take_for(&mut self, sys: &StateSpace) -> Option<FreqResponse> {
+    pub(crate) fn take_for(&self, sys: &StateSpace) -> Option<FreqResponse> {
         self.kept.take().filter(|(kept, _)| same_bits(kept, sys)).map(|(_, fr)| fr)
     }
 
     /// Keeps the evaluator `fr` of `sys`.
-    pub(crate) fn keep(&mut self, sys: &StateSpace, fr: FreqResponse) {
-        self.kept = Some((sys.clone(), fr));
+    pub(crate) fn keep(&self, sys: &StateSpace, fr: FreqResponse) {
+        self.kept.set(Some((sys.clone(), fr)));
+    }
+}
+
+impl std::fmt::Debug for ResponseSlot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ResponseSlot")
     }
 }
 
