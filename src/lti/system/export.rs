@@ -1,6 +1,6 @@
 //! A controller as ready-to-paste MATLAB or python-control code.
 //!
-//! Sign convention (algorithm.md §1): the controller is **positive feedback**, u = K y:
+//! Sign convention (docs/ALGORITHMS.md §1–2): the controller is **positive feedback**, u = K y:
 //!
 //! ```text
 //! xk' = AK xk + BK y,   u = CK xk + DK y
