@@ -160,6 +160,11 @@ fn any_value<T>(_: &T) -> Result<(), String> {
 }
 
 /// `Ok` when `ok`, else the message.
+/// The check of an optional count limit (`maxevals`, `max_starts`): absent, or at least 1.
+fn optional_limit(v: &Option<usize>) -> Result<(), String> {
+    require(*v != Some(0), || "must be at least 1 (omit it for no limit)".into())
+}
+
 fn require(ok: bool, problem: impl FnOnce() -> String) -> Result<(), String> {
     if ok {
         Ok(())
@@ -307,9 +312,7 @@ macro_rules! design_option_table {
             maxevals: Option<usize> = None,
                 key layered, flag "--maxevals",
                 accepts "≥ 1",
-                check |v: &Option<usize>| require(*v != Some(0), || {
-                    "must be at least 1 (omit it for no limit)".into()
-                }),
+                check optional_limit,
                 doc "objective evaluations per job (deterministic)";
             /// Number of random starting points (HIFOO `nrand`, default 3), or of perturbations of an
             /// initial controller. These starts are always made (unless a budget ends the run first).
@@ -408,9 +411,7 @@ macro_rules! design_option_table {
             max_starts: Option<usize> = None,
                 key layered, flag "--max-starts",
                 accepts "≥ 1",
-                check |v: &Option<usize>| require(*v != Some(0), || {
-                    "must be at least 1 (omit it for no limit)".into()
-                }),
+                check optional_limit,
                 doc "local searches per job, first starts included (deterministic)";
             /// Relative sizes r of the basin-hopping perturbations x* + ξ ∘ (‖x*‖·r), ξ ~ N(0, I), of the
             /// best point x* (the same form as the perturbations of an initial controller). The
