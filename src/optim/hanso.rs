@@ -24,7 +24,6 @@ use super::options::HansoOptions;
 use super::solver::OptimResult;
 use super::termination::Termination;
 use rand::RngCore;
-use rand_distr::{Distribution, StandardNormal};
 
 /// Result of [`hanso`].
 #[derive(Debug, Clone, PartialEq)]
@@ -39,11 +38,6 @@ pub struct HansoResult {
     pub best_start: usize,
     /// Objective evaluations made by the whole call.
     pub evals: usize,
-}
-
-/// `count` standard-normal starting points in ℝ^nvar (HANSO's default x0 = randn(nvar, count)).
-pub fn random_starts(nvar: usize, count: usize, rng: &mut dyn RngCore) -> Vec<Vec<f64>> {
-    (0..count).map(|_| (0..nvar).map(|_| StandardNormal.sample(&mut *rng)).collect()).collect()
 }
 
 /// HANSO-style driver: BFGS from every start (shared budget; a start whose f is not finite is

@@ -9,7 +9,10 @@
 //!   gradients at nearby iterates‖ and evaldist = the largest distance to those iterates.
 //! * [`gradient_sampling`]: Algorithm GS of Burke, Curtis, Lewis, Overton & Simões (2020),
 //!   "Gradient sampling methods for nonsmooth optimization" (HANSO 3.0's variant).
-//! * [`hanso`]: BFGS from several starts with a shared budget, then gradient sampling.
+//! * `hanso` (feature `test-support`: the design makes its own sequence of starts,
+//!   `design::search`): BFGS from several starts with a shared budget, then gradient sampling;
+//!   the optimiser's tests and `benches/optim.rs` use it.
+//! * [`random_starts`]: standard-normal starting points.
 //! * [`min_norm_in_hull`]: the simplex QP behind both certificates.
 //!
 //! Structure (docs/ALGORITHMS.md §7.5): each solver has a state and a `step` (mathematics only); one driver
@@ -23,6 +26,7 @@ mod bundle;
 mod control;
 mod error;
 mod gradsamp;
+#[cfg(any(test, feature = "test-support"))]
 mod hanso;
 mod linesearch;
 mod objective;
@@ -30,6 +34,7 @@ mod observer;
 mod options;
 mod qp;
 mod solver;
+mod starts;
 mod termination;
 #[cfg(any(test, feature = "test-support"))]
 pub mod test_problems;
@@ -38,12 +43,14 @@ pub use bfgs::{bfgs, BfgsState};
 pub use control::{thread_cpu_time, RunControl};
 pub use error::OptimError;
 pub use gradsamp::{gradient_sampling, GradSampState, GS_MAX_CONTRACT, GS_MIN_STEP_REL};
-pub use hanso::{hanso, random_starts, HansoResult};
+#[cfg(any(test, feature = "test-support"))]
+pub use hanso::{hanso, HansoResult};
 pub use objective::{FnObjective, Objective};
 pub use observer::{FnObserver, IterRecord, NoObserver, Observer, SolverKind};
 pub use options::{BfgsOptions, GradSampOptions, HansoOptions, NGRAD_CAP};
 pub use qp::{min_norm_clarabel, min_norm_dense, min_norm_in_hull, MinNormResult, QpMethod};
 pub use solver::OptimResult;
+pub use starts::random_starts;
 pub use termination::Termination;
 
 #[cfg(test)]

@@ -134,7 +134,7 @@ pub struct GradSampOptions {
     pub maxit: usize,
     /// Stop as soon as f < fvalquit. Default −∞.
     pub fvalquit: f64,
-    /// In [`hanso`](super::hanso), run gradient sampling only when the best BFGS point is not
+    /// In `hanso` (feature `test-support`), run gradient sampling only when the best BFGS point is not
     /// certified (dnorm > normtol), as HANSO 2.0 (which HIFOO 3.5 shipped with) did.
     /// Default true. Ignored by [`gradient_sampling`](super::gradient_sampling) itself.
     pub only_if_uncertified: bool,
@@ -194,7 +194,7 @@ impl GradSampOptions {
     }
 }
 
-/// Options of the HANSO-style driver [`hanso`](super::hanso).
+/// Options of the HANSO-style driver `hanso` (feature `test-support`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
 pub struct HansoOptions {
