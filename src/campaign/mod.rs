@@ -53,7 +53,7 @@ pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportEr
 pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
 pub use sanitise::for_terminal;
 pub use scheduler::{
-    execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, DesignRunner, ExecuteError, ExecuteOptions,
+    design_job, execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, ExecuteError, ExecuteOptions,
     JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Scheduler, Solo,
 };
 pub use shard::{select as shard_jobs, Shard};

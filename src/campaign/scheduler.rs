@@ -2,7 +2,7 @@
 //! callback on the calling thread. It never prints or writes (nextest's split; docs/ARCHITECTURE.md §2); the
 //! journal, traces and progress display are consumers.
 //!
-//! * The job runner is injected ([`JobRunner`]): production passes [`DesignRunner`]
+//! * The job runner is injected ([`JobRunner`]): production passes [`design_job`]
 //!   (`design::run`), tests pass fast fakes.
 //! * Per-job observers (the trace writer) are made by an injected [`ObserverFactory`] on the
 //!   worker that runs the job.
@@ -42,7 +42,7 @@ use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome
 use crate::lti::Controller;
 use crate::optim::thread_cpu_time;
 
-/// Runs one job. Production: [`DesignRunner`]; tests: closures.
+/// Runs one job. Production: [`design_job`]; tests: closures.
 pub trait JobRunner: Sync {
     /// Runs `job` from `init` (warm start) or from scratch, reporting iterations to `obs`.
     fn run(
@@ -67,18 +67,14 @@ where
     }
 }
 
-/// The production runner: [`crate::design::run`] with the job's plant and options.
-pub struct DesignRunner;
-
-impl JobRunner for DesignRunner {
-    fn run(
-        &self,
-        job: &Job,
-        init: Option<&Controller>,
-        obs: &mut dyn DesignObserver,
-    ) -> Result<DesignOutcome, DesignError> {
-        crate::design::run(&job.plant, &job.options, init, obs)
-    }
+/// The production runner (a [`JobRunner`] as every such function is): [`crate::design::run`]
+/// with the job's plant and options.
+pub fn design_job(
+    job: &Job,
+    init: Option<&Controller>,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
+    crate::design::run(&job.plant, &job.options, init, obs)
 }
 
 /// What [`Coordinator::claim`] found.

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use crate::campaign::{
-    campaign_dir, expand, for_terminal, journals_in, load_default_reference, plant_map, records_for, run_jobs,
-    shard_jobs, shard_plan, summarise, trace_observers, Campaign, CampaignStatus, DesignRunner, ExecuteOptions,
-    Follower, Job, JobRecord, JobRunner, ProgressDisplay, Reporter, RunnerTag, Shard, TornTail, TraceLevel,
+    campaign_dir, design_job, expand, for_terminal, journals_in, load_default_reference, plant_map, records_for,
+    run_jobs, shard_jobs, shard_plan, summarise, trace_observers, Campaign, CampaignStatus, ExecuteOptions, Follower,
+    Job, JobRecord, JobRunner, ProgressDisplay, Reporter, RunnerTag, Shard, TornTail, TraceLevel,
 };
 use anyhow::Context;
 
@@ -154,7 +154,7 @@ pub fn run(a: RunArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitC
 
     let runner: &dyn JobRunner = match &l.fake {
         Some(f) => f.as_ref(),
-        None => &DesignRunner,
+        None => &design_job,
     };
     let observers = trace_observers(&l.dir.join("traces"), l.campaign.trace_levels(a.trace));
     let mut reporter = Reporter::new(&jobs, ProgressDisplay::choose(a.no_progress));

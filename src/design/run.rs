@@ -46,12 +46,11 @@ pub fn run(
     init: Option<&Controller>,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
-    validate(plant, opts, init)?;
     let mut ctl = RunControl::new(opts.cpumax);
     if let Some(flag) = obs.cancel_flag() {
         ctl = ctl.with_cancel(flag);
     }
-    run_validated(plant, opts, init, &ctl, obs)
+    run_with_control(plant, opts, init, &ctl, obs)
 }
 
 /// As [`run`], with a caller-made [`RunControl`] (e.g. with a cancel flag:
@@ -65,7 +64,108 @@ pub fn run_with_control(
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
     validate(plant, opts, init)?;
-    run_validated(plant, opts, init, ctl, obs)
+    let shape = ControllerShape { nk: opts.order, m: plant.dims.m2, p: plant.dims.p2 };
+    let strong = opts.objective == ObjectiveKind::Strong;
+    let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let mut first = starting_points(plant, opts, init, shape, &mut rng);
+    let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
+    if opts.open_loop_start {
+        first.push(controller_to_x(&open_loop_controller(plant, shape.nk)));
+        kinds.push(StartKind::OpenLoop);
+    }
+    for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
+        first.push(controller_to_x(&k));
+        kinds.push(StartKind::Central);
+    }
+    // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
+    // asks for them and the plant is scaled at all.
+    let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
+        VariableScaling::Off => None,
+        VariableScaling::Alternate | VariableScaling::Always => variable_scaling(plant, shape).map(Into::into),
+    };
+    // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
+    // sub-budget of the search is checked between evaluations.
+    let stop_ctl = ctl.clone();
+    let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
+    // On large plants, hold back the largest evaluation seen from the CPU budget: the returned
+    // controller's figures (about one evaluation) are computed after the search, and should end
+    // near cpumax, not one evaluation after it. (Small plants never report: their runs are
+    // unchanged.)
+    let reserve_ctl = ctl.clone();
+    let report: Rc<dyn Fn(f64)> = Rc::new(move |s| reserve_ctl.reserve_cpu(s));
+    // The two objectives in coordinates with scaling `d` (each coordinate system has its own
+    // component cache: the cache is keyed by the objective's variables).
+    let objectives = |d: Option<Rc<[f64]>>| {
+        let cache = Rc::new(RefCell::new(ComponentCache::default()));
+        let new = |phase, cache| DesignObjective::new(plant, shape, phase, strong, opts.eps, opts.hinf_tol, cache);
+        let stab = new(ObjectivePhase::Stabilisation, Rc::clone(&cache))
+            .with_interrupt(Some(Rc::clone(&stop)))
+            .with_scaling(d.clone());
+        let perf = new(ObjectivePhase::Performance, cache)
+            .with_interrupt(Some(Rc::clone(&stop)))
+            .with_eval_cpu_report(Some(Rc::clone(&report)))
+            .with_scaling(d);
+        (stab, perf)
+    };
+    let (mut stab_obj, mut perf_obj) = objectives(None);
+    let mut scaled_objs = scaling.clone().map(|d| objectives(Some(d)));
+    let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
+    let scaled = match (&mut scaled_objs, &scaling) {
+        (Some((s, p)), Some(d)) => Some(ScaledObjectives { stab_obj: s, perf_obj: p, d: Rc::clone(d) }),
+        _ => None,
+    };
+    let res = Search {
+        stab_obj: &mut stab_obj,
+        perf_obj: &mut perf_obj,
+        adapter: &mut adapter,
+        rng: &mut rng,
+        ctl: &ctl,
+        scaled,
+    }
+    .run(opts, &first, &kinds, shape.nvar())?;
+    let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
+
+    let (final_x, certificate) = match &res.perf {
+        Some(b) => (b.x.clone(), Some(Certificate { dnorm: b.dnorm, evaldist: b.evaldist })),
+        None => (res.stab.x.clone(), None),
+    };
+    let status = if interrupted {
+        DesignStatus::Interrupted
+    } else if !res.stabilised {
+        DesignStatus::NotStabilised { best_alpha: res.stab.f }
+    } else if res.truncated {
+        DesignStatus::BudgetExhausted
+    } else if res.perf.as_ref().is_none_or(|b| b.x == b.from) {
+        DesignStatus::StabilisedOnly
+    } else if res.perf.as_ref().is_some_and(|b| b.dnorm <= opts.normtol) {
+        DesignStatus::Converged
+    } else {
+        DesignStatus::Stopped
+    };
+
+    let k = shape.controller(&final_x);
+    let cancelled = || ctl.cancelled();
+    let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
+    let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+    let iterations = res.phases.iter().map(|p| p.iters).sum();
+    let evaluations = res.phases.iter().map(|p| p.evals).sum();
+    Ok(DesignOutcome {
+        status,
+        controller: k,
+        gamma: fig.gamma,
+        k_hinf: fig.k_hinf,
+        alpha_cl: fig.alpha_cl,
+        alpha_k: fig.alpha_k,
+        objective: fig.objective,
+        controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
+        certificate,
+        iterations,
+        evaluations,
+        phases: res.phases,
+        design_cpu_s: ctl.cpu_elapsed(),
+        search: res.summary,
+    })
 }
 
 fn opt_err(field: &'static str, problem: impl Into<String>) -> DesignError {
@@ -179,115 +279,4 @@ pub(crate) fn controller_norm_active(opts: &DesignOptions, gamma: f64, k_hinf: f
         && gamma.is_finite()
         && k_hinf.is_finite()
         && opts.eps * k_hinf >= gamma * (1.0 - opts.hinf_tol)
-}
-
-fn run_validated(
-    plant: &Plant,
-    opts: &DesignOptions,
-    init: Option<&Controller>,
-    ctl: &RunControl,
-    obs: &mut dyn DesignObserver,
-) -> Result<DesignOutcome, DesignError> {
-    let shape = ControllerShape { nk: opts.order, m: plant.dims.m2, p: plant.dims.p2 };
-    let strong = opts.objective == ObjectiveKind::Strong;
-    let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
-    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let mut first = starting_points(plant, opts, init, shape, &mut rng);
-    let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
-    if opts.open_loop_start {
-        first.push(controller_to_x(&open_loop_controller(plant, shape.nk)));
-        kinds.push(StartKind::OpenLoop);
-    }
-    for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
-        first.push(controller_to_x(&k));
-        kinds.push(StartKind::Central);
-    }
-    // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
-    // asks for them and the plant is scaled at all.
-    let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
-        VariableScaling::Off => None,
-        VariableScaling::Alternate | VariableScaling::Always => variable_scaling(plant, shape).map(Into::into),
-    };
-    // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
-    // sub-budget of the search is checked between evaluations.
-    let stop_ctl = ctl.clone();
-    let stop: StopHook = Rc::new(move || stop_ctl.cancelled() || stop_ctl.cpu_exhausted());
-    // On large plants, hold back the largest evaluation seen from the CPU budget: the returned
-    // controller's figures (about one evaluation) are computed after the search, and should end
-    // near cpumax, not one evaluation after it. (Small plants never report: their runs are
-    // unchanged.)
-    let reserve_ctl = ctl.clone();
-    let report: Rc<dyn Fn(f64)> = Rc::new(move |s| reserve_ctl.reserve_cpu(s));
-    // The two objectives in coordinates with scaling `d` (each coordinate system has its own
-    // component cache: the cache is keyed by the objective's variables).
-    let objectives = |d: Option<Rc<[f64]>>| {
-        let cache = Rc::new(RefCell::new(ComponentCache::default()));
-        let new = |phase, cache| DesignObjective::new(plant, shape, phase, strong, opts.eps, opts.hinf_tol, cache);
-        let stab = new(ObjectivePhase::Stabilisation, Rc::clone(&cache))
-            .with_interrupt(Some(Rc::clone(&stop)))
-            .with_scaling(d.clone());
-        let perf = new(ObjectivePhase::Performance, cache)
-            .with_interrupt(Some(Rc::clone(&stop)))
-            .with_eval_cpu_report(Some(Rc::clone(&report)))
-            .with_scaling(d);
-        (stab, perf)
-    };
-    let (mut stab_obj, mut perf_obj) = objectives(None);
-    let mut scaled_objs = scaling.clone().map(|d| objectives(Some(d)));
-    let mut adapter = ObserverAdapter::new(obs, &stab_obj, Phase::Stabilisation);
-    let scaled = match (&mut scaled_objs, &scaling) {
-        (Some((s, p)), Some(d)) => Some(ScaledObjectives { stab_obj: s, perf_obj: p, d: Rc::clone(d) }),
-        _ => None,
-    };
-    let res = Search {
-        stab_obj: &mut stab_obj,
-        perf_obj: &mut perf_obj,
-        adapter: &mut adapter,
-        rng: &mut rng,
-        ctl: &ctl,
-        scaled,
-    }
-    .run(opts, &first, &kinds, shape.nvar())?;
-    let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
-
-    let (final_x, certificate) = match &res.perf {
-        Some(b) => (b.x.clone(), Some(Certificate { dnorm: b.dnorm, evaldist: b.evaldist })),
-        None => (res.stab.x.clone(), None),
-    };
-    let status = if interrupted {
-        DesignStatus::Interrupted
-    } else if !res.stabilised {
-        DesignStatus::NotStabilised { best_alpha: res.stab.f }
-    } else if res.truncated {
-        DesignStatus::BudgetExhausted
-    } else if res.perf.as_ref().is_none_or(|b| b.x == b.from) {
-        DesignStatus::StabilisedOnly
-    } else if res.perf.as_ref().is_some_and(|b| b.dnorm <= opts.normtol) {
-        DesignStatus::Converged
-    } else {
-        DesignStatus::Stopped
-    };
-
-    let k = shape.controller(&final_x);
-    let cancelled = || ctl.cancelled();
-    let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
-    let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
-    let iterations = res.phases.iter().map(|p| p.iters).sum();
-    let evaluations = res.phases.iter().map(|p| p.evals).sum();
-    Ok(DesignOutcome {
-        status,
-        controller: k,
-        gamma: fig.gamma,
-        k_hinf: fig.k_hinf,
-        alpha_cl: fig.alpha_cl,
-        alpha_k: fig.alpha_k,
-        objective: fig.objective,
-        controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
-        certificate,
-        iterations,
-        evaluations,
-        phases: res.phases,
-        design_cpu_s: ctl.cpu_elapsed(),
-        search: res.summary,
-    })
 }

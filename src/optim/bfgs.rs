@@ -30,7 +30,7 @@ use super::linesearch::{weak_wolfe, LsParams, LsStatus};
 use super::objective::{usable, Evaluator, Objective};
 use super::observer::{Observer, SolverKind};
 use super::options::BfgsOptions;
-use super::solver::{run, Limits, OptimResult, Solver, SolverState};
+use super::solver::{run, solver_state, Limits, OptimResult, Solver};
 use super::termination::Termination;
 use crate::numeric::dot;
 
@@ -58,17 +58,7 @@ pub struct BfgsState {
     pub skipped_updates: usize,
 }
 
-impl SolverState for BfgsState {
-    fn x(&self) -> &[f64] {
-        &self.x
-    }
-    fn f(&self) -> f64 {
-        self.f
-    }
-    fn dnorm(&self) -> f64 {
-        self.dnorm
-    }
-}
+solver_state!(BfgsState);
 
 pub(crate) struct Bfgs<'o> {
     pub(crate) opts: &'o BfgsOptions,
@@ -229,13 +219,6 @@ impl Solver for Bfgs<'_> {
     }
 }
 
-pub(crate) fn check_dims(obj: &dyn Objective, x0: &[f64]) -> Result<(), OptimError> {
-    if x0.len() != obj.nvar() {
-        return Err(OptimError::DimensionMismatch { what: "x0", expected: obj.nvar(), got: x0.len() });
-    }
-    Ok(())
-}
-
 /// One BFGS run from x0 (start index `start` is only passed to the observer).
 ///
 /// `Err` for invalid options, a wrong dimension, or a start where f or ∇f is not finite
@@ -248,21 +231,6 @@ pub fn bfgs(
     ctl: &RunControl,
     obs: &mut dyn Observer,
 ) -> Result<OptimResult, OptimError> {
-    bfgs_offset(obj, x0, start, opts, ctl, obs, 0)
-}
-
-pub(crate) fn bfgs_offset(
-    obj: &mut dyn Objective,
-    x0: &[f64],
-    start: usize,
-    opts: &BfgsOptions,
-    ctl: &RunControl,
-    obs: &mut dyn Observer,
-    evals_offset: usize,
-) -> Result<OptimResult, OptimError> {
     opts.validate()?;
-    check_dims(obj, x0)?;
-    let mut ev = Evaluator::new(obj, ctl, evals_offset);
-    let mut solver = Bfgs { opts };
-    run(&mut solver, &mut ev, x0, start, ctl, obs)
+    run(&mut Bfgs { opts }, obj, x0, start, ctl, obs)
 }

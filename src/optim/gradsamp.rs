@@ -24,7 +24,6 @@
 //! event, checked only in theory); this is omitted, as in practical implementations.
 //! The certificate returned is the one of [`bundle::certificate_at`](super::bundle) at the final x.
 
-use super::bfgs::check_dims;
 use super::bundle::certificate_at;
 use super::control::RunControl;
 use super::error::OptimError;
@@ -32,7 +31,7 @@ use super::objective::{usable, Evaluator, Objective};
 use super::observer::{Observer, SolverKind};
 use super::options::GradSampOptions;
 use super::qp::min_norm_in_hull;
-use super::solver::{run, Limits, OptimResult, Solver, SolverState};
+use super::solver::{run, solver_state, Limits, OptimResult, Solver};
 use super::termination::Termination;
 use crate::numeric::dot;
 use rand::{Rng, RngCore};
@@ -63,17 +62,7 @@ pub struct GradSampState {
     gs: Vec<Vec<f64>>,
 }
 
-impl SolverState for GradSampState {
-    fn x(&self) -> &[f64] {
-        &self.x
-    }
-    fn f(&self) -> f64 {
-        self.f
-    }
-    fn dnorm(&self) -> f64 {
-        self.dnorm
-    }
-}
+solver_state!(GradSampState);
 
 pub(crate) struct GradSamp<'a> {
     pub(crate) opts: &'a GradSampOptions,
@@ -216,21 +205,6 @@ pub fn gradient_sampling(
     ctl: &RunControl,
     obs: &mut dyn Observer,
 ) -> Result<OptimResult, OptimError> {
-    gradient_sampling_offset(obj, x0, opts, rng, ctl, obs, 0)
-}
-
-pub(crate) fn gradient_sampling_offset(
-    obj: &mut dyn Objective,
-    x0: &[f64],
-    opts: &GradSampOptions,
-    rng: &mut dyn RngCore,
-    ctl: &RunControl,
-    obs: &mut dyn Observer,
-    evals_offset: usize,
-) -> Result<OptimResult, OptimError> {
     opts.validate()?;
-    check_dims(obj, x0)?;
-    let mut ev = Evaluator::new(obj, ctl, evals_offset);
-    let mut solver = GradSamp { opts, rng };
-    run(&mut solver, &mut ev, x0, 0, ctl, obs)
+    run(&mut GradSamp { opts, rng }, obj, x0, 0, ctl, obs)
 }

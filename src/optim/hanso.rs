@@ -14,16 +14,29 @@
 //!   result replaces the BFGS one only if f decreased; at the same x the smaller certificate is
 //!   kept (HANSO).
 
-use super::bfgs::{bfgs_offset, check_dims};
+use super::bfgs::bfgs;
 use super::control::RunControl;
 use super::error::OptimError;
-use super::gradsamp::gradient_sampling_offset;
+use super::gradsamp::gradient_sampling;
 use super::objective::Objective;
-use super::observer::Observer;
+use super::observer::{IterRecord, Observer};
 use super::options::HansoOptions;
-use super::solver::OptimResult;
+use super::solver::{check_dims, OptimResult};
 use super::termination::Termination;
 use rand::RngCore;
+
+/// Passes each record on with the evaluations of the call's earlier runs added, so that
+/// [`IterRecord::evals`] counts the whole `hanso` call.
+struct EvalsBefore<'o> {
+    inner: &'o mut dyn Observer,
+    evals: usize,
+}
+
+impl Observer for EvalsBefore<'_> {
+    fn on_iter(&mut self, rec: &IterRecord<'_>) -> std::ops::ControlFlow<()> {
+        self.inner.on_iter(&IterRecord { evals: self.evals + rec.evals, ..*rec })
+    }
+}
 
 /// Result of [`hanso`].
 #[derive(Debug, Clone, PartialEq)]
@@ -67,7 +80,7 @@ pub fn hanso(
             results.push(Err(OptimError::NotRun { reason }));
             continue;
         }
-        let r = bfgs_offset(obj, x0, i, &opts.bfgs, ctl, obs, evals);
+        let r = bfgs(obj, x0, i, &opts.bfgs, ctl, &mut EvalsBefore { inner: &mut *obs, evals });
         match &r {
             Ok(res) => {
                 evals += res.evals;
@@ -97,7 +110,8 @@ pub fn hanso(
     let mut gs_result = None;
     let certified = best.dnorm <= opts.bfgs.normtol;
     if opts.gradient_sampling && ended.is_none() && !(opts.gradsamp.only_if_uncertified && certified) {
-        let gs = gradient_sampling_offset(obj, &best.x, &opts.gradsamp, rng, ctl, obs, evals)?;
+        let gs =
+            gradient_sampling(obj, &best.x, &opts.gradsamp, rng, ctl, &mut EvalsBefore { inner: &mut *obs, evals })?;
         evals += gs.evals;
         if gs.f < best.f {
             best = gs.clone();

@@ -56,14 +56,11 @@ pub(crate) struct Evaluator<'a> {
     pub(crate) ctl: &'a RunControl,
     /// Evaluations made through this evaluator.
     pub(crate) evals: usize,
-    /// Evaluations made before this evaluator (by earlier solver runs of the same call), only
-    /// for reporting.
-    pub(crate) evals_offset: usize,
 }
 
 impl<'a> Evaluator<'a> {
-    pub(crate) fn new(obj: &'a mut dyn Objective, ctl: &'a RunControl, evals_offset: usize) -> Self {
-        Evaluator { obj, ctl, evals: 0, evals_offset }
+    pub(crate) fn new(obj: &'a mut dyn Objective, ctl: &'a RunControl) -> Self {
+        Evaluator { obj, ctl, evals: 0 }
     }
 
     /// Evaluate without any budget check (used for the starting point).
@@ -103,10 +100,5 @@ impl<'a> Evaluator<'a> {
         self.evals += 1;
         self.ctl.count_eval();
         Ok(self.obj.eval_below(x, g, threshold))
-    }
-
-    /// Total for the observer.
-    pub(crate) fn evals_total(&self) -> usize {
-        self.evals_offset + self.evals
     }
 }

@@ -4,7 +4,7 @@
 
 use super::control::RunControl;
 use super::error::OptimError;
-use super::objective::Evaluator;
+use super::objective::{Evaluator, Objective};
 use super::observer::{IterRecord, Observer, SolverKind};
 use super::termination::Termination;
 use serde::{Deserialize, Serialize};
@@ -48,6 +48,24 @@ pub(crate) trait SolverState {
     fn dnorm(&self) -> f64;
 }
 
+/// Implements [`SolverState`] for a state struct with the fields `x`, `f` and `dnorm`.
+macro_rules! solver_state {
+    ($state:ty) => {
+        impl $crate::optim::solver::SolverState for $state {
+            fn x(&self) -> &[f64] {
+                &self.x
+            }
+            fn f(&self) -> f64 {
+                self.f
+            }
+            fn dnorm(&self) -> f64 {
+                self.dnorm
+            }
+        }
+    };
+}
+pub(crate) use solver_state;
+
 pub(crate) trait Solver {
     type State: SolverState;
     const KIND: SolverKind;
@@ -67,32 +85,46 @@ fn norm(x: &[f64]) -> f64 {
     x.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
-/// Run `solver` from x0 to termination.
+/// What the observer sees of state `s` at iteration `iter` (`step`: this iteration's step length).
+fn record<'s, S: Solver>(s: &'s S::State, start: usize, iter: usize, step: f64, ev: &Evaluator<'_>) -> IterRecord<'s> {
+    IterRecord {
+        solver: S::KIND,
+        start,
+        iter,
+        x: s.x(),
+        f: s.f(),
+        dnorm: s.dnorm(),
+        step,
+        evals: ev.evals,
+        cpu_s: ev.ctl.cpu_elapsed(),
+    }
+}
+
+/// `Err(DimensionMismatch)` unless x0 has `obj.nvar()` entries.
+pub(crate) fn check_dims(obj: &dyn Objective, x0: &[f64]) -> Result<(), OptimError> {
+    if x0.len() != obj.nvar() {
+        return Err(OptimError::DimensionMismatch { what: "x0", expected: obj.nvar(), got: x0.len() });
+    }
+    Ok(())
+}
+
+/// Run `solver` on `obj` from x0 to termination (x0 checked against `obj.nvar()`).
 pub(crate) fn run<S: Solver>(
     solver: &mut S,
-    ev: &mut Evaluator<'_>,
+    obj: &mut dyn Objective,
     x0: &[f64],
     start: usize,
     ctl: &RunControl,
     obs: &mut dyn Observer,
 ) -> Result<OptimResult, OptimError> {
+    check_dims(obj, x0)?;
+    let ev = &mut Evaluator::new(obj, ctl);
     let lim = solver.limits();
     let mut s = solver.init(ev, x0)?;
     let mut iter = 0usize;
     let mut step = 0.0;
     loop {
-        let rec = IterRecord {
-            solver: S::KIND,
-            start,
-            iter,
-            x: s.x(),
-            f: s.f(),
-            dnorm: s.dnorm(),
-            step,
-            evals: ev.evals_total(),
-            cpu_s: ctl.cpu_elapsed(),
-        };
-        let flow = obs.on_iter(&rec);
+        let flow = obs.on_iter(&record::<S>(&s, start, iter, step, ev));
         let term = if s.f() < lim.fvalquit {
             Some(Termination::TargetReached)
         } else if norm(s.x()) > lim.xnormquit {
@@ -118,18 +150,7 @@ pub(crate) fn run<S: Solver>(
             Ok(t) => step = t,
             Err(t) => {
                 // Report the (possibly partially advanced) state once more, then stop.
-                let rec = IterRecord {
-                    solver: S::KIND,
-                    start,
-                    iter,
-                    x: s.x(),
-                    f: s.f(),
-                    dnorm: s.dnorm(),
-                    step: 0.0,
-                    evals: ev.evals_total(),
-                    cpu_s: ctl.cpu_elapsed(),
-                };
-                let _ = obs.on_iter(&rec);
+                let _ = obs.on_iter(&record::<S>(&s, start, iter, 0.0, ev));
                 // A trial point may have met the target before the budget check fired.
                 let t = if s.f() < lim.fvalquit { Termination::TargetReached } else { t };
                 return Ok(solver.result(ev, s, t, iter));
