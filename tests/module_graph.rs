@@ -223,3 +223,50 @@ fn the_lti_part_order_is_checked() {
     assert!(lti_rank("norms::hinf") < lti_rank("synthesis::full_order::gamma_test"));
     assert_eq!(lti_rank("error"), lti_rank("interrupt"));
 }
+
+/// The parts of `campaign`, bottom up (docs/ARCHITECTURE.md §1), each a list of its modules (the
+/// files stay side by side in src/campaign/): a module may import its own part and the parts
+/// below it, never one above.
+const CAMPAIGN_PARTS: &[(&str, &[&str])] = &[
+    ("leaves", &["provenance", "reference", "sanitise", "trace_filter"]),
+    ("model", &["model", "spec", "jobs"]),
+    ("records", &["record", "journal", "claims", "shard"]),
+    ("execution", &["scheduler", "trace", "progress", "run", "fake"]),
+    ("reduction", &["reduce", "compare", "latex", "report", "plot", "status"]),
+];
+
+/// Rank of the part holding a campaign module (`plot::render` → that of `plot`).
+fn campaign_rank(module: &str) -> usize {
+    let top = module.split("::").next().unwrap();
+    CAMPAIGN_PARTS
+        .iter()
+        .position(|(_, mods)| mods.contains(&top))
+        .unwrap_or_else(|| panic!("src/campaign/{module}: in no part of campaign; add it to CAMPAIGN_PARTS"))
+}
+
+#[test]
+fn campaign_parts_import_only_downwards() {
+    let g = graph("campaign");
+    for (_, mods) in CAMPAIGN_PARTS {
+        for m in *mods {
+            assert!(g.contains_key(*m), "src/campaign/{m}: listed in CAMPAIGN_PARTS but not found");
+        }
+    }
+    for (m, edges) in &g {
+        for t in edges {
+            assert!(
+                campaign_rank(t) <= campaign_rank(m),
+                "src/campaign/{m} imports campaign::{t}, a part above its own (order: {:?})",
+                CAMPAIGN_PARTS.iter().map(|(p, _)| p).collect::<Vec<_>>()
+            );
+        }
+    }
+}
+
+#[test]
+fn the_campaign_part_order_is_checked() {
+    assert!(campaign_rank("journal") > campaign_rank("jobs"));
+    assert!(campaign_rank("report") > campaign_rank("scheduler"));
+    assert!(campaign_rank("plot::render") > campaign_rank("trace"));
+    assert_eq!(campaign_rank("spec"), campaign_rank("model"));
+}
