@@ -39,6 +39,7 @@ use super::options::DesignOptions;
 use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
 use super::scaling::{from_scaled, to_scaled};
 use budget::{ctl_stop, improves, stop_of, GsRounds};
+use plan::NextStart;
 
 pub use budget::{GS_RESERVE, GS_RESERVE_FACTOR};
 pub use plan::ALTERNATE_PERIOD;
@@ -255,12 +256,6 @@ impl Search<'_, '_, '_> {
             continued: false,
             refinements: 0,
         };
-        let mut k = 0usize; // local searches made
-        let mut cycle = 0usize; // continued starts drawn from the hop / random cycle
-        let mut gs_fallback_done = false;
-        let mut kinds: Vec<StartKind> = Vec::new(); // kind of local search k
-        let mut coords: Vec<Coords> = Vec::new(); // its coordinates
-        let mut cycle_coords = Coords::Raw; // coordinates of the current hop cycle
         let mut stop = None;
         let full_ctl = self.ctl;
         let returning = opts.return_gs_reserve && opts.gradient_sampling;
@@ -269,7 +264,7 @@ impl Search<'_, '_, '_> {
             full_ctl.maxevals().map_or(usize::MAX, |m| m - search_ctl.maxevals().unwrap_or(m)),
         );
         let mut rounds = GsRounds { first: first_reserve, ..Default::default() };
-        let plan = self.first_plan(opts.variable_scaling, first_kinds, first.len());
+        let mut plan = self.start_plan(opts.variable_scaling, first_kinds, first.len());
         // HIFOO's own first starts (random or init): the extra open-loop and central starts are
         // like the continued search, a budget may end the run before them without truncating it.
         let hifoo_starts = first_kinds
@@ -278,6 +273,7 @@ impl Search<'_, '_, '_> {
             .filter(|k| !matches!(k, StartKind::Central | StartKind::OpenLoop))
             .count();
         while stop.is_none() {
+            let k = plan.made(); // the index of this turn's local search
             let share_spent = ctl_stop(&search_ctl).is_some() && ctl_stop(full_ctl).is_none();
             // Gradient sampling where HIFOO's search makes it (after its first starts, with the
             // generator in the same state), and whenever the search's share is spent.
@@ -299,28 +295,22 @@ impl Search<'_, '_, '_> {
                 stop = Some(SearchStop::Starts);
                 break;
             }
-            let (s, better) = if let Some(&(i, c)) = plan.get(k) {
-                kinds.push(first_kinds.get(i).copied().unwrap_or(StartKind::Random));
-                coords.push(c);
-                let x0 = self.to_coords(&first[i], c);
-                self.local(&mut st, &x0, k, c, search_ctl)?
-            } else if !st.stabilised && opts.gradient_sampling && !gs_fallback_done {
-                gs_fallback_done = true;
-                kinds.push(StartKind::GradientSampling);
-                coords.push(st.stab.as_ref().map_or(Coords::Raw, |b| b.coords));
-                self.gs_stabilise(&mut st, k, search_ctl)?
-            } else {
-                if let Some(s) = budget::continued_stop(&st, search_ctl) {
-                    stop = Some(s);
-                    break;
+            let (s, better) = match plan.next(&st) {
+                NextStart::First(i, c) => {
+                    let x0 = self.to_coords(&first[i], c);
+                    self.local(&mut st, &x0, k, c, search_ctl)?
                 }
-                let (x0, kind, c) = self.continued_start(&mut st, &mut cycle, &mut cycle_coords, nvar);
-                kinds.push(kind);
-                st.continued = true;
-                coords.push(c);
-                self.local(&mut st, &x0, k, c, search_ctl)?
+                NextStart::Fallback => self.gs_stabilise(&mut st, k, search_ctl)?,
+                NextStart::Continued => {
+                    if let Some(s) = budget::continued_stop(&st, search_ctl) {
+                        stop = Some(s);
+                        break;
+                    }
+                    let (x0, c) = self.continued_start(&mut st, &mut plan, nvar);
+                    st.continued = true;
+                    self.local(&mut st, &x0, k, c, search_ctl)?
+                }
             };
-            k += 1;
             st.stall = if better { 0 } else { st.stall + 1 };
             // The search's share of a budget is spent but the budget is not: the next turn may
             // give the search back what gradient sampling does not need (`return_gs_reserve`).
@@ -329,6 +319,7 @@ impl Search<'_, '_, '_> {
             stop = s.filter(|_| !(returning && st.stabilised && share_only && !rounds.done));
         }
         let stop = stop.unwrap_or(SearchStop::Starts);
+        let (k, kinds, coords) = (plan.made(), plan.kinds, plan.coords);
         let truncated = k < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
 
         // Gradient sampling from the best stable point, under the whole budget (unless it already

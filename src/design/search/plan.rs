@@ -45,6 +45,58 @@ use crate::design::starts::{perturb, scaled_random_start};
 /// x̃) the incumbent was not found in, the others in those it was (module docs).
 pub const ALTERNATE_PERIOD: usize = 4;
 
+/// The sequence of local searches of one search, in the order of the module docs: the first
+/// starts, then gradient sampling on f_s if none of them was stabilised, then the continued
+/// search. It keeps what comes next and the kind and coordinates of every local search made.
+pub(super) struct StartPlan {
+    /// The first starts' local searches: (index into the first starts, coordinates, kind).
+    first: Vec<(usize, Coords, StartKind)>,
+    /// Whether the gradient-sampling fallback was made.
+    fallback_done: bool,
+    /// Continued starts drawn from the hop / random cycle so far.
+    cycle: usize,
+    /// Coordinates of the current hop cycle.
+    cycle_coords: Coords,
+    /// Kind of each local search made, in order.
+    pub kinds: Vec<StartKind>,
+    /// Coordinates of each local search made.
+    pub coords: Vec<Coords>,
+}
+
+/// The next local search of a [`StartPlan`].
+pub(super) enum NextStart {
+    /// First start number `i`, in coordinates `c`.
+    First(usize, Coords),
+    /// Gradient sampling on f_s from the point with the smallest f_s (HIFOO's fallback).
+    Fallback,
+    /// A start of the continued search, drawn by [`Search::continued_start`].
+    Continued,
+}
+
+impl StartPlan {
+    /// Local searches made (or begun) so far.
+    pub(super) fn made(&self) -> usize {
+        self.kinds.len()
+    }
+
+    /// What comes next after the local searches made; a first start or the fallback is recorded
+    /// as made (a continued start is recorded when [`Search::continued_start`] draws it).
+    pub(super) fn next(&mut self, st: &State<'_>) -> NextStart {
+        if let Some(&(i, c, kind)) = self.first.get(self.made()) {
+            self.kinds.push(kind);
+            self.coords.push(c);
+            return NextStart::First(i, c);
+        }
+        if !st.stabilised && st.opts.gradient_sampling && !self.fallback_done {
+            self.fallback_done = true;
+            self.kinds.push(StartKind::GradientSampling);
+            self.coords.push(st.stab.as_ref().map_or(Coords::Raw, |b| b.coords));
+            return NextStart::Fallback;
+        }
+        NextStart::Continued
+    }
+}
+
 impl Search<'_, '_, '_> {
     /// The coordinates of HIFOO's first starts (`continued` None) or of the hop cycle that begins
     /// with continued start number `j` (`continued` = (j, hop cycle length, coordinates of the
@@ -66,20 +118,29 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// The first starts' local searches, in order: (index into the first starts, coordinates).
-    /// Every start is made in the coordinates of [`Self::coords_of`]; with `Alternate` on a scaled
-    /// plant each central start is made twice, first in x, then in x̃ (module docs, "Coordinates").
-    pub(super) fn first_plan(&self, mode: VariableScaling, kinds: &[StartKind], n: usize) -> Vec<(usize, Coords)> {
+    /// The plan of a search whose first starts have the kinds `kinds` (`n` of them; a start
+    /// without a kind is a random one). Every first start is made in the coordinates of
+    /// [`Self::coords_of`]; with `Alternate` on a scaled plant each central start is made twice,
+    /// first in x, then in x̃ (module docs, "Coordinates").
+    pub(super) fn start_plan(&self, mode: VariableScaling, kinds: &[StartKind], n: usize) -> StartPlan {
         let c = self.coords_of(mode, None);
         let both = self.scaled.is_some() && mode == VariableScaling::Alternate;
-        let mut plan = Vec::with_capacity(2 * n);
+        let mut first = Vec::with_capacity(2 * n);
         for i in 0..n {
-            plan.push((i, c));
-            if both && kinds.get(i) == Some(&StartKind::Central) {
-                plan.push((i, Coords::Scaled));
+            let kind = kinds.get(i).copied().unwrap_or(StartKind::Random);
+            first.push((i, c, kind));
+            if both && kind == StartKind::Central {
+                first.push((i, Coords::Scaled, kind));
             }
         }
-        plan
+        StartPlan {
+            first,
+            fallback_done: false,
+            cycle: 0,
+            cycle_coords: Coords::Raw,
+            kinds: Vec::new(),
+            coords: Vec::new(),
+        }
     }
 
     /// The start of continued local search number `j` (0-based after the first starts), in
@@ -102,32 +163,33 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// The next start of the continued search and its coordinates: the incumbent itself if its
-    /// local search was cut (`continue_at_maxit`, recorded as a hop), else the next start of the
-    /// hop / random cycle (`cycle` counts them; a hop cycle's coordinates, kept in
-    /// `cycle_coords`, are chosen at its first start).
+    /// The next start of the continued search, recorded in `plan`, and its coordinates: the
+    /// incumbent itself if its local search was cut (`continue_at_maxit`, recorded as a hop),
+    /// else the next start of the hop / random cycle (a hop cycle's coordinates are chosen at its
+    /// first start).
     pub(super) fn continued_start(
         &mut self,
         st: &mut State<'_>,
-        cycle: &mut usize,
-        cycle_coords: &mut Coords,
+        plan: &mut StartPlan,
         nvar: usize,
-    ) -> (Vec<f64>, StartKind, Coords) {
+    ) -> (Vec<f64>, Coords) {
         let opts = st.opts;
-        match st.take_continuation() {
+        let (x0, kind, c) = match st.take_continuation() {
             Some((x, c)) => (self.to_coords(&x, c), StartKind::Hop, c),
             None => {
-                *cycle += 1;
-                // A hop cycle's coordinates are chosen at its first start.
+                plan.cycle += 1;
                 let len = opts.hop_scales.len() + 1;
-                if (*cycle - 1).is_multiple_of(len) {
+                if (plan.cycle - 1).is_multiple_of(len) {
                     let inc = st.perf.as_ref().or(st.stab.as_ref()).map_or(Coords::Raw, |b| b.coords);
-                    *cycle_coords = self.coords_of(opts.variable_scaling, Some((*cycle - 1, len, inc)));
+                    plan.cycle_coords = self.coords_of(opts.variable_scaling, Some((plan.cycle - 1, len, inc)));
                 }
-                let c = *cycle_coords;
-                let (x0, kind) = self.next_start(st, *cycle - 1, nvar, c);
+                let c = plan.cycle_coords;
+                let (x0, kind) = self.next_start(st, plan.cycle - 1, nvar, c);
                 (x0, kind, c)
             }
-        }
+        };
+        plan.kinds.push(kind);
+        plan.coords.push(c);
+        (x0, c)
     }
 }
