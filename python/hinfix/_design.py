@@ -110,7 +110,8 @@ def design(P, nmeas, ncon, order, *, eps=1e-3, strong=True, seed=0, cpumax=60.0,
     """
     mats = blocks(P, nmeas, ncon)
     opts = options_json(order, eps, strong, seed, cpumax, maxevals, search_options)
-    (ak, bk, ck, dk), text, used = _hinfix.design(list(mats), opts, _init_matrices(init))
+    name = getattr(P, "name", None) or "plant"  # python-control's name, for messages
+    (ak, bk, ck, dk), text, used = _hinfix.design(list(mats), opts, _init_matrices(init), name)
     out = loads(text)
     status = out["status"]["kind"]
     gamma, k_hinf = _float(out["gamma"]), _float(out["k_hinf"])

@@ -13,7 +13,6 @@ from check import linfnorm, relerr
 def test_random_stable_systems_agree_with_python_control(seed):
     rng = np.random.default_rng(seed)
     n, m, p = rng.integers(1, 9), rng.integers(1, 4), rng.integers(1, 4)
-    control.use_numpy_matrix = False
     np.random.seed(seed)  # control.rss draws from numpy's global generator
     sys = control.rss(int(n), int(p), int(m), strictly_proper=bool(seed % 2))
     value, peak = hinfix.hinfnorm(sys)
