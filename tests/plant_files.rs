@@ -283,3 +283,26 @@ fn a_changed_plant_named_like_a_paper_plant_is_not_compared_with_the_paper() {
     renamed.plant = "MyHelicopter".into();
     assert_eq!(compare_rows(&[renamed], &[], &reference)[0].paper, 0.1235);
 }
+
+/// `Plant::from_matrices` (the Python binding's entry) gives the plant of the file, bit for bit,
+/// and refuses what the file reader refuses, naming the matrix.
+#[test]
+fn a_plant_from_its_matrices_is_the_plant_of_its_file() {
+    for name in ["HE1", "AC8"] {
+        let p = Plant::load(plants_dir().join(format!("{name}.json"))).unwrap();
+        let q = Plant::from_matrices(name, p.matrices()).unwrap();
+        assert_eq!(q.dims, p.dims);
+        assert_eq!(q.fingerprint(), p.fingerprint(), "{name}");
+    }
+    let p = Plant::from_json_str(&good().to_string(), "t.json").unwrap();
+    let mut m: Vec<faer::Mat<f64>> = p.matrices().iter().map(|m| m.to_owned()).collect();
+    m[5][(0, 0)] = f64::NAN;
+    let refs: [faer::MatRef<'_, f64>; 9] = std::array::from_fn(|i| m[i].as_ref());
+    let err = Plant::from_matrices("T", refs).unwrap_err();
+    assert!(matches!(err, PlantErrorKind::Matrix { matrix: "D11", problem: MatrixJsonError::NotFinite { .. }, .. }));
+    m[5][(0, 0)] = 0.0;
+    m[6] = faer::Mat::zeros(2, 1); // D12 with 2 rows where C1 has 1
+    let refs: [faer::MatRef<'_, f64>; 9] = std::array::from_fn(|i| m[i].as_ref());
+    let err = Plant::from_matrices("T", refs).unwrap_err();
+    assert!(err.to_string().contains("D12"), "{err}");
+}

@@ -303,6 +303,30 @@ impl Plant {
         })
     }
 
+    /// A plant from its nine matrices in file order (A, B1, B2, C1, C2, D11, D12, D21, D22), e.g.
+    /// handed over by another program: `dims` are read off A (n), B1 (m1), B2 (m2), C1 (p1) and
+    /// C2 (p2), and the plant goes through the checks of a plant file (shapes, magnitudes, n, m2,
+    /// p2 ≥ 1), with the same messages; a non-finite entry is named by matrix, row and column.
+    /// Values are kept bit for bit (same matrices, same fingerprint as the plant's JSON file).
+    pub fn from_matrices(name: &str, mats: [MatRef<'_, f64>; 9]) -> Result<Plant, PlantErrorKind> {
+        use crate::lti::io::matrix_json::matrix_to_json;
+        let mut doc = Map::new();
+        for ((key, _, _), m) in MATRICES.iter().zip(mats) {
+            for j in 0..m.ncols() {
+                if let Some(i) = (0..m.nrows()).find(|&i| !m[(i, j)].is_finite()) {
+                    let problem = MatrixJsonError::NotFinite { row: i + 1, col: j + 1, value: m[(i, j)] };
+                    return Err(PlantErrorKind::Matrix { matrix: key, problem, hint: String::new() });
+                }
+            }
+            doc.insert((*key).into(), matrix_to_json(m));
+        }
+        let [a, b1, b2, c1, c2, ..] = mats;
+        let dims = Dims { n: a.nrows(), m1: b1.ncols(), m2: b2.ncols(), p1: c1.nrows(), p2: c2.nrows() };
+        doc.insert("name".into(), name.into());
+        doc.insert("dims".into(), serde_json::to_value(dims).expect("dims serialise"));
+        Self::from_json_value(&Value::Object(doc))
+    }
+
     /// The plant as a JSON document in the file format (provenance kept).
     pub fn to_json(&self) -> Value {
         use crate::lti::io::matrix_json::matrix_to_json;

@@ -1,0 +1,76 @@
+"""Bad inputs raise clear Python exceptions carrying the crate's message (never a panic)."""
+import numpy as np
+import pytest
+import control
+
+import hinfix
+
+
+@pytest.fixture(scope="module")
+def he1():
+    return hinfix.load_plant("HE1")
+
+
+def test_hinfix_error_is_a_runtime_error():
+    assert issubclass(hinfix.HinfixError, RuntimeError)
+
+
+def test_partition_errors(he1):
+    P, nmeas, ncon = he1
+    with pytest.raises(ValueError, match=r"nmeas must be in 1..=3, got 0"):
+        hinfix.design(P, 0, ncon, 1)
+    with pytest.raises(ValueError, match=r"ncon must be in 1..=4, got 7"):
+        hinfix.design(P, nmeas, 7, 1)
+    with pytest.raises(TypeError, match="nmeas must be an integer"):
+        hinfix.design(P, 1.5, ncon, 1)
+    with pytest.raises(ValueError, match="discrete-time"):
+        hinfix.design(control.c2d(P, 0.1), nmeas, ncon, 1)
+
+
+def test_option_errors_carry_the_crates_message(he1):
+    P, nmeas, ncon = he1
+    with pytest.raises(ValueError, match="ε must be finite and positive"):
+        hinfix.design(P, nmeas, ncon, 1, eps=-1.0)
+    with pytest.raises(ValueError, match="option `nrand`: invalid type: string"):
+        hinfix.design(P, nmeas, ncon, 1, nrand="3")
+    with pytest.raises(ValueError, match="exceeds the plant order n = 4"):
+        hinfix.design(P, nmeas, ncon, 5)
+    with pytest.raises(ValueError, match="option `order`: invalid value: integer `-1`"):
+        hinfix.design(P, nmeas, ncon, -1)
+    with pytest.raises(ValueError, match="must be at least 1"):
+        hinfix.design(P, nmeas, ncon, 1, maxevals=0)
+    with pytest.raises(ValueError, match="cpumax"):
+        hinfix.design(P, nmeas, ncon, 1, cpumax=float("nan"))
+    with pytest.raises(TypeError, match="unknown design option.*nrandd"):
+        hinfix.design(P, nmeas, ncon, 1, nrandd=3)
+    with pytest.raises(TypeError, match="strong=True/False"):
+        hinfix.design(P, nmeas, ncon, 1, objective="plain")
+
+
+def test_plant_errors_name_the_matrix(he1):
+    P, nmeas, ncon = he1
+    A = P.A.copy()
+    A[1, 2] = np.inf
+    bad = control.ss(A, P.B, P.C, P.D)
+    with pytest.raises(ValueError, match=r"matrix `A` entry \(2, 3\) is not finite"):
+        hinfix.design(bad, nmeas, ncon, 1)
+    with pytest.raises(ValueError, match="nine"):
+        hinfix.design((P.A, P.B), None, None, 1)
+    with pytest.raises(ValueError, match="must be real"):
+        hinfix.design([P.A * 1j] + [np.zeros((4, 1))] * 8, None, None, 1)
+    with pytest.raises(ValueError, match="B2"):
+        mats = [P.A, P.B[:, :2], np.zeros((3, 2)), P.C[:2], P.C[2:], P.D[:2, :2], P.D[:2, 2:], P.D[2:, :2],
+                P.D[2:, 2:]]
+        hinfix.design(mats, None, None, 1)
+    with pytest.raises(ValueError, match="no plant named `he2`"):
+        hinfix.load_plant("he2")
+
+
+def test_initial_controller_errors(he1):
+    P, nmeas, ncon = he1
+    with pytest.raises(ValueError, match="exceeds the target order"):
+        hinfix.design(P, nmeas, ncon, 1, init=control.rss(2, ncon, nmeas))
+    with pytest.raises(ValueError, match="Bk is 1×2, expected 1×1"):
+        hinfix.design(P, nmeas, ncon, 1, init=([[-1.0]], [[1.0, 2.0]], [[1.0], [1.0]], [[0.0], [0.0]]))
+    with pytest.raises(ValueError, match="initial controller"):
+        hinfix.design(P, nmeas, ncon, 1, init=control.ss([], [], [], np.zeros((3, 3))))
