@@ -44,12 +44,13 @@ pub use kernels::riccati::{care_residual, solve_care, CareSolution, RiccatiError
 pub(crate) use kernels::spectral::abscissa_of;
 pub(crate) use kernels::spectral::eigenvalues as eigenvalues_of;
 pub use kernels::spectral::{
-    is_stable, is_stable_with_margin, spectral_abscissa, spectral_abscissa_grad, stability_margin, MIN_EIGVEC_COSINE,
+    is_schur_stable, is_schur_stable_with_margin, is_stable, is_stable_with_margin, spectral_abscissa,
+    spectral_abscissa_grad, spectral_radius, spectral_radius_grad, stability_margin, MIN_EIGVEC_COSINE,
     STABILITY_MARGIN_RTOL,
 };
 pub use norms::gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    ControllerGradient,
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_radius_grad, controller_abscissa_grad,
+    controller_hinf_grad, controller_radius_grad, ControllerGradient,
 };
 pub(crate) use norms::hinf::hinf_norm_with_poles;
 pub use norms::hinf::{

@@ -30,7 +30,7 @@ use super::hinf::{hinf_norm_reusing, HinfNorm, HinfParams};
 use crate::lti::error::LtiError;
 use crate::lti::kernels::freq_response::FreqResponse;
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
-use crate::lti::kernels::spectral::rightmost_eigen;
+use crate::lti::kernels::spectral::{largest_modulus_eigen, rightmost_eigen, ExtremeEigen};
 use crate::lti::kernels::step_stats::{for_order, timed, Step};
 use crate::lti::system::closed_loop::ClosedLoop;
 use crate::lti::system::controller::Controller;
@@ -43,24 +43,63 @@ pub type ControllerGradient = Controller;
 /// α(Acl) and its gradient. α is finite for unstable loops; +∞ with a NaN gradient if the
 /// eigensolver fails or the loop has non-finite entries. Err(IllPosed) for an ill-posed loop.
 pub fn closed_loop_abscissa_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
-    let cl = ClosedLoop::new(plant, k)?;
-    Ok(match rightmost_eigen(cl.sys.a.as_ref()) {
-        Some(e) => (e.alpha, cl.chain_rule(&e.u, &e.v_scaled, None)),
-        None => (f64::INFINITY, nan_like(k)),
-    })
+    closed_loop_eigen_grad(plant, k, &ABSCISSA)
+}
+
+/// ρ(Acl) and its gradient, for a discrete-time plant with a discrete-time controller (the same
+/// closed loop as in continuous time, docs/ALGORITHMS.md §11.1); as
+/// [`closed_loop_abscissa_grad`] otherwise.
+pub fn closed_loop_radius_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
+    closed_loop_eigen_grad(plant, k, &RADIUS)
 }
 
 /// α(Ak) and its gradient (only the Ak block is nonzero); nk = 0: (−∞, zeros).
 pub fn controller_abscissa_grad(k: &Controller) -> (f64, ControllerGradient) {
+    controller_eigen_grad(k, &ABSCISSA)
+}
+
+/// ρ(Ak) and its gradient (only the Ak block is nonzero); nk = 0: (0, zeros) (a static
+/// controller has no dynamics). The strong-stabilisation constraint of a discrete-time design is
+/// ρ(Ak) < 1.
+pub fn controller_radius_grad(k: &Controller) -> (f64, ControllerGradient) {
+    controller_eigen_grad(k, &RADIUS)
+}
+
+/// An eigenvalue function of a state matrix (α or ρ): how its eigen-triple is found, its value
+/// from the eigenvalue, its value for a 0×0 matrix.
+struct EigenFunction {
+    triple: fn(MatRef<'_, f64>) -> Option<ExtremeEigen>,
+    value: fn(c64) -> f64,
+    empty: f64,
+}
+
+const ABSCISSA: EigenFunction = EigenFunction { triple: rightmost_eigen, value: |l| l.re, empty: f64::NEG_INFINITY };
+const RADIUS: EigenFunction = EigenFunction { triple: largest_modulus_eigen, value: |l| l.norm(), empty: 0.0 };
+
+/// `f`(Acl) and its gradient through the closed loop's chain rule.
+fn closed_loop_eigen_grad(
+    plant: &Plant,
+    k: &Controller,
+    f: &EigenFunction,
+) -> Result<(f64, ControllerGradient), LtiError> {
+    let cl = ClosedLoop::new(plant, k)?;
+    Ok(match (f.triple)(cl.sys.a.as_ref()) {
+        Some(e) => ((f.value)(e.lambda), cl.chain_rule(&e.u, &e.v_scaled, None)),
+        None => (f64::INFINITY, nan_like(k)),
+    })
+}
+
+/// `f`(Ak) and its gradient (only the Ak block is nonzero).
+fn controller_eigen_grad(k: &Controller, f: &EigenFunction) -> (f64, ControllerGradient) {
     let nk = k.order();
     if nk == 0 {
-        return (f64::NEG_INFINITY, Controller::zeros(0, k.outputs(), k.inputs()));
+        return (f.empty, Controller::zeros(0, k.outputs(), k.inputs()));
     }
-    match rightmost_eigen(k.ak.as_ref()) {
+    match (f.triple)(k.ak.as_ref()) {
         Some(e) => {
             let mut g = Controller::zeros(nk, k.outputs(), k.inputs());
-            g.ak = Mat::from_fn(nk, nk, |i, j| (e.u[i].conj() * e.v_scaled[j]).re);
-            (e.alpha, g)
+            g.ak = e.real_gradient();
+            ((f.value)(e.lambda), g)
         }
         None => (f64::INFINITY, nan_like(k)),
     }
