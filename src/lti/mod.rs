@@ -1,5 +1,6 @@
 //! Linear time-invariant systems: plants, controllers, closed loops, spectral abscissa, the H∞
-//! norm, their gradients with respect to the controller, and the full-order H∞ bound.
+//! norm, their gradients with respect to the controller, and the full-order H∞ bound; in
+//! discrete time the spectral radius and the H∞ norm on the unit circle with their gradients.
 //!
 //! The parts, each in its folder, from the bottom up (a part imports only parts below it,
 //! `tests/module_graph.rs`; docs/ARCHITECTURE.md §1):
@@ -47,6 +48,9 @@ pub use kernels::spectral::{
     is_schur_stable, is_schur_stable_with_margin, is_stable, is_stable_with_margin, spectral_abscissa,
     spectral_abscissa_grad, spectral_radius, spectral_radius_grad, stability_margin, MIN_EIGVEC_COSINE,
     STABILITY_MARGIN_RTOL,
+};
+pub use norms::discrete::{
+    closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete, hinf_norm_grad_discrete,
 };
 pub use norms::gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_radius_grad, controller_abscissa_grad,
