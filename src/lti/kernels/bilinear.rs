@@ -1,5 +1,5 @@
 //! The bilinear (Cayley) transform of a discrete-time system into a continuous-time one with the
-//! same frequency response on the boundary (docs/ALGORITHMS.md §11.2): the discrete H∞ norm is
+//! same frequency response on the boundary (docs/ALGORITHMS.md §10.2): the discrete H∞ norm is
 //! the continuous norm of the image.
 //!
 //! The Möbius map z = (1 + s)/(1 − s) sends the imaginary axis s = iω onto the unit circle

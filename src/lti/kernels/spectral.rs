@@ -1,5 +1,5 @@
 //! Spectral abscissa α(M) = max Re λ(M), spectral radius ρ(M) = max |λ(M)| and their gradients
-//! (docs/ALGORITHMS.md §4, §11.1).
+//! (docs/ALGORITHMS.md §4, §10.1).
 //!
 //! For a simple eigenvalue λ with right eigenvector v (M v = λ v) and left eigenvector u
 //! (uᴴ M = λ uᴴ), first-order perturbation theory gives dλ = uᴴ dM v / (uᴴ v), hence

@@ -1,6 +1,6 @@
 //! The H∞ norm of a discrete-time system, ‖G‖∞ = sup_{θ ∈ [0, π]} σmax(G(e^{iθ})) with
 //! G(z) = C(zI − A)⁻¹B + D, its peak frequency θ (rad/sample; ω = θ/Ts rad/s for a sampling
-//! time Ts), and its gradients (docs/ALGORITHMS.md §11).
+//! time Ts), and its gradients (docs/ALGORITHMS.md §10).
 //!
 //! # Method: the bilinear transform, then the continuous norm
 //! 1. ρ(A) ≥ 1 (the spectral radius, `spectral.rs`; any pole on or outside the unit circle) or

@@ -47,7 +47,7 @@ pub fn closed_loop_abscissa_grad(plant: &Plant, k: &Controller) -> Result<(f64, 
 }
 
 /// ρ(Acl) and its gradient, for a discrete-time plant with a discrete-time controller (the same
-/// closed loop as in continuous time, docs/ALGORITHMS.md §11.1); as
+/// closed loop as in continuous time, docs/ALGORITHMS.md §10.1); as
 /// [`closed_loop_abscissa_grad`] otherwise.
 pub fn closed_loop_radius_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
     closed_loop_eigen_grad(plant, k, &RADIUS)
