@@ -22,6 +22,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde_json::Value;
 
+mod common;
+use common::add_modal_pair;
+
 /// Relative agreement required with the reference values.
 const REL_TOL: f64 = 1e-8;
 
@@ -224,17 +227,7 @@ fn sigma_modal(mb: &Member, theta: f64) -> f64 {
             }
             i += 1;
         } else {
-            // (zI − [σ ω; −ω σ])⁻¹ = [w, ω; −ω, w]/(w² + ω²) with w = z − σ.
-            let (w, om) = (z - l.re, l.im);
-            let det = w * w + om * om;
-            let (m00, m01, m10, m11) = (w / det, c64::new(om, 0.0) / det, c64::new(-om, 0.0) / det, w / det);
-            for a in 0..p {
-                let (c0, c1) = (mb.c_modal[(a, i)], mb.c_modal[(a, i + 1)]);
-                for b in 0..m {
-                    let (b0, b1) = (mb.b_modal[(i, b)], mb.b_modal[(i + 1, b)]);
-                    g[(a, b)] += (m00 * b0 + m01 * b1) * c0 + (m10 * b0 + m11 * b1) * c1;
-                }
-            }
+            add_modal_pair(&mut g, z, (l.re, l.im), &mb.c_modal, &mb.b_modal, i);
             i += 2;
         }
     }
