@@ -28,6 +28,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
+mod common;
+use common::add_modal_pair;
+
 /// Allowed relative shortfall of `hinf_norm` below the truth: the norm's tolerance plus the
 /// rounding difference between two evaluations of σmax(G(iω)) by different methods, plus
 /// [`EVAL_ERROR_FACTOR`]·ρ (see [`eval_error`]).
@@ -255,18 +258,7 @@ fn sigma_modal(mb: &Member, w: f64) -> f64 {
                 }
                 i += 1;
             } else {
-                // (iωI − [σ ω₀; −ω₀ σ])⁻¹ = [z −ω₀; ω₀ z]⁻¹·... with z = iω − σ: inverse of
-                // [z, −ω₀; ω₀, z] is [z, ω₀; −ω₀, z]/(z² + ω₀²).
-                let z = iw - re;
-                let det = z * z + im * im;
-                let (m00, m01, m10, m11) = (z / det, c64::new(im, 0.0) / det, c64::new(-im, 0.0) / det, z / det);
-                for a in 0..p {
-                    let (c0, c1) = (mb.c_modal[(a, i)], mb.c_modal[(a, i + 1)]);
-                    for b in 0..m {
-                        let (b0, b1) = (mb.b_modal[(i, b)], mb.b_modal[(i + 1, b)]);
-                        g[(a, b)] += (m00 * b0 + m01 * b1) * c0 + (m10 * b0 + m11 * b1) * c1;
-                    }
-                }
+                add_modal_pair(&mut g, iw, (re, im), &mb.c_modal, &mb.b_modal, i);
                 i += 2;
             }
         }

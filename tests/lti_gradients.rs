@@ -1,10 +1,13 @@
 //! Central finite-difference checks of every gradient (α_cl, α_K, ‖Tzw‖∞, ‖K‖∞) at seeded random
-//! points, with D22 = 0 and D22 ≠ 0, nk = 0 and nk > 0; plus the ill-posed loop.
+//! points, with D22 = 0 and D22 ≠ 0, nk = 0 and nk > 0; the same in discrete time (ρ_cl, ρ_K and
+//! the norms on the unit circle); plus the ill-posed loop.
 
 use faer::Mat;
 use hinfix::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    hinf_norm, spectral_abscissa, Controller, Dims, HinfParams, LtiError, Plant,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_discrete,
+    closed_loop_radius_grad, controller_abscissa_grad, controller_hinf_grad, controller_hinf_grad_discrete,
+    controller_radius_grad, hinf_norm, hinf_norm_discrete, hinf_norm_grad_discrete, spectral_abscissa, spectral_radius,
+    Controller, Dims, HinfParams, LtiError, Plant, StateSpace,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -138,6 +141,64 @@ fn gradients_match_finite_differences() {
         check_fd(&format!("{label} ‖K‖∞"), &k, &g, |kk| controller_hinf_grad(kk, FD_HINF_TOL).0.value);
     }
     assert!(checked_hinf >= 6, "too few stable random loops ({checked_hinf})");
+}
+
+/// `a` scaled to spectral radius `rho`, times `sign` (−1 puts the dominant poles of the Hurwitz
+/// matrices above, mostly real negative, near z = +ρ instead of z = −ρ).
+fn schur(a: &Mat<f64>, rho: f64, sign: f64) -> Mat<f64> {
+    a * faer::Scale(sign * rho / spectral_radius(a.as_ref()))
+}
+
+/// Discrete time: ρ(Acl), ρ(Ak), ‖Tzw‖∞ and ‖K‖∞ on the unit circle against central differences,
+/// dominant poles near z = −1 and near z = +1 (both sides of the bilinear transform's choice);
+/// the system-matrix gradient of `hinf_norm_grad_discrete` is the controller's own.
+#[test]
+fn discrete_time_gradients_match_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(20261205);
+    let params = HinfParams::new(FD_HINF_TOL);
+    let mut checked_hinf = 0;
+    for case in 0..12 {
+        let d22 = case % 2 == 1;
+        let sign = if case % 4 < 2 { 1.0 } else { -1.0 };
+        let nk = [0, 1, 2, 3][case / 3 % 4];
+        let (n, m1, m2, p1, p2) = [(4, 2, 1, 2, 1), (5, 2, 2, 3, 2), (6, 1, 2, 2, 3)][case % 3];
+        let mut plant = random_plant(&mut rng, n, m1, m2, p1, p2, d22);
+        plant.a = schur(&plant.a, 0.5, sign);
+        let mut k = random_controller(&mut rng, nk, m2, p2);
+        if nk > 0 {
+            k.ak = schur(&k.ak, 0.7, -sign);
+        }
+        let label = format!("discrete case {case} (n={n}, nk={nk}, D22≠0: {d22}, sign {sign})");
+
+        let (rho, g) = closed_loop_radius_grad(&plant, &k).unwrap();
+        check_fd(&format!("{label} ρ_cl"), &k, &g, |kk| spectral_radius(closed_loop(&plant, kk).unwrap().a.as_ref()));
+        let (h, g) = closed_loop_hinf_grad_discrete(&plant, &k, &params).unwrap();
+        if rho < 1.0 {
+            assert!(h.value.is_finite() && (0.0..=std::f64::consts::PI).contains(&h.peak_freq), "{label}: {h:?}");
+            check_fd(&format!("{label} ‖Tzw‖∞ (peak θ = {})", h.peak_freq), &k, &g, |kk| {
+                hinf_norm_discrete(&closed_loop(&plant, kk).unwrap(), &params).unwrap().value
+            });
+            checked_hinf += 1;
+        } else {
+            assert_eq!(h.value, f64::INFINITY, "{label}");
+            assert!(g.dk[(0, 0)].is_nan());
+        }
+        let (rho_k, g) = controller_radius_grad(&k);
+        if nk == 0 {
+            assert_eq!(rho_k, 0.0);
+        } else {
+            assert!((rho_k - 0.7).abs() < 1e-12, "{label}: ρ(Ak) = {rho_k}");
+            check_fd(&format!("{label} ρ_K"), &k, &g, |kk| spectral_radius(kk.ak.as_ref()));
+        }
+        let (hk, g) = controller_hinf_grad_discrete(&k, FD_HINF_TOL);
+        assert!(hk.value.is_finite());
+        check_fd(&format!("{label} ‖K‖∞"), &k, &g, |kk| controller_hinf_grad_discrete(kk, FD_HINF_TOL).0.value);
+        let ks = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
+        let (hs, gs) = hinf_norm_grad_discrete(&ks, &params).unwrap();
+        assert_eq!(hs, hk, "{label}");
+        assert_eq!((gs.a, gs.b, gs.c, gs.d), (g.ak, g.bk, g.ck, g.dk), "{label}");
+    }
+    assert!(checked_hinf >= 6, "too few stable random discrete loops ({checked_hinf})");
 }
 
 /// From closed-loop order 30 on, the H∞ gradient's vectors come from the norm's Hessenberg form

@@ -1,5 +1,6 @@
 //! Linear time-invariant systems: plants, controllers, closed loops, spectral abscissa, the H∞
-//! norm, their gradients with respect to the controller, and the full-order H∞ bound.
+//! norm, their gradients with respect to the controller, and the full-order H∞ bound; in
+//! discrete time the spectral radius and the H∞ norm on the unit circle with their gradients.
 //!
 //! The parts, each in its folder, from the bottom up (a part imports only parts below it,
 //! `tests/module_graph.rs`; docs/ARCHITECTURE.md §1):
@@ -44,12 +45,16 @@ pub use kernels::riccati::{care_residual, solve_care, CareSolution, RiccatiError
 pub(crate) use kernels::spectral::abscissa_of;
 pub(crate) use kernels::spectral::eigenvalues as eigenvalues_of;
 pub use kernels::spectral::{
-    is_stable, is_stable_with_margin, spectral_abscissa, spectral_abscissa_grad, stability_margin, MIN_EIGVEC_COSINE,
+    is_schur_stable, is_schur_stable_with_margin, is_stable, is_stable_with_margin, spectral_abscissa,
+    spectral_abscissa_grad, spectral_radius, spectral_radius_grad, stability_margin, MIN_EIGVEC_COSINE,
     STABILITY_MARGIN_RTOL,
 };
+pub use norms::discrete::{
+    closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete, hinf_norm_grad_discrete,
+};
 pub use norms::gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    ControllerGradient,
+    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_radius_grad, controller_abscissa_grad,
+    controller_hinf_grad, controller_radius_grad, ControllerGradient,
 };
 pub(crate) use norms::hinf::hinf_norm_with_poles;
 pub use norms::hinf::{
@@ -62,8 +67,8 @@ pub use synthesis::balanced_truncation::{
 };
 pub use synthesis::central_controller::{CentralError, CentralProblem, GAMMA_OPT_RTOL, START_REGULARISATION};
 pub use synthesis::full_order::{
-    full_order_gamma, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma, FullOrderOptions, Regularisation,
-    FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
+    full_order_gamma, full_order_gamma_discrete, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma,
+    FullOrderOptions, Regularisation, FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
 pub use system::closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use system::controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};

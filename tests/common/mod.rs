@@ -223,3 +223,28 @@ pub fn fake_campaign_bin() -> std::path::PathBuf {
     }
     bin
 }
+
+/// Adds the contribution of one complex modal pair to a transfer matrix g at the point s
+/// (s = iω or z = e^{iθ}): C₂(sI − [σ ω₀; −ω₀ σ])⁻¹B₂ with C₂ = columns i, i + 1 of `c_modal`
+/// and B₂ = rows i, i + 1 of `b_modal`. With w = s − σ, the inverse of [w, −ω₀; ω₀, w] is
+/// [w, ω₀; −ω₀, w]/(w² + ω₀²).
+pub fn add_modal_pair(
+    g: &mut faer::Mat<faer::c64>,
+    s: faer::c64,
+    (re, im): (f64, f64),
+    c_modal: &faer::Mat<f64>,
+    b_modal: &faer::Mat<f64>,
+    i: usize,
+) {
+    use faer::c64;
+    let z = s - re;
+    let det = z * z + im * im;
+    let (m00, m01, m10, m11) = (z / det, c64::new(im, 0.0) / det, c64::new(-im, 0.0) / det, z / det);
+    for a in 0..g.nrows() {
+        let (c0, c1) = (c_modal[(a, i)], c_modal[(a, i + 1)]);
+        for b in 0..g.ncols() {
+            let (b0, b1) = (b_modal[(i, b)], b_modal[(i + 1, b)]);
+            g[(a, b)] += (m00 * b0 + m01 * b1) * c0 + (m10 * b0 + m11 * b1) * c1;
+        }
+    }
+}

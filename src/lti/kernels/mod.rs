@@ -8,6 +8,8 @@
 //! * the Hamiltonian level sets of the H∞ norm: `square_reduced.rs` (Van Loan's square-reduced
 //!   method), its PVL reduction `pvl_update.rs`, and the pencil form used near a singular
 //!   γ²I − DᵀD, `level_set_pencil.rs`;
+//! * discrete time: `bilinear.rs` (the Cayley transform to a continuous-time system with the
+//!   same response on the boundary, for the discrete H∞ norm);
 //! * matrix equations: `lyapunov.rs`, `riccati.rs` (and the stable/antistable splitting);
 //! * `step_stats.rs`: per-thread counters (and optional CPU times) of these steps, for the
 //!   benches; no computed value depends on them.
@@ -15,6 +17,7 @@
 //! Imports `system` (for [`StateSpace`](crate::lti::StateSpace)) and the shared `error`,
 //! `interrupt`; never `norms` or `synthesis`.
 
+pub(crate) mod bilinear;
 pub(crate) mod freq_response;
 pub(crate) mod hessenberg_qr;
 pub(crate) mod hessenberg_solve;

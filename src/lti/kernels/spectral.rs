@@ -1,10 +1,17 @@
-//! Spectral abscissa α(M) = max Re λ(M) and its gradient (docs/ALGORITHMS.md §4).
+//! Spectral abscissa α(M) = max Re λ(M), spectral radius ρ(M) = max |λ(M)| and their gradients
+//! (docs/ALGORITHMS.md §4, §10.1).
 //!
 //! For a simple eigenvalue λ with right eigenvector v (M v = λ v) and left eigenvector u
 //! (uᴴ M = λ uᴴ), first-order perturbation theory gives dλ = uᴴ dM v / (uᴴ v), hence
 //!
 //! ```text
 //! ∇α(M) = Re( ū vᵀ ) / (uᴴ v)      (a real matrix; ⟨G, dM⟩ = Σ G_ij dM_ij)
+//! ```
+//!
+//! and, for the eigenvalue λ of largest modulus (d|λ| = Re(λ̄ dλ)/|λ|),
+//!
+//! ```text
+//! ∇ρ(M) = Re( (λ̄/|λ|) ū vᵀ ) / (uᴴ v)
 //! ```
 //!
 //! (Burke, Henrion, Lewis & Overton, "HIFOO — a MATLAB package for fixed-order controller design
@@ -21,7 +28,9 @@
 //!   the direction and bound the magnitude: |uᴴv| is replaced by
 //!   max(|uᴴv|, [`MIN_EIGVEC_COSINE`]·‖u‖‖v‖) with the phase of uᴴv kept, so the gradient is
 //!   always finite (‖∇α‖ ≤ 1/MIN_EIGVEC_COSINE) and points the right way.
-//! * **NaN / Inf** entries, or an eigensolver failure: α = +∞ (treated as unstable).
+//! * **NaN / Inf** entries, or an eigensolver failure: α = +∞ (treated as unstable); so is ρ.
+//! * The same rules hold for ρ (pairs: the member with Im λ > 0; ties in |λ|, e.g. λ and −λ: the
+//!   first; the same regularised uᴴv).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{self, ComputeEigenvectors};
@@ -83,6 +92,31 @@ pub fn is_stable_with_margin(alpha: f64, a: MatRef<'_, f64>) -> bool {
     alpha < -stability_margin(a)
 }
 
+/// ρ(A) = max |λ(A)|, the spectral radius (the discrete-time counterpart of
+/// [`spectral_abscissa`]): 0 for a 0×0 matrix (no dynamics), +∞ if A has non-finite entries or
+/// the eigensolver fails. Same eigenvalues as [`spectral_abscissa`].
+pub fn spectral_radius(a: MatRef<'_, f64>) -> f64 {
+    match eigenvalues(a) {
+        Some(ev) => radius_of(&ev),
+        None => f64::INFINITY,
+    }
+}
+
+/// Whether a discrete-time system with spectral radius `rho` (= ρ(A), from [`spectral_radius`])
+/// is (asymptotically) stable: ρ < 1, **strictly** (a pole on the unit circle makes the H∞ norm
+/// infinite). NaN is not stable; 0 (an empty matrix) is. The optimiser's test, as
+/// [`is_stable`] is in continuous time.
+pub fn is_schur_stable(rho: f64) -> bool {
+    rho < 1.0
+}
+
+/// Whether a discrete-time system of state matrix `a` with spectral radius `rho` is stable with
+/// the verification margin: ρ < 1 − [`stability_margin`]`(a)` (the eigenvalues' rounding error
+/// is absolute, of order ε‖A‖, as in [`is_stable_with_margin`]). NaN is not stable.
+pub fn is_schur_stable_with_margin(rho: f64, a: MatRef<'_, f64>) -> bool {
+    rho < 1.0 - stability_margin(a)
+}
+
 /// Eigenvalues of a real square matrix; `None` on non-finite input or failure. From n =
 /// [`HESSENBERG_QR_FROM`] on by a Hessenberg reduction and our Francis QR (`hessenberg_qr.rs`,
 /// faster than faer's `evd_real` and exactly the poles the H∞ norm uses), below it by faer.
@@ -123,20 +157,54 @@ pub(crate) fn abscissa_of(ev: &[c64]) -> f64 {
     alpha
 }
 
-/// The rightmost eigenvalue with its left and right eigenvectors.
+/// max |λ| over a spectrum (0 for an empty one); +∞ if any eigenvalue is not finite.
+pub(crate) fn radius_of(ev: &[c64]) -> f64 {
+    let mut rho = 0.0f64;
+    for l in ev {
+        if !(l.re.is_finite() && l.im.is_finite()) {
+            return f64::INFINITY;
+        }
+        rho = rho.max(l.re.hypot(l.im));
+    }
+    rho
+}
+
+/// An extreme eigenvalue (the rightmost, or one of largest modulus) with its left and right
+/// eigenvectors.
 #[derive(Debug, Clone)]
-pub(crate) struct RightmostEigen {
-    /// α = Re λ.
-    pub alpha: f64,
+pub(crate) struct ExtremeEigen {
+    /// The eigenvalue λ (the member with Im λ ≥ 0 of a conjugate pair).
+    pub lambda: c64,
     /// Left eigenvector u (uᴴ A = λ uᴴ).
     pub u: Vec<c64>,
     /// Right eigenvector v scaled by 1/(uᴴv) (regularised, see the module docs), so that
-    /// ∇α = Re(ū vᵀ).
+    /// ∇α = Re(ū vᵀ); for the spectral radius ([`largest_modulus_eigen`]) further by λ̄/|λ|, so
+    /// that ∇ρ = Re(ū vᵀ).
     pub v_scaled: Vec<c64>,
 }
 
 /// Rightmost eigen-triple of A (n ≥ 1); `None` for non-finite input or eigensolver failure.
-pub(crate) fn rightmost_eigen(a: MatRef<'_, f64>) -> Option<RightmostEigen> {
+pub(crate) fn rightmost_eigen(a: MatRef<'_, f64>) -> Option<ExtremeEigen> {
+    extreme_eigen(a, |re, _| re)
+}
+
+/// Eigen-triple of A (n ≥ 1) of largest modulus |λ| = ρ(A), with `v_scaled` also multiplied by
+/// the phase λ̄/|λ| (1 for λ = 0), so that ∇ρ = Re(ū vᵀ) (module docs); `None` for non-finite
+/// input or eigensolver failure.
+pub(crate) fn largest_modulus_eigen(a: MatRef<'_, f64>) -> Option<ExtremeEigen> {
+    let mut e = extreme_eigen(a, f64::hypot)?;
+    let r = e.lambda.norm();
+    if r > 0.0 {
+        let phase = e.lambda.conj() * (1.0 / r);
+        e.v_scaled.iter_mut().for_each(|z| *z *= phase);
+    }
+    Some(e)
+}
+
+/// The eigen-triple of A (n ≥ 1) maximising `key(Re λ, Im λ)` (the first on ties; `key` must
+/// give both members of a conjugate pair the same value), right eigenvector scaled by 1/(uᴴv);
+/// `None` for non-finite input or eigensolver failure.
+fn extreme_eigen(a: MatRef<'_, f64>, key: impl Fn(f64, f64) -> f64) -> Option<ExtremeEigen> {
     let n = a.nrows();
     if n == 0 || !crate::numeric::all_finite(a) {
         return None;
@@ -169,7 +237,7 @@ pub(crate) fn rightmost_eigen(a: MatRef<'_, f64>) -> Option<RightmostEigen> {
         if !(wr[i].is_finite() && wi[i].is_finite()) {
             return None;
         }
-        if wr[i] > wr[k] {
+        if key(wr[i], wi[i]) > key(wr[k], wi[k]) {
             k = i;
         }
     }
@@ -199,14 +267,29 @@ pub(crate) fn rightmost_eigen(a: MatRef<'_, f64>) -> Option<RightmostEigen> {
     // ∇α = Re(ū vᵀ / s): fold 1/s into v.
     let sinv = s.inv();
     let v_scaled = v.into_iter().map(|z| z * sinv).collect();
-    Some(RightmostEigen { alpha: wr[k], u, v_scaled })
+    Some(ExtremeEigen { lambda: c64::new(wr[k], wi[k].abs()), u, v_scaled })
 }
 
 /// ∇α(A) as a dense real matrix Re(ū vᵀ)/(uᴴv); `None` where α is +∞.
 pub fn spectral_abscissa_grad(a: MatRef<'_, f64>) -> Option<(f64, Mat<f64>)> {
     let e = rightmost_eigen(a)?;
-    let n = a.nrows();
-    Some((e.alpha, Mat::from_fn(n, n, |i, j| (e.u[i].conj() * e.v_scaled[j]).re)))
+    Some((e.lambda.re, e.real_gradient()))
+}
+
+impl ExtremeEigen {
+    /// The real matrix Re(ū vᵀ) (with `v_scaled` for v): ∇α or ∇ρ.
+    pub(crate) fn real_gradient(&self) -> Mat<f64> {
+        let n = self.u.len();
+        Mat::from_fn(n, n, |i, j| (self.u[i].conj() * self.v_scaled[j]).re)
+    }
+}
+
+/// ∇ρ(A) as a dense real matrix Re((λ̄/|λ|) ū vᵀ)/(uᴴv) for the eigenvalue λ of largest modulus
+/// (module docs); `None` where ρ is +∞ or A is 0×0. At ρ = 0 (A nilpotent) ρ is not
+/// differentiable and the phase λ̄/|λ| is taken as 1.
+pub fn spectral_radius_grad(a: MatRef<'_, f64>) -> Option<(f64, Mat<f64>)> {
+    let e = largest_modulus_eigen(a)?;
+    Some((e.lambda.norm(), e.real_gradient()))
 }
 
 #[cfg(test)]
@@ -273,5 +356,96 @@ mod tests {
         let (alpha, g) = spectral_abscissa_grad(a.as_ref()).unwrap();
         assert!((alpha + 1.0).abs() < 1e-4);
         assert!((0..3).all(|i| (0..3).all(|j| g[(i, j)].is_finite())));
+    }
+
+    /// A dense 3×3 from rows.
+    fn m3(rows: [[f64; 3]; 3]) -> Mat<f64> {
+        Mat::from_fn(3, 3, |i, j| rows[i][j])
+    }
+
+    /// Central differences of `f` against the gradient `g`, entry by entry.
+    fn assert_fd(a: &Mat<f64>, g: &Mat<f64>, f: impl Fn(MatRef<'_, f64>) -> f64, tol: f64) {
+        let h = 1e-6;
+        for i in 0..a.nrows() {
+            for j in 0..a.ncols() {
+                let (mut ap, mut am) = (a.clone(), a.clone());
+                ap[(i, j)] += h;
+                am[(i, j)] -= h;
+                let fd = (f(ap.as_ref()) - f(am.as_ref())) / (2.0 * h);
+                assert!((fd - g[(i, j)]).abs() < tol, "({i},{j}) fd {fd} vs {}", g[(i, j)]);
+            }
+        }
+    }
+
+    /// Diagonal A: ρ = max |aᵢᵢ| and ∇ρ = sign(aₖₖ) eₖeₖᵀ, a negative dominant eigenvalue included.
+    #[test]
+    fn radius_of_a_diagonal_matrix() {
+        let a = m3([[0.3, 0.0, 0.0], [0.0, -0.8, 0.0], [0.0, 0.0, 0.5]]);
+        assert_eq!(spectral_radius(a.as_ref()), 0.8);
+        let (rho, g) = spectral_radius_grad(a.as_ref()).unwrap();
+        assert_eq!(rho, 0.8);
+        for i in 0..3 {
+            for j in 0..3 {
+                let want = if (i, j) == (1, 1) { -1.0 } else { 0.0 };
+                assert!((g[(i, j)] - want).abs() < 1e-14, "({i},{j}) {}", g[(i, j)]);
+            }
+        }
+        assert!(is_schur_stable(rho) && !is_schur_stable(1.0) && !is_schur_stable(f64::NAN));
+        assert!(is_schur_stable_with_margin(rho, a.as_ref()));
+        assert!(!is_schur_stable_with_margin(1.0 - 1e-15, a.as_ref()));
+    }
+
+    /// For a 2×2 block with a complex pair, |λ|² = det A, so ρ = √det A and ∇ρ = (ρ/2)·A⁻ᵀ; for
+    /// A = r·R(φ), a scaled rotation, ∇ρ = R(φ)/2. Also a non-normal block, and the block embedded
+    /// beside a smaller real eigenvalue.
+    #[test]
+    fn radius_gradient_of_rotation_blocks() {
+        let (r, phi) = (0.9f64, 2.3f64);
+        let (c, s) = (phi.cos(), phi.sin());
+        let rot = m3([[r * c, -r * s, 0.0], [r * s, r * c, 0.0], [0.0, 0.0, -0.4]]);
+        let (rho, g) = spectral_radius_grad(rot.as_ref()).unwrap();
+        assert!((rho - r).abs() < 1e-15);
+        let want = [[c / 2.0, -s / 2.0, 0.0], [s / 2.0, c / 2.0, 0.0], [0.0, 0.0, 0.0]];
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((g[(i, j)] - want[i][j]).abs() < 1e-14, "({i},{j}) {} vs {}", g[(i, j)], want[i][j]);
+            }
+        }
+        // Non-normal 2×2 with a complex pair: det = 0.52, trace² − 4 det < 0.
+        let a = Mat::from_fn(2, 2, |i, j| [[0.2, 3.0], [-0.16, 0.4]][i][j]);
+        let det = 0.2 * 0.4 + 3.0 * 0.16;
+        let (rho, g) = spectral_radius_grad(a.as_ref()).unwrap();
+        assert!((rho - f64::sqrt(det)).abs() < 1e-14);
+        // (ρ/2)·A⁻ᵀ = (ρ/2)/det · [[a11, −a10], [−a01, a00]]
+        let want = [[0.4, 0.16], [-3.0, 0.2]];
+        for i in 0..2 {
+            for j in 0..2 {
+                let w = rho / 2.0 / det * want[i][j];
+                assert!((g[(i, j)] - w).abs() < 1e-13, "({i},{j}) {} vs {w}", g[(i, j)]);
+            }
+        }
+    }
+
+    /// ∇ρ against central differences: a dominant complex pair, a dominant negative real
+    /// eigenvalue; and the empty, NaN and nilpotent cases.
+    #[test]
+    fn radius_gradient_matches_fd() {
+        let pair = m3([[0.5, 0.6, 0.3], [-0.5, 0.4, 0.1], [0.2, 0.1, -0.3]]);
+        let real = m3([[-0.9, 0.2, 0.3], [0.1, 0.4, 0.1], [0.2, -0.3, 0.1]]);
+        for a in [pair, real] {
+            let (rho, g) = spectral_radius_grad(a.as_ref()).unwrap();
+            assert!((rho - spectral_radius(a.as_ref())).abs() < 1e-14);
+            assert_fd(&a, &g, spectral_radius, 1e-7);
+        }
+        assert_eq!(spectral_radius(Mat::<f64>::zeros(0, 0).as_ref()), 0.0);
+        assert!(spectral_radius_grad(Mat::<f64>::zeros(0, 0).as_ref()).is_none());
+        let mut a = Mat::<f64>::identity(2, 2);
+        a[(0, 1)] = f64::NAN;
+        assert_eq!(spectral_radius(a.as_ref()), f64::INFINITY);
+        assert!(spectral_radius_grad(a.as_ref()).is_none());
+        let nil = Mat::from_fn(2, 2, |i, j| if (i, j) == (0, 1) { 1.0 } else { 0.0 });
+        let (rho, g) = spectral_radius_grad(nil.as_ref()).unwrap();
+        assert_eq!(rho, 0.0);
+        assert!((0..2).all(|i| (0..2).all(|j| g[(i, j)].is_finite())));
     }
 }

@@ -30,7 +30,7 @@ use super::hinf::{hinf_norm_reusing, HinfNorm, HinfParams};
 use crate::lti::error::LtiError;
 use crate::lti::kernels::freq_response::FreqResponse;
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
-use crate::lti::kernels::spectral::rightmost_eigen;
+use crate::lti::kernels::spectral::{largest_modulus_eigen, rightmost_eigen, ExtremeEigen};
 use crate::lti::kernels::step_stats::{for_order, timed, Step};
 use crate::lti::system::closed_loop::ClosedLoop;
 use crate::lti::system::controller::Controller;
@@ -43,24 +43,63 @@ pub type ControllerGradient = Controller;
 /// α(Acl) and its gradient. α is finite for unstable loops; +∞ with a NaN gradient if the
 /// eigensolver fails or the loop has non-finite entries. Err(IllPosed) for an ill-posed loop.
 pub fn closed_loop_abscissa_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
-    let cl = ClosedLoop::new(plant, k)?;
-    Ok(match rightmost_eigen(cl.sys.a.as_ref()) {
-        Some(e) => (e.alpha, cl.chain_rule(&e.u, &e.v_scaled, None)),
-        None => (f64::INFINITY, nan_like(k)),
-    })
+    closed_loop_eigen_grad(plant, k, &ABSCISSA)
+}
+
+/// ρ(Acl) and its gradient, for a discrete-time plant with a discrete-time controller (the same
+/// closed loop as in continuous time, docs/ALGORITHMS.md §10.1); as
+/// [`closed_loop_abscissa_grad`] otherwise.
+pub fn closed_loop_radius_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
+    closed_loop_eigen_grad(plant, k, &RADIUS)
 }
 
 /// α(Ak) and its gradient (only the Ak block is nonzero); nk = 0: (−∞, zeros).
 pub fn controller_abscissa_grad(k: &Controller) -> (f64, ControllerGradient) {
+    controller_eigen_grad(k, &ABSCISSA)
+}
+
+/// ρ(Ak) and its gradient (only the Ak block is nonzero); nk = 0: (0, zeros) (a static
+/// controller has no dynamics). The strong-stabilisation constraint of a discrete-time design is
+/// ρ(Ak) < 1.
+pub fn controller_radius_grad(k: &Controller) -> (f64, ControllerGradient) {
+    controller_eigen_grad(k, &RADIUS)
+}
+
+/// An eigenvalue function of a state matrix (α or ρ): how its eigen-triple is found, its value
+/// from the eigenvalue, its value for a 0×0 matrix.
+struct EigenFunction {
+    triple: fn(MatRef<'_, f64>) -> Option<ExtremeEigen>,
+    value: fn(c64) -> f64,
+    empty: f64,
+}
+
+const ABSCISSA: EigenFunction = EigenFunction { triple: rightmost_eigen, value: |l| l.re, empty: f64::NEG_INFINITY };
+const RADIUS: EigenFunction = EigenFunction { triple: largest_modulus_eigen, value: |l| l.norm(), empty: 0.0 };
+
+/// `f`(Acl) and its gradient through the closed loop's chain rule.
+fn closed_loop_eigen_grad(
+    plant: &Plant,
+    k: &Controller,
+    f: &EigenFunction,
+) -> Result<(f64, ControllerGradient), LtiError> {
+    let cl = ClosedLoop::new(plant, k)?;
+    Ok(match (f.triple)(cl.sys.a.as_ref()) {
+        Some(e) => ((f.value)(e.lambda), cl.chain_rule(&e.u, &e.v_scaled, None)),
+        None => (f64::INFINITY, nan_like(k)),
+    })
+}
+
+/// `f`(Ak) and its gradient (only the Ak block is nonzero).
+fn controller_eigen_grad(k: &Controller, f: &EigenFunction) -> (f64, ControllerGradient) {
     let nk = k.order();
     if nk == 0 {
-        return (f64::NEG_INFINITY, Controller::zeros(0, k.outputs(), k.inputs()));
+        return (f.empty, Controller::zeros(0, k.outputs(), k.inputs()));
     }
-    match rightmost_eigen(k.ak.as_ref()) {
+    match (f.triple)(k.ak.as_ref()) {
         Some(e) => {
             let mut g = Controller::zeros(nk, k.outputs(), k.inputs());
-            g.ak = Mat::from_fn(nk, nk, |i, j| (e.u[i].conj() * e.v_scaled[j]).re);
-            (e.alpha, g)
+            g.ak = e.real_gradient();
+            ((f.value)(e.lambda), g)
         }
         None => (f64::INFINITY, nan_like(k)),
     }
@@ -79,27 +118,50 @@ pub fn closed_loop_hinf_grad(
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
     let kept = params.reuse.and_then(|slot| slot.take_for(&cl.sys));
-    Ok(match hinf_with_vectors(&cl.sys, params, kept)? {
+    Ok(closed_loop_grad_from(&cl, k, hinf_with_vectors(&cl.sys, params, kept)?))
+}
+
+/// The norm and gradient of the closed loop `cl` of `k` from the norm and the vectors at its peak
+/// (`None`: unstable).
+pub(crate) fn closed_loop_grad_from(
+    cl: &ClosedLoop<'_>,
+    k: &Controller,
+    peak: Option<(HinfNorm, Option<PeakVectors>)>,
+) -> (HinfNorm, ControllerGradient) {
+    match peak {
         Some((norm, Some(pv))) => (norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))),
         Some((norm, None)) => (norm, nan_like(k)),
         None => (HinfNorm::UNSTABLE, nan_like(k)),
-    })
+    }
 }
 
 /// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
 pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
-    let sys = StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
-    let Ok(Some((norm, Some(pv)))) = hinf_with_vectors(&sys, &HinfParams::new(tol), None) else {
+    controller_grad_from(k, hinf_with_vectors(&controller_system(k), &HinfParams::new(tol), None))
+}
+
+/// The controller (Ak, Bk, Ck, Dk) as a system.
+pub(crate) fn controller_system(k: &Controller) -> StateSpace {
+    StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() }
+}
+
+/// ‖K‖∞ and its gradient from the norm of `k` and the vectors at its peak.
+pub(crate) fn controller_grad_from(
+    k: &Controller,
+    peak: Result<Option<(HinfNorm, Option<PeakVectors>)>, LtiError>,
+) -> (HinfNorm, ControllerGradient) {
+    let Ok(Some((norm, Some(pv)))) = peak else {
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
+    let [ak, bk, ck, dk] = matrix_gradients(&pv);
+    (norm, Controller { ak, bk, ck, dk })
+}
+
+/// The gradients of σmax at the peak with respect to (A, B, C, D) of the system itself:
+/// Re(ā bᵀ), Re(ā vᵀ), Re(ū bᵀ), Re(ū vᵀ) (module docs).
+pub(crate) fn matrix_gradients(pv: &PeakVectors) -> [Mat<f64>; 4] {
     let outer = |x: &[c64], y: &[c64]| Mat::from_fn(x.len(), y.len(), |i, j| (x[i].conj() * y[j]).re);
-    let g = Controller {
-        ak: outer(&pv.a, &pv.b),
-        bk: outer(&pv.a, &pv.v),
-        ck: outer(&pv.u, &pv.b),
-        dk: outer(&pv.u, &pv.v),
-    };
-    (norm, g)
+    [outer(&pv.a, &pv.b), outer(&pv.a, &pv.v), outer(&pv.u, &pv.b), outer(&pv.u, &pv.v)]
 }
 
 /// Vectors of the H∞ gradient at the peak (module docs).
@@ -112,6 +174,8 @@ pub(crate) struct PeakVectors {
     pub a: Vec<c64>,
     /// b = Z⁻¹ B v (n); zero at ω = ∞.
     pub b: Vec<c64>,
+    /// σmax(G) at the point (0 if G is empty).
+    pub sigma: f64,
 }
 
 /// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `params.stop`
@@ -149,48 +213,72 @@ pub(crate) fn hinf_with_vectors(
 /// if the SVD fails or iωI − A is singular. From order [`HESSENBERG_QR_FROM`] on (measured: the
 /// dense LU was 2–3 % of a BDT2 or CM4 design run).
 fn peak_vectors_hessenberg(fr: &mut FreqResponse, w: f64) -> Option<PeakVectors> {
-    let (u, v) = leading_singular_pair(fr.eval(w))?;
+    let (u, v, sigma) = leading_singular_pair(fr.eval(w))?;
     let (a, b) = fr.transfer_vectors(w, &u, &v)?;
-    finite_vectors(PeakVectors { u, v, a, b })
+    finite_vectors(PeakVectors { u, v, a, b, sigma })
 }
 
-/// The leading singular pair (u, v) of G (p×m, both nonzero): G v = σmax u; `None` if the SVD
-/// fails.
-fn leading_singular_pair(g: MatRef<'_, c64>) -> Option<(Vec<c64>, Vec<c64>)> {
+/// The leading singular triple (u, v, σmax) of G (p×m, both nonzero): G v = σmax u; `None` if
+/// the SVD fails.
+fn leading_singular_pair(g: MatRef<'_, c64>) -> Option<(Vec<c64>, Vec<c64>, f64)> {
     let svd = g.thin_svd().ok()?;
     let s = svd.S();
     let k = (0..s.dim()).fold(0, |b, i| if s[i].re > s[b].re { i } else { b });
     let u = (0..g.nrows()).map(|i| svd.U()[(i, k)]).collect();
     let v = (0..g.ncols()).map(|j| svd.V()[(j, k)]).collect();
-    Some((u, v))
+    Some((u, v, s[k].re))
 }
 
 /// `pv` if all its entries are finite.
 fn finite_vectors(pv: PeakVectors) -> Option<PeakVectors> {
-    let PeakVectors { u, v, a, b } = &pv;
+    let PeakVectors { u, v, a, b, .. } = &pv;
     let finite = a.iter().chain(b).chain(u).chain(v).all(|z| z.re.is_finite() && z.im.is_finite());
     finite.then_some(pv)
 }
 
 /// u, v, a, b at frequency w (module docs); `None` if an SVD fails.
 pub(crate) fn peak_vectors(sys: &StateSpace, w: f64) -> Option<PeakVectors> {
+    peak_vectors_at(sys, w.is_finite().then_some(c64::new(0.0, w)))
+}
+
+/// u, v, a, b with Z = zI − A at the point z of the complex plane (`None`: z = ∞), for the
+/// continuous (z = iω) and the discrete (z = e^{iθ}) norm alike; `None` if an SVD fails.
+pub(crate) fn peak_vectors_at(sys: &StateSpace, z: Option<c64>) -> Option<PeakVectors> {
     let (n, m, p) = (sys.order(), sys.inputs(), sys.outputs());
     let cz = |x: f64| c64::new(x, 0.0);
     let zero = c64::new(0.0, 0.0);
-    let finite_w = w.is_finite() && n > 0;
-    let (g, lu_x) = if finite_w {
-        let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
-        let lu = z.partial_piv_lu();
-        let x = lu.solve(Mat::<c64>::from_fn(n, m, |i, j| cz(sys.b[(i, j)]))); // Z⁻¹B
-        let g = Mat::<c64>::from_fn(p, m, |i, j| (0..n).fold(cz(sys.d[(i, j)]), |s, k| s + x[(k, j)] * sys.c[(i, k)]));
-        (g, Some((lu, x)))
-    } else {
-        (Mat::<c64>::from_fn(p, m, |i, j| cz(sys.d[(i, j)])), None)
+    // (On the imaginary axis the diagonal is −a + iω exactly as it always was: no 0 − a.)
+    let entry = |z: c64, i: usize, j: usize| {
+        let a = sys.a[(i, j)];
+        if i != j {
+            c64::new(-a, 0.0)
+        } else if z.re == 0.0 {
+            c64::new(-a, z.im)
+        } else {
+            c64::new(z.re - a, z.im)
+        }
+    };
+    let (g, lu_x) = match z.filter(|_| n > 0) {
+        Some(z) => {
+            let zm = Mat::<c64>::from_fn(n, n, |i, j| entry(z, i, j));
+            let lu = zm.partial_piv_lu();
+            let x = lu.solve(Mat::<c64>::from_fn(n, m, |i, j| cz(sys.b[(i, j)]))); // Z⁻¹B
+            let g =
+                Mat::<c64>::from_fn(p, m, |i, j| (0..n).fold(cz(sys.d[(i, j)]), |s, k| s + x[(k, j)] * sys.c[(i, k)]));
+            (g, Some((lu, x)))
+        }
+        None => (Mat::<c64>::from_fn(p, m, |i, j| cz(sys.d[(i, j)])), None),
     };
     if p == 0 || m == 0 {
-        return Some(PeakVectors { u: vec![zero; p], v: vec![zero; m], a: vec![zero; n], b: vec![zero; n] });
+        return Some(PeakVectors {
+            u: vec![zero; p],
+            v: vec![zero; m],
+            a: vec![zero; n],
+            b: vec![zero; n],
+            sigma: 0.0,
+        });
     }
-    let (u, v) = leading_singular_pair(g.as_ref())?;
+    let (u, v, sigma) = leading_singular_pair(g.as_ref())?;
     let (a, b) = match lu_x {
         Some((lu, x)) => {
             let b: Vec<c64> = (0..n).map(|i| (0..m).fold(zero, |s, j| s + x[(i, j)] * v[j])).collect();
@@ -200,10 +288,10 @@ pub(crate) fn peak_vectors(sys: &StateSpace, w: f64) -> Option<PeakVectors> {
         }
         None => (vec![zero; n], vec![zero; n]),
     };
-    finite_vectors(PeakVectors { u, v, a, b })
+    finite_vectors(PeakVectors { u, v, a, b, sigma })
 }
 
-fn nan_like(k: &Controller) -> Controller {
+pub(crate) fn nan_like(k: &Controller) -> Controller {
     let f = |m: &Mat<f64>| Mat::from_fn(m.nrows(), m.ncols(), |_, _| f64::NAN);
     Controller { ak: f(&k.ak), bk: f(&k.bk), ck: f(&k.ck), dk: f(&k.dk) }
 }

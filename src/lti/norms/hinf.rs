@@ -142,7 +142,8 @@ const SCREEN_CLIMB_MAX_EVALS: usize = 12;
 pub struct HinfNorm {
     /// ‖G‖∞; +∞ if the system is unstable (or its data are not finite).
     pub value: f64,
-    /// A frequency (rad/s) attaining it: may be +∞ (peak approached as ω → ∞); NaN if the value
+    /// A frequency (rad/s) attaining it: may be +∞ (peak approached as ω → ∞); from the
+    /// discrete-time functions (`hinf_norm_discrete`, …) a θ ∈ [0, π] in rad/sample; NaN if the value
     /// is +∞.
     pub peak_freq: f64,
 }

@@ -5,5 +5,6 @@
 //!
 //! Imports `kernels` and `system`; never `synthesis`.
 
+pub(crate) mod discrete;
 pub(crate) mod gradient;
 pub(crate) mod hinf;

@@ -11,12 +11,17 @@
 //!   symmetric eigen-decomposition, LU solve, block concatenation).
 //!
 //! This file holds the result, the error and the options, and the entry points
-//! [`full_order_gamma`] and [`full_order_gamma_with`]; all public names of the former single file
+//! [`full_order_gamma`], [`full_order_gamma_with`] and, for discrete-time plants through the
+//! bilinear transform, [`full_order_gamma_discrete`]; all public names of the former single file
 //! `full_order.rs` stay reachable here.
 
 use std::fmt;
 
+use faer::Mat;
+
+use crate::lti::kernels::bilinear::Cayley;
 use crate::lti::system::plant::Plant;
+use crate::lti::system::state_space::StateSpace;
 use crate::numeric::all_finite;
 
 mod bracketing;
@@ -188,6 +193,48 @@ impl Default for FullOrderOptions {
 /// γ_opt of the plant with default options (see the module docs).
 pub fn full_order_gamma(plant: &Plant) -> Result<FullOrderGamma, FullOrderError> {
     full_order_gamma_with(plant, &FullOrderOptions::default())
+}
+
+/// γ_opt of a discrete-time plant: the continuous-time γ_opt of its bilinear image
+/// (`kernels/bilinear.rs`, docs/ALGORITHMS.md §10.4). The map z = ±(1 + s)/(1 − s) takes every
+/// discrete controller to a continuous one of the same order and back, the closed loop of the
+/// images to the image of the closed loop, the unit disc to the left half-plane and the circle
+/// to the axis, so the two infima are equal. The result's notes and regularisation refer to the
+/// image (its D12 and D21 are P12 and P21 at z = ∓1, not the discrete D12 and D21).
+/// `Err(LinearAlgebra)` if A has eigenvalues at both z = 1 and z = −1 (no image).
+pub fn full_order_gamma_discrete(plant: &Plant, opts: &FullOrderOptions) -> Result<FullOrderGamma, FullOrderError> {
+    let image = bilinear_plant(plant)?;
+    full_order_gamma_with(&image, opts)
+}
+
+/// The bilinear image of a discrete-time plant, as one system (A, [B1 B2], [C1; C2], D).
+fn bilinear_plant(plant: &Plant) -> Result<Plant, FullOrderError> {
+    let d = plant.dims;
+    let (cols, rows) = (linalg::concat_cols, linalg::concat_rows);
+    let b = cols(plant.b1.as_ref(), plant.b2.as_ref());
+    let c = rows(plant.c1.as_ref(), plant.c2.as_ref());
+    let top = cols(plant.d11.as_ref(), plant.d12.as_ref());
+    let dd = rows(top.as_ref(), cols(plant.d21.as_ref(), plant.d22.as_ref()).as_ref());
+    let sys = StateSpace { a: plant.a.clone(), b, c, d: dd };
+    if !sys.is_finite() {
+        return Err(FullOrderError::NonFinite);
+    }
+    let image = Cayley::new(&sys)
+        .ok_or(FullOrderError::LinearAlgebra("bilinear transform: A has eigenvalues at both z = 1 and z = −1"))?
+        .sys;
+    let block = |m: &Mat<f64>, r0: usize, c0: usize, r: usize, c: usize| m.as_ref().submatrix(r0, c0, r, c).to_owned();
+    Ok(Plant {
+        a: image.a,
+        b1: block(&image.b, 0, 0, d.n, d.m1),
+        b2: block(&image.b, 0, d.m1, d.n, d.m2),
+        c1: block(&image.c, 0, 0, d.p1, d.n),
+        c2: block(&image.c, d.p1, 0, d.p2, d.n),
+        d11: block(&image.d, 0, 0, d.p1, d.m1),
+        d12: block(&image.d, 0, d.m1, d.p1, d.m2),
+        d21: block(&image.d, d.p1, 0, d.p2, d.m1),
+        d22: block(&image.d, d.p1, d.m1, d.p2, d.m2),
+        ..plant.clone()
+    })
 }
 
 /// γ_opt of the plant with explicit options.
