@@ -195,6 +195,11 @@ fn assert_same_table(got: &str, want: &str, what: &str) {
                 continue;
             }
             let (x, y): (f64, f64) = (a.parse().unwrap_or(f64::NAN), b.parse().unwrap_or(f64::NAN));
+            // no number: an empty cell of older builds, "nan" since non-finite numbers are
+            // written one way
+            if x.is_nan() && y.is_nan() && [a, *b].iter().all(|c| c.is_empty() || *c == "nan") {
+                continue;
+            }
             assert!((x - y).abs() <= 1e-12 * x.abs().max(y.abs()), "{what}: {a} vs {b} in\n{gl}\n{wl}");
         }
     }

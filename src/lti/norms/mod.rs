@@ -7,3 +7,4 @@
 
 pub(crate) mod gradient;
 pub(crate) mod hinf;
+pub(crate) mod sigma;
