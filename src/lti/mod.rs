@@ -25,7 +25,6 @@ mod norms;
 mod synthesis;
 mod system;
 
-pub(crate) use kernels::freq_response;
 pub use kernels::freq_response::ResponseSlot;
 pub use kernels::step_stats;
 pub(crate) use system::export;
