@@ -1,11 +1,15 @@
-//! Convergence of one job from its MCAP trace: the objective against CPU seconds, phase
-//! boundaries (stabilisation → BFGS → gradient sampling) as dashed vertical lines and restarts
-//! (a new starting point) as dotted ones with a triangle on the curve.
+//! Convergence of one job from its MCAP trace, drawn for a reader: the best objective so far
+//! against CPU seconds (a thick step curve), behind it a thinned sample of the local searches (at
+//! most [`MAX_RUNS_DRAWN`], those that set a new best first, each of at most
+//! [`MAX_POINTS_PER_RUN`] points: a fast job makes thousands, which drew a grey wall and a 9.3 MB
+//! SVG), a triangle where a restart set a new best, and a dashed line at the first entry into
+//! each later phase (BFGS, gradient sampling) with its label placed clear of the others.
 //!
 //! The stabilisation phase minimises max(α(A_cl), ε·α(A_K)), which ends below zero, while the
-//! later phases minimise max(‖T_zw‖∞, ε‖K‖∞) > 0: the two are drawn in two panels sharing the
-//! time axis (the upper one logarithmic when the objective spans more than a decade). A trace
-//! whose CPU clock never advanced (the test runner's) is drawn against the iteration count.
+//! later phases minimise max(‖T_zw‖∞, ε‖K‖∞) > 0: the first local search's stabilisation is drawn
+//! in a lower panel of its own (the upper one logarithmic when the objective spans more than a
+//! decade). A trace whose CPU clock never advanced (the test runner's) is drawn against the
+//! iteration count.
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
@@ -47,14 +51,6 @@ impl ConvergenceFigure {
         } else {
             i as f64
         }
-    }
-
-    /// (x, f) of the finite points of the phases matching `stab`.
-    fn points(&self, stab: bool) -> Vec<(f64, f64, &str)> {
-        (0..self.iterations.len())
-            .filter(|&i| (self.iterations[i].phase == STABILISATION) == stab && self.iterations[i].f.is_finite())
-            .map(|i| (self.x_of(i), self.iterations[i].f, self.iterations[i].phase.as_str()))
-            .collect()
     }
 
     /// Phase boundaries: where the phase changes, drawn at the last message before the change.
@@ -127,10 +123,24 @@ impl ConvergenceFigure {
     /// x range of a panel: the whole run for the objective; for the stabilisation panel only
     /// its own iterations (it usually takes a small fraction of the run and would be a sliver).
     fn x_range(&self, stab: bool) -> (f64, f64) {
-        let n = self.iterations.len();
-        let xs = (0..n).filter(|&i| !stab || self.iterations[i].phase == STABILISATION).map(|i| self.x_of(i));
-        let hi = xs.filter(|x| x.is_finite()).fold(0f64, f64::max);
+        let hi = if stab {
+            // the first local search's stabilisation: the later ones are slivers spread over
+            // the whole run
+            self.panel_runs(true).iter().flat_map(|r| r.points.iter().map(|p| p.0)).fold(0f64, f64::max)
+        } else {
+            (0..self.iterations.len()).map(|i| self.x_of(i)).filter(|x| x.is_finite()).fold(0f64, f64::max)
+        };
         (0.0, if hi > 0.0 { hi * 1.02 } else { 1.0 })
+    }
+
+    /// The runs a panel draws from: every local search of the objective's phases, or the first
+    /// local search's stabilisation.
+    fn panel_runs(&self, stab: bool) -> Vec<Run> {
+        let mut runs = self.runs(stab);
+        if stab {
+            runs.truncate(1);
+        }
+        runs
     }
 
     fn panel<DB: DrawingBackend, Y>(
@@ -153,7 +163,7 @@ impl ConvergenceFigure {
         let mut chart = b.build_cartesian_2d(x0..x1, y).map_err(msg)?;
         let x_desc = match (self.x_is_cpu(), stab) {
             (true, false) => "CPU time (s)",
-            (true, true) => "CPU time (s), stabilisation phase only",
+            (true, true) => "CPU time (s), stabilisation phase of the first local search",
             (false, _) => "iteration (no CPU time in the trace)",
         };
         let y_desc = if stab { "max(α(A_cl), ε·α(A_K))" } else { "objective max(‖T_zw‖∞, ε‖K‖∞)" };
@@ -178,7 +188,8 @@ impl ConvergenceFigure {
         let px_per_x = f64::from(area.dim_in_pixel().0.saturating_sub(110).max(1)) / (x1 - x0).max(f64::MIN_POSITIVE);
         let mut rows: [Option<f64>; 3] = [None; 3];
         let row_height = (yhi - ylo) * 0.07;
-        for m in self.first_phase_markers().into_iter().filter(|m| m.x <= x1) {
+        let markers = if stab { Vec::new() } else { self.first_phase_markers() };
+        for m in markers.into_iter().filter(|m| m.x <= x1 && m.label != STABILISATION) {
             let style = ShapeStyle::from(&colour::MARK).stroke_width(2);
             chart.draw_series(DashedLineSeries::new(vec![(m.x, ylo), (m.x, yhi)], 8, 5, style)).map_err(msg)?;
             let width = (m.label.chars().count() as f64 + 2.0) * 8.5 / px_per_x;
@@ -204,7 +215,7 @@ impl ConvergenceFigure {
         // The local searches, thinned: those that set a new best and an even sample of the
         // others, at most MAX_RUNS_DRAWN, each with at most MAX_POINTS_PER_RUN points, drawn
         // faintly behind the best-so-far curve.
-        let runs = self.runs(stab);
+        let runs = self.panel_runs(stab);
         let line_colour = if stab { colour::PAPER } else { colour::OURS };
         let faint = line_colour.mix(0.35).stroke_width(1);
         let shown = thin_runs(&runs);
@@ -212,7 +223,7 @@ impl ConvergenceFigure {
             let s = chart.draw_series(LineSeries::new(decimate(&runs[i].points), faint)).map_err(msg)?;
             if n == 0 {
                 let label =
-                    if stab { "stabilisation objective (local searches, thinned)" } else { "local searches (thinned)" };
+                    if stab { "stabilisation objective (first local search)" } else { "local searches (thinned)" };
                 s.label(label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], faint));
             }
         }
@@ -246,7 +257,7 @@ impl ConvergenceFigure {
         stab: bool,
         caption: Option<&str>,
     ) -> Result<(), DrawError> {
-        let ys: Vec<f64> = self.points(stab).iter().map(|p| p.1).collect();
+        let ys: Vec<f64> = self.panel_runs(stab).iter().flat_map(|r| r.points.iter().map(|p| p.1)).collect();
         let (lo, hi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
         if !stab && spans_decades(lo, hi) {

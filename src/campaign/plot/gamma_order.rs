@@ -92,7 +92,12 @@ impl GammaOrderFigure {
                     Text::new(
                         format!("γ_opt = {}", tick(g)),
                         (kmin as f64 - 0.45, g),
-                        (FONT_FAMILY, 16).into_font().color(&colour::BOUND),
+                        (FONT_FAMILY, 16).into_font().color(&colour::BOUND).pos(
+                            plotters::style::text_anchor::Pos::new(
+                                plotters::style::text_anchor::HPos::Left,
+                                plotters::style::text_anchor::VPos::Bottom,
+                            ),
+                        ),
                     )
                     .into_dyn(),
                 ))

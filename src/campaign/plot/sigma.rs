@@ -58,6 +58,24 @@ impl SigmaFigure {
     }
 }
 
+/// The points of a log-log curve worth drawing: a point is kept when it moves at least about a
+/// pixel (1/800 of the axes' log spans) from the last one kept, and so is every local maximum and
+/// the last point. The adaptive grid is denser than the pixels where the curve is steep, and a
+/// thick line through sub-pixel segments draws hairy edges.
+fn for_screen(points: impl Iterator<Item = (f64, f64)>, x: (f64, f64), y: (f64, f64)) -> Vec<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = points.collect();
+    let (dx, dy) = ((x.1 / x.0).ln() / 800.0, (y.1 / y.0).ln() / 800.0);
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(pts.len());
+    for (i, &p) in pts.iter().enumerate() {
+        let peak = i > 0 && i + 1 < pts.len() && p.1 >= pts[i - 1].1 && p.1 >= pts[i + 1].1;
+        let far = out.last().is_none_or(|&(x0, y0)| (p.0 / x0).ln().abs() >= dx || (p.1 / y0).ln().abs() >= dy);
+        if far || peak || i + 1 == pts.len() {
+            out.push(p);
+        }
+    }
+    out
+}
+
 /// The σ axis's ticks: [`log_ticks`], or its two ends when the range is too narrow for any.
 fn y_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let t = log_ticks(lo, hi);
@@ -97,15 +115,15 @@ impl Figure for SigmaFigure {
             .axis_desc_style((FONT_FAMILY, 17))
             .draw()
             .map_err(msg)?;
-        let cl_style = colour::OURS.stroke_width(3);
+        let cl_style = colour::OURS.stroke_width(2);
         chart
-            .draw_series(LineSeries::new(Self::positive(&self.closed_loop), cl_style))
+            .draw_series(LineSeries::new(for_screen(Self::positive(&self.closed_loop), (w0, w1), (lo, hi)), cl_style))
             .map_err(msg)?
             .label("σ_max(T_zw(iω)), closed loop")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], cl_style));
         let k_style = colour::CONTROLLER.stroke_width(2);
         chart
-            .draw_series(LineSeries::new(Self::positive(&self.controller), k_style))
+            .draw_series(LineSeries::new(for_screen(Self::positive(&self.controller), (w0, w1), (lo, hi)), k_style))
             .map_err(msg)?
             .label("σ_max(K(iω)), controller")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], k_style));
