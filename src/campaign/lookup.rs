@@ -13,8 +13,9 @@ use super::reduce::BestRow;
 pub enum Entry {
     /// A job id, or a prefix of one that names a single job.
     Job(String),
-    /// The best job of a `best.csv` row: plant label, n_K and, when the campaign has both, the
-    /// objective (`strong` or `plain`).
+    /// The best job of a `best.csv` row: plant label, n_K and the objective (`strong` or
+    /// `plain`); without one, the strong row when the campaign ran both (the design's default
+    /// objective), else the only row.
     Best {
         /// Plant as `best.csv` names it.
         plant: String,
@@ -74,11 +75,14 @@ fn best_job_id(dir: &Path, plant: &str, order: usize, objective: Option<&str>) -
     let err = |message: String| LookupError::Best { path: path.clone(), message };
     let mut reader = csv::Reader::from_path(&path).map_err(|e| err(e.to_string()))?;
     let rows: Vec<BestRow> = reader.deserialize().collect::<Result<_, _>>().map_err(|e| err(e.to_string()))?;
-    let matching: Vec<&BestRow> = rows
+    let mut matching: Vec<&BestRow> = rows
         .iter()
         .filter(|r| r.plant == plant && r.order == order)
         .filter(|r| objective.is_none_or(|o| r.objective.name() == o))
         .collect();
+    if objective.is_none() && matching.len() > 1 {
+        matching.retain(|r| r.objective == crate::design::ObjectiveKind::Strong);
+    }
     let what = format!("plant {plant}, n_K = {order}{}", objective.map(|o| format!(", {o}")).unwrap_or_default());
     match matching.as_slice() {
         [] => {
@@ -89,9 +93,6 @@ fn best_job_id(dir: &Path, plant: &str, order: usize, objective: Option<&str>) -
             .job_id
             .clone()
             .ok_or_else(|| LookupError::NotFound(format!("{}: {what} has no verified job", path.display()))),
-        _ => Err(LookupError::Ambiguous(format!(
-            "{}: {what} has a row per objective; add --objective strong or --objective plain",
-            path.display()
-        ))),
+        _ => Err(LookupError::Ambiguous(format!("{}: {what} has several rows", path.display()))),
     }
 }

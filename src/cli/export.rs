@@ -40,7 +40,8 @@ pub struct ExportArgs {
     /// With --results and --plant: the controller order n_K.
     #[arg(long, requires = "plant")]
     pub order: Option<usize>,
-    /// With --plant: the objective of the row, when the campaign ran both.
+    /// With --plant: the objective of the row (default: the strong row when the campaign ran
+    /// both).
     #[arg(long, value_parser = ["strong", "plain"], requires = "plant")]
     pub objective: Option<String>,
     /// With --results: a job id (or a unique prefix of one).
