@@ -127,26 +127,16 @@ pub fn parity_interlacing(plant: &Plant) -> Option<ParityInterlacing> {
         // no real unstable pole: nothing can lie between two zeros
         return Some(ParityInterlacing { zeros: Vec::new(), poles, violation: None });
     }
-    let entries: Vec<(usize, usize)> = (0..plant.dims.p2)
-        .flat_map(|i| (0..plant.dims.m2).map(move |j| (i, j)))
-        .filter(|&(i, j)| !identically_zero(a, plant.b2.col(j), plant.c2.row(i), plant.d22[(i, j)], scale))
+    let entries: Vec<Entry<'_>> = (0..plant.dims.p2)
+        .flat_map(|i| (0..plant.dims.m2).map(move |j| Entry::of(plant, i, j)))
+        .filter(|&g| !identically_zero(g, scale))
         .collect();
-    let Some(&(i0, j0)) = entries.first() else {
+    let Some(&first) = entries.first() else {
         // P22 ≡ 0: no blocking-zero structure to check
         return Some(ParityInterlacing { zeros: Vec::new(), poles, violation: None });
     };
-    let vanishes = |s: f64| {
-        entries.iter().all(|&(i, j)| {
-            let (b, c, d) = (plant.b2.col(j), plant.c2.row(i), plant.d22[(i, j)]);
-            if s.is_infinite() {
-                d == 0.0
-            } else {
-                entry_vanishes_at(a, b, c, d, s)
-            }
-        })
-    };
-    let (b, c, d) = (plant.b2.col(j0), plant.c2.row(i0), plant.d22[(i0, j0)]);
-    let mut candidates = entry_real_zeros(a, b, c, d, scale)?;
+    let vanishes = |s: f64| entries.iter().all(|&g| if s.is_infinite() { g.d == 0.0 } else { entry_vanishes_at(g, s) });
+    let mut candidates = entry_real_zeros(first, scale)?;
     candidates.retain(|&s| closed_rhp(s));
     candidates.push(f64::INFINITY);
     let common: Vec<f64> = candidates.into_iter().filter(|&s| vanishes(s)).collect();
@@ -163,6 +153,22 @@ pub fn parity_interlacing(plant: &Plant) -> Option<ParityInterlacing> {
     Some(ParityInterlacing { zeros, poles, violation })
 }
 
+/// One entry g(s) = c(sI − A)⁻¹b + d of P22.
+#[derive(Clone, Copy)]
+struct Entry<'a> {
+    a: MatRef<'a, f64>,
+    b: faer::ColRef<'a, f64>,
+    c: faer::RowRef<'a, f64>,
+    d: f64,
+}
+
+impl<'a> Entry<'a> {
+    /// Entry (i, j) of `plant`'s P22.
+    fn of(plant: &'a Plant, i: usize, j: usize) -> Self {
+        Entry { a: plant.a.as_ref(), b: plant.b2.col(j), c: plant.c2.row(i), d: plant.d22[(i, j)] }
+    }
+}
+
 /// Two zeros (or a zero and a pole) within [`PIP_RTOL`] of each other; +∞ only matches +∞.
 fn same(s: f64, t: f64) -> bool {
     if s.is_infinite() || t.is_infinite() {
@@ -173,13 +179,8 @@ fn same(s: f64, t: f64) -> bool {
 
 /// Whether c(sI − A)⁻¹b + d ≡ 0: d = 0 and every Markov parameter c Aᵏ b (k < n) is zero to
 /// rounding (computed on A/‖A‖, so nothing overflows).
-fn identically_zero(
-    a: MatRef<'_, f64>,
-    b: faer::ColRef<'_, f64>,
-    c: faer::RowRef<'_, f64>,
-    d: f64,
-    scale: f64,
-) -> bool {
+fn identically_zero(g: Entry<'_>, scale: f64) -> bool {
+    let Entry { a, b, c, d } = g;
     if d != 0.0 {
         return false;
     }
@@ -198,13 +199,8 @@ fn identically_zero(
 /// Candidates for the real finite zeros of c(sI − A)⁻¹b + d: the real λ = σ + 1/μ of the
 /// eigenvalues μ of (M − σE)⁻¹E (the module docs), with the shift σ = −0.73·max(1, ‖A‖) (or a
 /// second one should M − σE be singular there); `None` if no shift works or the eigenvalues fail.
-fn entry_real_zeros(
-    a: MatRef<'_, f64>,
-    b: faer::ColRef<'_, f64>,
-    c: faer::RowRef<'_, f64>,
-    d: f64,
-    scale: f64,
-) -> Option<Vec<f64>> {
+fn entry_real_zeros(g: Entry<'_>, scale: f64) -> Option<Vec<f64>> {
+    let Entry { a, b, c, d } = g;
     let n = a.nrows();
     let e = Mat::from_fn(n + 1, n + 1, |i, j| if i == j && i < n { 1.0 } else { 0.0 });
     for sigma in [-0.73 * scale, -1.61 * scale] {
@@ -237,7 +233,8 @@ fn entry_real_zeros(
 /// Whether g(s) = c(sI − A)⁻¹b + d vanishes at the real s: |g(s)| ≤ [`PIP_RTOL`]·(‖c‖‖x‖ + |d|)
 /// with x = (sI − A)⁻¹b (the size of what cancels); false where sI − A is singular (a pole, not a
 /// zero).
-fn entry_vanishes_at(a: MatRef<'_, f64>, b: faer::ColRef<'_, f64>, c: faer::RowRef<'_, f64>, d: f64, s: f64) -> bool {
+fn entry_vanishes_at(g: Entry<'_>, s: f64) -> bool {
+    let Entry { a, b, c, d } = g;
     let n = a.nrows();
     let z = Mat::from_fn(n, n, |i, j| if i == j { s } else { 0.0 } - a[(i, j)]);
     let x = z.partial_piv_lu().solve(Mat::from_fn(n, 1, |i, _| b[i]));
