@@ -269,7 +269,7 @@ fn gamma_vs_order_labels_its_whole_range_and_the_bound() {
 /// boundary per phase, and its SVG stays small (one was 9.3 MB).
 #[test]
 fn a_trace_of_thousands_of_restarts_is_drawn_thinned_and_small() {
-    use hinfix::campaign::plot::convergence::{best_so_far, thin_runs, MAX_POINTS_PER_RUN, MAX_RUNS_DRAWN};
+    use hinfix::campaign::plot::convergence::{best_so_far, decimate, thin_runs, MAX_POINTS_PER_RUN, MAX_RUNS_DRAWN};
     let mut its = Vec::new();
     let mut t = 0.0;
     for start in 0..3000 {
@@ -305,6 +305,8 @@ fn a_trace_of_thousands_of_restarts_is_drawn_thinned_and_small() {
     let polylines = svg.matches("<polyline").count();
     // (thousands before thinning: one per local search and a dotted line per restart)
     assert!(polylines <= 600, "{polylines} polylines");
-    assert!(MAX_POINTS_PER_RUN <= 200);
+    let long: Vec<(f64, f64)> = (0..5000).map(|i| (i as f64, 1.0 / (1.0 + i as f64))).collect();
+    let short = decimate(&long);
+    assert_eq!((short.len(), short[0], *short.last().unwrap()), (MAX_POINTS_PER_RUN, long[0], long[4999]));
     check_png(&png_bytes(&fig, Path::new("c.png")).unwrap(), "many restarts");
 }

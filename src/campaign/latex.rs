@@ -284,7 +284,7 @@ pub fn cost_table(p: &str, rows: &[&CostRow]) -> String {
     let _ = writeln!(s, "\\label{{tab:hinfix-{}-strong-vs-plain}}", label_key(p));
     s.push_str("\\begin{tabular}{rrlrr}\n\\toprule\n$n_K$ & $\\gamma$ plain & $K$ & $\\gamma$ strong & strong/plain \\\\\n\\midrule\n");
     let mut sorted = rows.to_vec();
-    sorted.sort_by(|a, b| b.order.cmp(&a.order));
+    sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
     for r in sorted {
         let k = match r.plain_controller_stable {
             Some(true) => "stable",

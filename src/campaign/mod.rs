@@ -52,8 +52,8 @@ pub use reference::{
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use report::{
-    compare_rows, cost_rows, write_reports, CampaignAbout, CompareRow, CostRow, FullOrderRow, ReportError,
-    ReportSummary, FULL_ORDER_MAX_N,
+    compare_rows, cost_rows, full_order_controller_stable, write_reports, CampaignAbout, CompareRow, CostRow,
+    FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
 pub use sanitise::for_terminal;

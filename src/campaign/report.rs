@@ -20,7 +20,8 @@ use super::sanitise::{for_csv, for_terminal};
 // The rows moved to `compare` (so that `latex` and `report` no longer import each other); these
 // paths stay valid.
 pub use super::compare::{
-    compare_rows, cost_rows, full_order_rows, CampaignAbout, CompareRow, CostRow, FullOrderRow, FULL_ORDER_MAX_N,
+    compare_rows, cost_rows, full_order_controller_stable, full_order_rows, CampaignAbout, CompareRow, CostRow,
+    FullOrderRow, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 
 /// Errors writing the report, naming the file.

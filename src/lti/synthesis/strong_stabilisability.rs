@@ -10,8 +10,8 @@
 //!
 //! How it is computed here: the poles are the eigenvalues of A (the realisation is assumed
 //! stabilisable and detectable from u and y, as any design needs; then the closed-RHP poles of P22
-//! are exactly A's closed-RHP eigenvalues). The finite zeros of an entry g_ij = c_i(sI − A)⁻¹b_j
-//! + d_ij are the finite generalised eigenvalues λ of its Rosenbrock pencil (M, E) = ([[A, b_j],
+//! are exactly A's closed-RHP eigenvalues). The finite zeros of an entry
+//! g_ij = c_i(sI − A)⁻¹b_j + d_ij are the finite generalised eigenvalues λ of its Rosenbrock pencil (M, E) = ([[A, b_j],
 //! [c_i, d_ij]], diag(I, 0)); they are computed as λ = σ + 1/μ from the eigenvalues μ of
 //! (M − σE)⁻¹E for a real shift σ left of the origin (the crate's eigenvalue kernel: faer's QZ took
 //! seconds on BDT2's 83 × 83 pencils), and a real closed-RHP candidate is kept only if g_ij(λ)
