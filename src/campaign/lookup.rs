@@ -96,3 +96,30 @@ fn best_job_id(dir: &Path, plant: &str, order: usize, objective: Option<&str>) -
         _ => Err(LookupError::Ambiguous(format!("{}: {what} has several rows", path.display()))),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::ObjectiveKind;
+
+    /// A (plant, order) with rows of both objectives: the strong one unless --objective says
+    /// plain; an order without a row names the rows there are.
+    #[test]
+    fn an_entry_picks_its_row_by_objective() {
+        let dir = tempfile::tempdir().unwrap();
+        let row = |objective, id: &str| BestRow {
+            job_id: Some(id.into()),
+            objective,
+            ..BestRow::new("P".into(), "fp".into(), 2)
+        };
+        let mut w = csv::Writer::from_path(dir.path().join("best.csv")).unwrap();
+        w.serialize(row(ObjectiveKind::Strong, "s1")).unwrap();
+        w.serialize(row(ObjectiveKind::Plain, "p1")).unwrap();
+        w.flush().unwrap();
+        assert_eq!(best_job_id(dir.path(), "P", 2, None).unwrap(), "s1");
+        assert_eq!(best_job_id(dir.path(), "P", 2, Some("plain")).unwrap(), "p1");
+        let e = best_job_id(dir.path(), "P", 3, None).unwrap_err().to_string();
+        assert!(e.contains("no row for plant P, n_K = 3") && e.contains("P n_K=2"), "{e}");
+        assert!(matches!(find_record(dir.path(), &Entry::Job("nope".into())), Err(LookupError::NotFound(_))));
+    }
+}
