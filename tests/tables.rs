@@ -170,6 +170,15 @@ fn a_plant_of_ones_own_gets_the_campaign_layout_and_the_two_objectives_side_by_s
     assert_eq!(hinfix::campaign::cost_rows(&best).len(), 2);
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tables.tex"), &tex).unwrap();
-    std::fs::write(dir.path().join("compare.tex"), compare_tex(&compare_rows(&best, &full, &reference()))).unwrap();
+    let compare = compare_tex(&compare_rows(&best, &full, &reference()));
+    assert!(
+        compare.contains("plant & $n_K$ & objective & ours") && compare.contains("two\\_mass & 1 & plain & 2.5000"),
+        "{compare}"
+    );
+    assert!(
+        !compare_tex(&compare_rows(&best[..1], &full, &reference())).contains("objective"),
+        "one objective: old layout"
+    );
+    std::fs::write(dir.path().join("compare.tex"), compare).unwrap();
     common::latex_compiles(dir.path());
 }

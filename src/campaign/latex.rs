@@ -304,15 +304,19 @@ pub fn cost_table(p: &str, rows: &[&CostRow]) -> String {
     s
 }
 
-/// `compare.tex`: ours vs the paper per plant and order.
+/// `compare.tex`: ours vs the paper per plant and order; with an `objective` column after
+/// n_K only when the rows have both objectives (a campaign of one objective keeps its layout).
 pub fn compare_tex(rows: &[CompareRow]) -> String {
-    let mut s = String::from("% hinfix vs Gumussoy, Millstone & Overton (2008)\n\\begin{tabular}{lrrrlrr}\n\\toprule\nplant & $n_K$ & ours & paper & literature & full order & ours/paper \\\\\n\\midrule\n");
+    let mixed = rows.iter().any(|r| r.objective != rows[0].objective);
+    let (cols, head) = if mixed { ("lrlrrlrr", " & objective") } else { ("lrrrlrr", "") };
+    let mut s = format!("% hinfix vs Gumussoy, Millstone & Overton (2008)\n\\begin{{tabular}}{{{cols}}}\n\\toprule\nplant & $n_K${head} & ours & paper & literature & full order & ours/paper \\\\\n\\midrule\n");
     for r in rows {
         let lit =
             r.literature.iter().map(|(src, g)| format!("{} {}", escape(src), num(*g))).collect::<Vec<_>>().join("; ");
+        let objective = if mixed { format!(" & {}", r.objective.name()) } else { String::new() };
         let _ = writeln!(
             s,
-            "{} & {} & {} & {} & {} & {} & {} \\\\",
+            "{} & {}{objective} & {} & {} & {} & {} & {} \\\\",
             escape(&r.plant),
             r.order,
             num(r.ours),
