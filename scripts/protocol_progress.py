@@ -13,6 +13,7 @@ With --compare it also prints the folder's compare.csv (written by `campaign rep
 Markdown table: per plant and order, ours, the paper's HIFOO value and their ratio.
 """
 import csv
+import math
 import argparse
 import collections
 import glob
@@ -87,9 +88,10 @@ def main():
             for row in csv.DictReader(f):
                 def num(key, fmt):
                     try:
-                        return fmt.format(float(row[key]))
+                        x = float(row[key])
                     except ValueError:
                         return "–"
+                    return fmt.format(x) if math.isfinite(x) else "–"
                 ours, paper, ratio = num("ours", "{:#.4g}"), num("paper", "{:#.4g}"), num("ratio", "{:.4f}")
                 print(f"| {row['plant']} | {row['order']} | {ours} | {paper} | {ratio} |")
 

@@ -184,6 +184,32 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
 
     latex_compiles(&t);
 
+    // `export` takes the results folder and an entry (plant and order, or a job id prefix), and
+    // prints MATLAB by default: the same controller either way.
+    let export = |args: &[&str]| {
+        let out = Command::new(BIN).arg("export").arg("--results").arg(&t).args(args).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let by_entry = export(&["--plant", "REA2", "--order", "1"]);
+    assert!(by_entry.contains("K = ss(AK, BK, CK, DK)") && by_entry.contains(&recs[0].job_id.0), "{by_entry}");
+    assert_eq!(export(&["--job", &recs[0].job_id.0[..12]]), by_entry);
+    assert!(export(&["--job", &recs[0].job_id.0, "--to", "python"]).contains("control.ss("));
+    let out =
+        Command::new(BIN).args(["export", "--results"]).arg(&t).args(["--plant", "REA2", "--order", "2"]).output();
+    let stderr = String::from_utf8_lossy(&out.as_ref().unwrap().stderr).to_string();
+    assert!(stderr.contains("no row for plant REA2, n_K = 2"), "{stderr}");
+
+    // MCAP log times are Unix epoch times (ns) of the run, not times since the job started.
+    let mut times = Vec::new();
+    let bytes = std::fs::read(&traces[0]).unwrap();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        times.push(m.unwrap().log_time);
+    }
+    let finished = recs[0].finished_unix_s * 1e9;
+    assert!(!times.is_empty());
+    assert!(times.iter().all(|&t| (t as f64) <= finished + 1e9 && (t as f64) >= finished - 600e9), "{times:?}");
+
     // Bad campaign file: a clear error naming the file and the line, exit code 1, no panic.
     std::fs::write(&file, "name = \"t\"\n[defaults]\nepz = [1e-2]\n[[problem]]\nplant = \"REA2\"\norders = [1]\n")
         .unwrap();

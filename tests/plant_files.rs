@@ -51,6 +51,34 @@ fn a_valid_file_loads() {
     assert!(p.d22_is_zero());
 }
 
+/// As a .mat file, a JSON plant may leave out `name` (the file's stem names it) and `dims`
+/// (inferred from the blocks; an empty `[]` block is a zero block): the same plant, same
+/// fingerprint.
+#[test]
+fn name_and_dims_may_be_left_out() {
+    let full = Plant::from_json_str(&good().to_string(), "t.json").unwrap();
+    let bare = with(|o| {
+        o.remove("name");
+        o.remove("dims");
+    });
+    let p = Plant::from_json_str(&bare, "dir/two_mass.json").unwrap();
+    assert_eq!(p.name, "two_mass");
+    assert_eq!(p.dims, full.dims);
+    assert_eq!(p.fingerprint(), full.fingerprint());
+    // an empty block stands for zeros when the dims are inferred
+    let bare_d22 = with(|o| {
+        o.remove("dims");
+        o["D22"] = json!([]);
+    });
+    let q = Plant::from_json_str(&bare_d22, "t.json").unwrap();
+    assert_eq!(q.fingerprint(), full.fingerprint());
+    // with dims given, an empty block of a non-empty shape is still an error
+    let with_dims = with(|o| {
+        o["D22"] = json!([]);
+    });
+    assert!(Plant::from_json_str(&with_dims, "t.json").is_err());
+}
+
 #[test]
 fn bad_plant_files_each_get_their_own_error() {
     type Check = fn(&PlantErrorKind) -> bool;
@@ -62,22 +90,6 @@ fn bad_plant_files_each_get_their_own_error() {
             "invalid JSON at line 1",
         ),
         ("not an object", "[1, 2]".to_string(), |k| matches!(k, PlantErrorKind::NotObject), "top level"),
-        (
-            "missing name",
-            with(|o| {
-                o.remove("name");
-            }),
-            |k| matches!(k, PlantErrorKind::MissingField { field: "name" }),
-            "`name` is missing",
-        ),
-        (
-            "missing dims",
-            with(|o| {
-                o.remove("dims");
-            }),
-            |k| matches!(k, PlantErrorKind::MissingField { field: "dims" }),
-            "`dims` is missing",
-        ),
         (
             "negative dimension",
             with(|o| {

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use hinfix::campaign::plot::{png_bytes, svg_text, SIZE};
+use hinfix::campaign::plot::{log_ticks, png_bytes, svg_text, SIZE};
 use hinfix::campaign::plot::{ConvergenceFigure, GammaOrderFigure};
 use hinfix::campaign::TraceIteration;
 
@@ -212,6 +212,7 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
     let pa = GammaOrderFigure {
         plant: "PA".into(),
         ours: vec![(1, 0.000351), (2, 0.00035)],
+        plain: vec![],
         paper: vec![(1, 0.00035), (2, 0.00035)],
         full_order: Some((1e-6, false)),
     };
@@ -219,6 +220,7 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
     let he1 = GammaOrderFigure {
         plant: "HE1".into(),
         ours: vec![(1, 0.124), (2, 0.11)],
+        plain: vec![],
         paper: vec![(1, 0.1235)],
         full_order: Some((0.0737, false)),
     };
@@ -228,4 +230,83 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
         check_png(&png_bytes(fig, p).unwrap(), &fig.plant);
         check_svg(&svg_text(fig, p).unwrap(), &fig.plant);
     }
+}
+
+/// γ from 2.5 to 40 on a log axis is labelled below 10 too (it once had the one label 10); the
+/// full-order line carries its value; the plain objective's series is drawn when there is one.
+#[test]
+fn gamma_vs_order_labels_its_whole_range_and_the_bound() {
+    let ticks = log_ticks(2.2, 45.0);
+    assert!(ticks.iter().any(|&t| t < 10.0) && ticks.iter().any(|&t| t > 10.0), "{ticks:?}");
+    assert!((4..=12).contains(&ticks.len()), "{ticks:?}");
+    assert_eq!(log_ticks(1e-7, 2.0), vec![1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0]);
+    let fig = GammaOrderFigure {
+        plant: "own".into(),
+        ours: vec![(1, 40.0), (2, 4.0), (3, 2.6)],
+        plain: vec![(1, 3.0), (2, 2.55)],
+        paper: vec![],
+        full_order: Some((2.5, false)),
+    };
+    assert!(fig.log_axis());
+    let svg = svg_text(&fig, Path::new("g.svg")).unwrap();
+    check_svg(&svg, "own");
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let texts: Vec<String> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .filter_map(|n| n.text())
+        .map(|t| t.trim().to_string())
+        .collect();
+    for label in
+        ["3", "5", "20", "γ_opt = 2.5", "full-order bound γ_opt = 2.5", "ours, plain objective (K may be unstable)"]
+    {
+        assert!(texts.iter().any(|t| t == label), "{label} missing from {texts:?}");
+    }
+}
+
+/// A fast job's trace with thousands of local searches: the figure shows the best objective
+/// so far, at most MAX_RUNS_DRAWN searches of at most MAX_POINTS_PER_RUN points, one labelled
+/// boundary per phase, and its SVG stays small (one was 9.3 MB).
+#[test]
+fn a_trace_of_thousands_of_restarts_is_drawn_thinned_and_small() {
+    use hinfix::campaign::plot::convergence::{best_so_far, decimate, thin_runs, MAX_POINTS_PER_RUN, MAX_RUNS_DRAWN};
+    let mut its = Vec::new();
+    let mut t = 0.0;
+    for start in 0..3000 {
+        for i in 0..4 {
+            t += 1e-3;
+            its.push(it("stabilisation", start, i, 0.5 - 0.2 * i as f64, t));
+        }
+        for i in 0..30 {
+            t += 1e-3;
+            let f = 2.0 + 1.0 / (1.0 + start as f64).sqrt() + 0.5 / (1.0 + i as f64);
+            its.push(it("optimisation", start, i, f, t));
+        }
+        if start % 10 == 0 {
+            for i in 0..5 {
+                t += 1e-3;
+                its.push(it("gradient_sampling", start, i, 2.0 + 1.0 / (1.0 + start as f64).sqrt(), t));
+            }
+        }
+    }
+    let fig = ConvergenceFigure { title: "many".into(), iterations: its };
+    assert_eq!(fig.first_phase_markers().len(), 3, "stabilisation, BFGS and gradient sampling, once each");
+    let runs = fig.runs(false);
+    assert!(runs.len() > 3000);
+    let shown = thin_runs(&runs);
+    assert!(shown.len() <= MAX_RUNS_DRAWN && !shown.is_empty());
+    let best = best_so_far(&runs);
+    assert!(best.windows(2).all(|w| w[1].1 <= w[0].1 && w[1].0 >= w[0].0), "the best so far never rises");
+    let low = runs.iter().flat_map(|r| r.points.iter().map(|p| p.1)).fold(f64::INFINITY, f64::min);
+    assert_eq!(best.last().unwrap().1, low);
+    let svg = svg_text(&fig, Path::new("c.svg")).unwrap();
+    check_svg(&svg, "many restarts");
+    assert!(svg.len() < 400_000, "SVG of {} bytes", svg.len());
+    let polylines = svg.matches("<polyline").count();
+    // (thousands before thinning: one per local search and a dotted line per restart)
+    assert!(polylines <= 600, "{polylines} polylines");
+    let long: Vec<(f64, f64)> = (0..5000).map(|i| (i as f64, 1.0 / (1.0 + i as f64))).collect();
+    let short = decimate(&long);
+    assert_eq!((short.len(), short[0], *short.last().unwrap()), (MAX_POINTS_PER_RUN, long[0], long[4999]));
+    check_png(&png_bytes(&fig, Path::new("c.png")).unwrap(), "many restarts");
 }

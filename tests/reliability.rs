@@ -493,8 +493,22 @@ fn design_and_check_exit_4_when_not_stabilised() {
         output(&mut design_cli(p.to_str().unwrap(), "0", &k, &["--cpumax", "2", "--stop-on-stall", "--nrand", "1"]));
     assert_eq!(code, Some(4), "{out}{err}");
     assert!(out.contains("NOT STABILISED"), "{out}");
+    // a controller that does not stabilise is never written to --out as if it were a result …
+    assert!(!k.exists(), "{out}");
+    assert!(out.contains("no controller written: it does not stabilise"), "{out}");
+    // … only on request, under a name that says what it is
+    let (code, out, err) = output(&mut design_cli(
+        p.to_str().unwrap(),
+        "0",
+        &k,
+        &["--cpumax", "2", "--stop-on-stall", "--nrand", "1", "--out-unverified"],
+    ));
+    assert_eq!(code, Some(4), "{out}{err}");
+    let unverified = dir.join("K.unverified.json");
+    assert!(!k.exists() && unverified.is_file(), "{out}");
+    assert!(out.contains("NOT STABILISING controller written to"), "{out}");
     let (code, out, err) =
-        output(&mut cli(&["check", "--plant", p.to_str().unwrap(), "--controller", k.to_str().unwrap()]));
+        output(&mut cli(&["check", "--plant", p.to_str().unwrap(), "--controller", unverified.to_str().unwrap()]));
     assert_eq!(code, Some(4), "{out}{err}");
     assert!(out.contains("UNSTABLE"), "{out}");
     // a stabilising controller: exit 0

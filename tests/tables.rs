@@ -6,8 +6,9 @@ use std::path::Path;
 
 use hinfix::campaign::BestRow;
 use hinfix::campaign::{compare_rows, FullOrderRow};
-use hinfix::campaign::{compare_tex, sig4, sig_figs, tables_tex};
+use hinfix::campaign::{compare_tex, sig4, sig_figs, tables_tex, tables_tex_about, CampaignAbout};
 use hinfix::campaign::{load_reference, ReferenceRow, PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV};
+use hinfix::design::ObjectiveKind;
 
 mod common;
 
@@ -77,8 +78,8 @@ fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_us
         row("My_Plant", 1, 2.5),
     ];
     let full = vec![
-        FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: false },
-        FullOrderRow { plant: "ZerenOzbay".into(), gamma: 34.24, from_paper: false },
+        FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: false, controller_stable: None },
+        FullOrderRow { plant: "ZerenOzbay".into(), gamma: 34.24, from_paper: false, controller_stable: None },
     ];
     let tex = tables_tex(&best, &full, &reference);
     let block = |p: &str| {
@@ -102,7 +103,7 @@ fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_us
     assert_eq!(tex.matches("\\caption{").count(), 3);
     assert!(!tex.contains("dagger"), "no † when no value is the paper's");
 
-    let with_paper = vec![FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: true }];
+    let with_paper = vec![FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: true, controller_stable: None }];
     let tex2 = tables_tex(&best[..2], &with_paper, &reference);
     assert_eq!(tex2.matches("$^\\dagger$").count(), 2, "one mark and its note:\n{tex2}");
 
@@ -110,5 +111,74 @@ fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_us
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tables.tex"), tables_tex(&best, &with_paper, &reference)).unwrap();
     std::fs::write(dir.path().join("compare.tex"), compare_tex(&compare_rows(&best, &full, &reference))).unwrap();
+    common::latex_compiles(dir.path());
+}
+
+/// A plant without a published reference gets the campaign layout: no paper columns, a caption
+/// that describes the campaign, the columns a reader needs (n_K, objective, γ, ε, seed, ‖K‖∞,
+/// α(A_K), CPU seconds), the full-order row as the unconstrained bound with its controller's
+/// stability; both objectives on one (plant, n_K) add the side-by-side table.
+#[test]
+fn a_plant_of_ones_own_gets_the_campaign_layout_and_the_two_objectives_side_by_side() {
+    let strong = |k: usize, g: f64| BestRow {
+        k_hinf: Some(40.0),
+        alpha_k: Some(-0.5),
+        cpu_to_best_s: Some(12.34),
+        controller_stable: Some(true),
+        ..row("two_mass", k, g)
+    };
+    let plain = |k: usize, g: f64, stable: bool| BestRow {
+        objective: ObjectiveKind::Plain,
+        controller_stable: Some(stable),
+        k_hinf: Some(if stable { 30.0 } else { f64::INFINITY }),
+        alpha_k: Some(if stable { -0.1 } else { 0.3 }),
+        ..strong(k, g)
+    };
+    let best = vec![strong(1, 3.0), plain(1, 2.5, false), strong(2, 2.6), plain(2, 2.6, true), strong(3, 2.55)];
+    let full =
+        vec![FullOrderRow { plant: "two_mass".into(), gamma: 2.4, from_paper: false, controller_stable: Some(false) }];
+    let about =
+        CampaignAbout { names: vec!["own".into()], eps: vec![1e-3, 1e-2], seeds: 3, cpumax: vec![20.0], jobs: 30 };
+    let tex = tables_tex_about(&best, &full, &reference(), &about);
+    assert!(
+        !tex.contains("paper (HIFOO)")
+            && !tex.contains("ours/paper")
+            && !tex.contains("Gumussoy, Millstone \\& Overton (2008).}"),
+        "{tex}"
+    );
+    assert!(
+        tex.contains("\\texttt{own} (30 jobs: $\\varepsilon \\in \\{10^{-3}, 10^{-2}\\}$, 3 seeds, 20 CPU~s per job)"),
+        "{tex}"
+    );
+    assert!(
+        tex.contains(
+            "$n_K$ & objective & $\\gamma$ & $\\varepsilon$ & seed & $\\|K\\|_\\infty$ & $\\alpha(A_K)$ & CPU s"
+        ),
+        "{tex}"
+    );
+    assert!(
+        tex.contains("the unconstrained bound (any order, $K$ may be unstable); central $K$ at $1.01\\gamma$ unstable"),
+        "{tex}"
+    );
+    assert!(tex.contains("1 & strong & 3.000 & $10^{-3}$ & 0 & 40.00 & -0.5000 & 12.3 \\\\"), "{tex}");
+    assert!(tex.contains("1 & plain, $K$ unstable & 2.500 & $10^{-3}$ & 0 & $\\infty$ & 0.3000 & 12.3 \\\\"), "{tex}");
+    // the side-by-side table: orders with both objectives only, ratio strong/plain
+    let side = &tex[tex.find("strong-vs-plain").expect("a side-by-side table")..];
+    assert!(side.contains("1 & 2.500 & unstable & 3.000 & 1.200 \\\\"), "{side}");
+    assert!(side.contains("2 & 2.600 & stable & 2.600 & 1.000 \\\\"), "{side}");
+    assert!(!side.contains("\n3 & "), "{side}");
+    assert_eq!(hinfix::campaign::cost_rows(&best).len(), 2);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tables.tex"), &tex).unwrap();
+    let compare = compare_tex(&compare_rows(&best, &full, &reference()));
+    assert!(
+        compare.contains("plant & $n_K$ & objective & ours") && compare.contains("two\\_mass & 1 & plain & 2.5000"),
+        "{compare}"
+    );
+    assert!(
+        !compare_tex(&compare_rows(&best[..1], &full, &reference())).contains("objective"),
+        "one objective: old layout"
+    );
+    std::fs::write(dir.path().join("compare.tex"), compare).unwrap();
     common::latex_compiles(dir.path());
 }

@@ -3,9 +3,12 @@
 
 use std::fmt::Write as _;
 
-use super::compare::{CompareRow, FullOrderRow, FULL_ORDER_MAX_N};
+use super::compare::{
+    cost_rows, CampaignAbout, CompareRow, CostRow, FullOrderRow, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+};
 use super::reduce::BestRow;
 use super::reference::{RefMethod, ReferenceRow};
+use crate::design::ObjectiveKind;
 
 /// Escapes LaTeX specials and drops control characters: [`super::sanitise::for_latex`], which
 /// every LaTeX table uses (kept under this name too).
@@ -60,11 +63,48 @@ fn label_key(name: &str) -> String {
 /// highest down: our best re-verified γ, the paper's HIFOO γ and ours/paper. Plants for which the
 /// reference table has values from earlier literature get a literature column (their orders
 /// appear as rows of their own when we have no result there). 4 significant figures throughout.
+///
+/// A plant without a published reference (no row of `reference` is its), or one the campaign ran
+/// only with the plain objective, gets the campaign layout instead ([`campaign_table`]); a plant
+/// with best rows of both objectives at some n_K also gets the side-by-side table of the two
+/// ([`cost_table`]). The same as [`tables_tex_about`] with nothing known of the campaign.
 pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[ReferenceRow]) -> String {
+    tables_tex_about(best, full, reference, &CampaignAbout::default())
+}
+
+/// [`tables_tex`], with the campaign's facts for the captions of the campaign layout.
+pub fn tables_tex_about(
+    best: &[BestRow],
+    full: &[FullOrderRow],
+    reference: &[ReferenceRow],
+    about: &CampaignAbout,
+) -> String {
     let mut s = String::from("% hinfix: best γ per controller order (re-verified) in the layout of\n% Gumussoy, Millstone & Overton (2008); needs \\usepackage{booktabs}\n");
     let mut plants: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
     plants.dedup();
+    let costs = cost_rows(best);
     for (p, fp) in plants {
+        let strong: Vec<BestRow> =
+            best.iter().filter(|r| r.plant == p && r.objective == ObjectiveKind::Strong).cloned().collect();
+        let f = full.iter().find(|f| f.plant == p);
+        if !reference.iter().any(|r| r.is_for(fp)) || strong.is_empty() {
+            let rows: Vec<&BestRow> = best.iter().filter(|r| r.plant == p).collect();
+            s.push_str(&campaign_table(p, &rows, f, about));
+        } else {
+            s.push_str(&paper_table(p, fp, &strong, f, reference));
+        }
+        let cost: Vec<&CostRow> = costs.iter().filter(|c| c.plant == p).collect();
+        if !cost.is_empty() {
+            s.push_str(&cost_table(p, &cost));
+        }
+    }
+    s
+}
+
+/// One plant's table in the paper's layout (`best`: its strong rows).
+fn paper_table(p: &str, fp: &str, best: &[BestRow], f: Option<&FullOrderRow>, reference: &[ReferenceRow]) -> String {
+    let mut s = String::new();
+    {
         let refs = |m: RefMethod| reference.iter().filter(move |r| r.is_for(fp) && r.method == m);
         let literature: Vec<&ReferenceRow> = refs(RefMethod::Literature).collect();
         let has_lit = !literature.is_empty();
@@ -82,7 +122,6 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
                 cells.join("; ")
             }
         };
-        let f = full.iter().find(|f| f.plant == p);
         let dagger = f.is_some_and(|f| f.from_paper);
         let paper_full = refs(RefMethod::FullOrder).next();
         let _ = writeln!(s, "\\begin{{table}}[!htbp]\n\\centering");
@@ -137,15 +176,147 @@ pub fn tables_tex(best: &[BestRow], full: &[FullOrderRow], reference: &[Referenc
     s
 }
 
-/// `compare.tex`: ours vs the paper per plant and order.
+/// ε in math mode: `10^{-3}` for a power of ten, else 4 significant figures.
+fn eps_math(x: f64) -> String {
+    let e = x.log10().round();
+    if x > 0.0 && (10f64.powf(e) - x).abs() <= 1e-12 * x {
+        format!("10^{{{}}}", e as i64)
+    } else {
+        sig4(x).trim_matches('$').to_string()
+    }
+}
+
+/// ε for a table cell: [`eps_math`] in `$…$`.
+fn eps_tex(x: f64) -> String {
+    format!("${}$", eps_math(x))
+}
+
+/// A number that may be +∞ (‖K‖∞ of an unstable controller): `$\infty$`, else [`sig4`].
+fn sig4_inf(x: f64) -> String {
+    if x == f64::INFINITY {
+        "$\\infty$".into()
+    } else {
+        sig4(x)
+    }
+}
+
+/// The caption's account of the campaign: "the campaign `name` (N jobs: ε ∈ {…}, S seeds,
+/// C CPU s per job)".
+fn about_text(about: &CampaignAbout) -> String {
+    if about.names.is_empty() {
+        return "the campaign".into();
+    }
+    let names: Vec<String> = about.names.iter().map(|n| format!("\\texttt{{{}}}", escape(n))).collect();
+    let eps: Vec<String> = about.eps.iter().map(|&e| eps_math(e)).collect();
+    let cpu: Vec<String> =
+        about.cpumax.iter().map(|&c| if c.is_finite() { format!("{c}") } else { "unbounded".into() }).collect();
+    format!(
+        "the campaign {} ({} jobs: $\\varepsilon \\in \\{{{}\\}}$, {} seed{}, {} CPU~s per job)",
+        names.join(", "),
+        about.jobs,
+        eps.join(", "),
+        about.seeds,
+        if about.seeds == 1 { "" } else { "s" },
+        cpu.join(" or ")
+    )
+}
+
+/// One plant's table in the campaign layout, for a plant without a published reference: per n_K
+/// (highest first) and objective the best re-verified controller's γ, its job's ε and seed,
+/// ‖K‖∞, α(A_K), the CPU seconds its job took to reach it and the objective; first the full-order
+/// row, the unconstrained bound, with whether its central controller is stable.
+pub fn campaign_table(p: &str, rows: &[&BestRow], f: Option<&FullOrderRow>, about: &CampaignAbout) -> String {
+    let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
+    let _ = writeln!(
+        s,
+        "\\caption{{{}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and spectral abscissa $\\alpha(A_K)$, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.}}",
+        escape(p),
+        about_text(about)
+    );
+    let _ = writeln!(s, "\\label{{tab:hinfix-{}}}", label_key(p));
+    s.push_str("\\begin{tabular}{rlrrrrrr}\n\\toprule\n$n_K$ & objective & $\\gamma$ & $\\varepsilon$ & seed & $\\|K\\|_\\infty$ & $\\alpha(A_K)$ & CPU s \\\\\n\\midrule\n");
+    if let Some(f) = f {
+        let k = match f.controller_stable {
+            Some(true) => format!("; central $K$ at ${FULL_ORDER_CENTRAL_LEVEL}\\gamma$ stable"),
+            Some(false) => format!("; central $K$ at ${FULL_ORDER_CENTRAL_LEVEL}\\gamma$ unstable"),
+            None => String::new(),
+        };
+        let _ = writeln!(
+            s,
+            "full & \\multicolumn{{7}}{{l}}{{$\\gamma = {}$: the unconstrained bound (any order, $K$ may be unstable){k}}} \\\\\n\\midrule",
+            sig4(f.gamma)
+        );
+    }
+    let mut sorted: Vec<&&BestRow> = rows.iter().collect();
+    sorted.sort_by(|a, b| b.order.cmp(&a.order).then(a.objective.name().cmp(b.objective.name()).reverse()));
+    for r in sorted {
+        let objective = match (r.objective, r.controller_stable) {
+            (ObjectiveKind::Plain, Some(false)) => "plain, $K$ unstable".to_string(),
+            (o, _) => o.name().to_string(),
+        };
+        let opt = |x: Option<f64>| x.map_or("--".to_string(), sig4_inf);
+        let _ = writeln!(
+            s,
+            "{} & {objective} & {} & {} & {} & {} & {} & {} \\\\",
+            r.order,
+            sig4(r.gamma),
+            r.eps.map_or("--".into(), eps_tex),
+            r.seed.map_or("--".into(), |x| x.to_string()),
+            opt(r.k_hinf),
+            opt(r.alpha_k),
+            r.cpu_to_best_s.map_or("--".into(), |t| format!("{t:.1}"))
+        );
+    }
+    s.push_str("\\bottomrule\n\\end{tabular}\n\\end{table}\n\n");
+    s
+}
+
+/// The side-by-side table of the two objectives for one plant: per n_K, γ of the plain
+/// objective and whether its controller is stable, γ of the strong one and their ratio (the
+/// comparison of the paper's tables).
+pub fn cost_table(p: &str, rows: &[&CostRow]) -> String {
+    let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
+    let _ = writeln!(
+        s,
+        "\\caption{{{}: the cost of strong stabilisation. Per order $n_K$, the best re-verified $\\gamma$ without a stability requirement on $K$ (plain) and whether that $K$ is stable, the best with a stable $K$ (strong), and their ratio.}}",
+        escape(p)
+    );
+    let _ = writeln!(s, "\\label{{tab:hinfix-{}-strong-vs-plain}}", label_key(p));
+    s.push_str("\\begin{tabular}{rrlrr}\n\\toprule\n$n_K$ & $\\gamma$ plain & $K$ & $\\gamma$ strong & strong/plain \\\\\n\\midrule\n");
+    let mut sorted = rows.to_vec();
+    sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
+    for r in sorted {
+        let k = match r.plain_controller_stable {
+            Some(true) => "stable",
+            Some(false) => "unstable",
+            None => "--",
+        };
+        let _ = writeln!(
+            s,
+            "{} & {} & {k} & {} & {} \\\\",
+            r.order,
+            sig4(r.gamma_plain),
+            sig4(r.gamma_strong),
+            sig4(r.ratio)
+        );
+    }
+    s.push_str("\\bottomrule\n\\end{tabular}\n\\end{table}\n\n");
+    s
+}
+
+/// `compare.tex`: ours vs the paper per plant and order; with an `objective` column after
+/// n_K only when the rows have both objectives (a campaign of one objective keeps its layout).
 pub fn compare_tex(rows: &[CompareRow]) -> String {
-    let mut s = String::from("% hinfix vs Gumussoy, Millstone & Overton (2008)\n\\begin{tabular}{lrrrlrr}\n\\toprule\nplant & $n_K$ & ours & paper & literature & full order & ours/paper \\\\\n\\midrule\n");
+    let mixed = rows.iter().any(|r| r.objective != rows[0].objective);
+    let (cols, head) = if mixed { ("lrlrrlrr", " & objective") } else { ("lrrrlrr", "") };
+    let mut s = format!("% hinfix vs Gumussoy, Millstone & Overton (2008)\n\\begin{{tabular}}{{{cols}}}\n\\toprule\nplant & $n_K${head} & ours & paper & literature & full order & ours/paper \\\\\n\\midrule\n");
     for r in rows {
         let lit =
             r.literature.iter().map(|(src, g)| format!("{} {}", escape(src), num(*g))).collect::<Vec<_>>().join("; ");
+        let objective = if mixed { format!(" & {}", r.objective.name()) } else { String::new() };
         let _ = writeln!(
             s,
-            "{} & {} & {} & {} & {} & {} & {} \\\\",
+            "{} & {}{objective} & {} & {} & {} & {} & {} \\\\",
             escape(&r.plant),
             r.order,
             num(r.ours),

@@ -15,6 +15,7 @@ pub(crate) mod fake;
 mod jobs;
 pub(crate) mod journal;
 pub(crate) mod latex;
+mod lookup;
 mod model;
 pub mod plot;
 pub(crate) mod progress;
@@ -40,7 +41,8 @@ pub use journal::{
     is_journal_name, journals_in, parse_journal, read_journal, CorruptLine, Follower, JournalError, JournalRead,
     JournalWriter, TornTail, JOURNAL_FILE,
 };
-pub use latex::{compare_tex, sig4, sig_figs, tables_tex};
+pub use latex::{campaign_table, compare_tex, cost_table, sig4, sig_figs, tables_tex, tables_tex_about};
+pub use lookup::{find_record, Entry, LookupError};
 pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
 pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};
@@ -49,7 +51,10 @@ pub use reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
-pub use report::{compare_rows, write_reports, CompareRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_MAX_N};
+pub use report::{
+    compare_rows, cost_rows, full_order_controller_stable, write_reports, CampaignAbout, CompareRow, CostRow,
+    FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+};
 pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
 pub use sanitise::for_terminal;
 pub use scheduler::{

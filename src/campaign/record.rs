@@ -341,7 +341,7 @@ impl JobRecord {
             if let Some(serde_json::Value::Array(phases)) = obj.get_mut("phases") {
                 for p in phases {
                     if let Some(p) = p.as_object_mut() {
-                        p.remove("cpu_s");
+                        p.remove("design_cpu_s");
                     }
                 }
             }

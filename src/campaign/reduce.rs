@@ -4,6 +4,9 @@
 //! closed loop is formed again (`lti::closed_loop`), both α(A_cl) and α(Ak) are checked to be
 //! below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F)), and
 //! γ = ‖Tzw‖∞ is recomputed. The reported γ is always the recomputed one, never the journal's.
+//! A job of the plain objective (no stability asked of K) counts with an unstable controller
+//! too: its row says whether the controller is stable (`controller_stable`), which is what the
+//! comparison of the two objectives needs. Rows are per (plant, order, objective).
 //!
 //! A plant is identified by its content fingerprint, never by its name: records are verified
 //! against the plant with their `plant_fingerprint` and grouped by it, so two different plants
@@ -17,6 +20,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::record::JobRecord;
+use crate::design::ObjectiveKind;
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm, is_stable_with_margin, spectral_abscissa, stability_margin,
     HinfParams, Plant, DEFAULT_HINF_TOL,
@@ -55,8 +59,10 @@ pub enum Verdict {
         alpha_cl: f64,
         /// α(Ak) (None for order 0).
         alpha_k: Option<f64>,
-        /// Recomputed ‖K‖∞.
+        /// Recomputed ‖K‖∞ (+∞ for an unstable controller of a plain job).
         k_hinf: f64,
+        /// Whether the controller is stable with the margin (always for a strong job).
+        controller_stable: bool,
     },
     /// Not counted, with the reason.
     Rejected(String),
@@ -84,23 +90,22 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
         return Verdict::Rejected(format!("closed loop not stable (α = {alpha_cl}, must be below −{margin:.1e})"));
     }
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
-    if let Some(a) = alpha_k {
-        if !is_stable_with_margin(a, k.ak.as_ref()) {
-            let margin = stability_margin(k.ak.as_ref());
-            return Verdict::Rejected(format!("controller not stable (α_K = {a}, must be below −{margin:.1e})"));
-        }
+    let controller_stable = alpha_k.is_none_or(|a| is_stable_with_margin(a, k.ak.as_ref()));
+    if !controller_stable && record.options.objective == ObjectiveKind::Strong {
+        let (a, margin) = (alpha_k.unwrap_or(f64::NAN), stability_margin(k.ak.as_ref()));
+        return Verdict::Rejected(format!("controller not stable (α_K = {a}, must be below −{margin:.1e})"));
     }
     let gamma = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set").value;
     if !gamma.is_finite() {
         return Verdict::Rejected(format!("γ not finite ({gamma})"));
     }
     let k_hinf = controller_hinf_grad(k, DEFAULT_HINF_TOL).0.value;
-    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf }
+    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf, controller_stable }
 }
 
 /// Relative distance to the best γ within which a replicate counts as reaching it
-/// ([`BestRow::near_best`]).
-pub const NEAR_BEST_RTOL: f64 = 1e-3;
+/// ([`BestRow::near_best`]): the crate's one tie tolerance of norms, [`crate::lti::NORM_TIE_RTOL`].
+pub const NEAR_BEST_RTOL: f64 = crate::lti::NORM_TIE_RTOL;
 
 /// Best result of one (plant, order).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -150,9 +155,18 @@ pub struct BestRow {
     /// Jobs that did not fail but whose controller did not re-verify (e.g. not stabilised).
     #[serde(default)]
     pub unverified: usize,
+    /// The design objective of the row's jobs: `strong` or `plain` (rows of best.csv files of
+    /// older builds, which had no such column, read as `strong`).
+    #[serde(default)]
+    pub objective: ObjectiveKind,
+    /// Whether the best controller is stable (with the margin of [`verify`]); always true for
+    /// `strong`, and what a `plain` row's γ cost; empty when no job verified.
+    #[serde(default)]
+    pub controller_stable: Option<bool>,
 }
 
-/// Best γ per (plant, order), sorted by plant label then order. Records of plants missing
+/// Best γ per (plant, order, objective), sorted by plant label, order, then objective (strong
+/// before plain). Records of plants missing
 /// from `plants` count as runs that failed verification; duplicate records of a job count once,
 /// by their best verified one.
 pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> {
@@ -190,15 +204,16 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
         }
         Some(total)
     };
-    let mut rows: BTreeMap<(String, usize), (BestRow, Vec<f64>)> = BTreeMap::new();
+    let mut rows: BTreeMap<(String, usize, u8), (BestRow, Vec<f64>)> = BTreeMap::new();
     for &(r, ref verdict) in per_job.values() {
         let label = labels[&r.plant_fingerprint].clone();
-        let (row, gammas) = rows
-            .entry((label.clone(), r.order))
-            .or_insert_with(|| (BestRow::new(label, r.plant_fingerprint.clone(), r.order), Vec::new()));
+        let objective = r.options.objective;
+        let (row, gammas) = rows.entry((label.clone(), r.order, objective as u8)).or_insert_with(|| {
+            (BestRow { objective, ..BestRow::new(label, r.plant_fingerprint.clone(), r.order) }, Vec::new())
+        });
         row.runs += 1;
         match verdict {
-            &Some(Verdict::Verified { gamma, alpha_k, k_hinf, .. }) => {
+            &Some(Verdict::Verified { gamma, alpha_k, k_hinf, controller_stable, .. }) => {
                 row.verified += 1;
                 gammas.push(gamma);
                 if !(gamma >= row.gamma) {
@@ -208,6 +223,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
                     row.seed = Some(r.seed);
                     row.k_hinf = Some(k_hinf);
                     row.alpha_k = alpha_k;
+                    row.controller_stable = Some(controller_stable);
                     row.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
                     row.chain_cpu_to_best_s = row.cpu_to_best_s.zip(chain_cpu_before(r)).map(|(t, before)| t + before);
                 }
@@ -244,6 +260,8 @@ impl BestRow {
             near_best: 0,
             failed: 0,
             unverified: 0,
+            objective: ObjectiveKind::Strong,
+            controller_stable: None,
         }
     }
 }
@@ -385,6 +403,37 @@ mod tests {
         assert!(why.contains("must be below −1.0e-12"), "{why}");
         let p = plant_with_pole("P", -1e-9, 1.0);
         assert!(matches!(verify(&record(&p, "P", 0), &p), Verdict::Verified { .. }));
+    }
+
+    /// A plain job (no stability asked of K) whose stabilising controller is unstable counts,
+    /// with `controller_stable = false`, in a row of its own; the same controller in a strong
+    /// job does not verify.
+    #[test]
+    fn a_plain_job_with_an_unstable_controller_counts_as_such() {
+        // ẋ = −x + w + u, y = x; K: ẋk = 0.5 xk + y, u = −2 xk: A_cl = [[−1, −2], [1, 0.5]] is
+        // stable (trace −0.5, det 1.5), Ak = 0.5 is not.
+        let p = plant("P", 1.0);
+        let unstable_k = |objective| {
+            let mut rec = record(&p, "P", 0);
+            rec.order = 1;
+            rec.options = DesignOptions { order: 1, objective, ..rec.options.clone() };
+            let JobResult::Designed(o) = &mut rec.result else { unreachable!("a designed record") };
+            let mut k = crate::lti::Controller::zeros(1, 1, 1);
+            (k.ak[(0, 0)], k.bk[(0, 0)], k.ck[(0, 0)]) = (0.5, 1.0, -2.0);
+            o.controller = k;
+            rec.job_id = job_id(&p.fingerprint(), &rec.options, None, RunnerTag::Design);
+            rec
+        };
+        let plain = unstable_k(ObjectiveKind::Plain);
+        assert!(matches!(verify(&plain, &p), Verdict::Verified { controller_stable: false, .. }));
+        let strong = unstable_k(ObjectiveKind::Strong);
+        assert!(matches!(verify(&strong, &p), Verdict::Rejected(_)));
+        let rows = best_per_order(&[plain, strong], &map(&[&p]));
+        assert_eq!(rows.len(), 2, "{rows:?}");
+        let (s, pl) = (&rows[0], &rows[1]);
+        assert_eq!((s.objective, s.verified, s.unverified, s.controller_stable), (ObjectiveKind::Strong, 0, 1, None));
+        assert_eq!((pl.objective, pl.verified, pl.controller_stable), (ObjectiveKind::Plain, 1, Some(false)));
+        assert!(pl.gamma.is_finite() && pl.k_hinf == Some(f64::INFINITY), "{pl:?}");
     }
 
     #[test]

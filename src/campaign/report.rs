@@ -1,5 +1,6 @@
 //! The campaign's report files, written atomically (tmp in the same directory, fsync, rename):
-//! `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`. Pure functions of journal records,
+//! `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`, and `strong_vs_plain.csv` when the
+//! campaign ran both objectives on a (plant, n_K). Pure functions of journal records,
 //! the plants and the paper's reference rows, so `campaign report` reruns without jobs.
 //!
 //! The rows themselves (ours against the paper's, the full-order bound) are computed by
@@ -18,7 +19,10 @@ use super::sanitise::{for_csv, for_terminal};
 
 // The rows moved to `compare` (so that `latex` and `report` no longer import each other); these
 // paths stay valid.
-pub use super::compare::{compare_rows, full_order_rows, CompareRow, FullOrderRow, FULL_ORDER_MAX_N};
+pub use super::compare::{
+    compare_rows, cost_rows, full_order_controller_stable, full_order_rows, CampaignAbout, CompareRow, CostRow,
+    FullOrderRow, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+};
 
 /// Errors writing the report, naming the file.
 #[derive(Debug, thiserror::Error)]
@@ -57,13 +61,30 @@ pub struct ReportSummary {
 
 impl fmt::Display for ReportSummary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}", "plant", "nK", "ours", "paper", "ratio", "verified")?;
+        // the objective is named only when the campaign ran both
+        let mixed = self.compare.iter().any(|r| r.objective != self.compare[0].objective);
+        writeln!(
+            f,
+            "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}{}",
+            "plant",
+            "nK",
+            "ours",
+            "paper",
+            "ratio",
+            "verified",
+            if mixed { "  objective" } else { "" }
+        )?;
         for r in &self.compare {
-            let b = self.best.iter().find(|b| b.plant == r.plant && b.order == r.order);
+            let b = self.best.iter().find(|b| b.plant == r.plant && b.order == r.order && b.objective == r.objective);
             let v = b.map(|b| format!("{}/{}", b.verified, b.runs)).unwrap_or_default();
+            let objective = match (mixed, b.and_then(|b| b.controller_stable)) {
+                (false, _) => String::new(),
+                (true, Some(false)) => format!("  {} (K unstable)", r.objective.name()),
+                (true, _) => format!("  {}", r.objective.name()),
+            };
             writeln!(
                 f,
-                "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}",
+                "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}{objective}",
                 for_terminal(&r.plant),
                 r.order,
                 latex::num(r.ours),
@@ -100,14 +121,13 @@ struct CompareCsv {
     literature: String,
     full_order: String,
     ratio: String,
+    objective: &'static str,
 }
 
+/// A number cell: non-finite values as "inf", "-inf", "nan", as in best.csv and every JSON file
+/// (builds before left the cell empty).
 fn csv_num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        String::new()
-    }
+    crate::design::f64_text(x)
 }
 
 /// Reduces `records` and writes the four report files into `out_dir` (created if needed).
@@ -130,8 +150,18 @@ pub fn write_reports(
     files.push(p);
 
     let p = out_dir.join("tables.tex");
-    write_atomic(&p, latex::tables_tex(&best, &full, reference).as_bytes())?;
+    let about = CampaignAbout::of(records);
+    write_atomic(&p, latex::tables_tex_about(&best, &full, reference, &about).as_bytes())?;
     files.push(p);
+
+    // the two objectives side by side, when the campaign ran both on a (plant, n_K)
+    let costs = cost_rows(&best);
+    if !costs.is_empty() {
+        let p = out_dir.join("strong_vs_plain.csv");
+        let rows = costs.iter().map(|c| CostRow { plant: for_csv(&c.plant), ..c.clone() });
+        write_atomic(&p, &csv_bytes(&p, rows)?)?;
+        files.push(p);
+    }
 
     let p = out_dir.join("compare.csv");
     let rows = compare.iter().map(|r| CompareCsv {
@@ -142,6 +172,7 @@ pub fn write_reports(
         literature: for_csv(&r.literature.iter().map(|(s, g)| format!("{s}={g}")).collect::<Vec<_>>().join("; ")),
         full_order: csv_num(r.full_order),
         ratio: csv_num(r.ratio),
+        objective: r.objective.name(),
     });
     write_atomic(&p, &csv_bytes(&p, rows)?)?;
     files.push(p);

@@ -11,6 +11,10 @@
 //! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled (with its
 //!   `search` summary: starts, best start, CPU time to best, stop reason).
 //!
+//! A message's MCAP `log_time` (and `publish_time`) is the wall-clock time of its iteration in
+//! nanoseconds since the Unix epoch (what MCAP tools such as Foxglove expect): the writer's start
+//! as Unix time plus the monotonic time elapsed since, so the times of one trace never go back.
+//!
 //! Non-finite numbers are written as the strings `"inf"`, `"-inf"` or `"nan"` (JSON has no
 //! such numbers); the schema allows number or string for every float.
 //!
@@ -168,6 +172,11 @@ pub fn result_schema() -> Value {
     })
 }
 
+/// Nanoseconds since the Unix epoch now (0 on a clock set before 1970).
+fn unix_now_ns() -> u64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64)
+}
+
 /// An iteration waiting to be written: its sequence number and time are those of its arrival.
 #[derive(Debug)]
 struct Stamped {
@@ -190,6 +199,8 @@ pub struct TraceWriter {
     since_flush: usize,
     last_flush: Instant,
     started: Instant,
+    /// Unix time of `started`, in nanoseconds.
+    started_unix_ns: u64,
     error: Option<TraceError>,
 }
 
@@ -241,6 +252,9 @@ impl TraceWriter {
             seq: 0,
             since_flush: 0,
             last_flush: Instant::now(),
+            // Unix time first: the monotonic clock added to it then never runs ahead of the
+            // wall clock
+            started_unix_ns: unix_now_ns(),
             started: Instant::now(),
             error: None,
         })
@@ -255,7 +269,7 @@ impl TraceWriter {
     fn stamp(&mut self) -> (u32, u64) {
         let seq = self.seq;
         self.seq += 1;
-        (seq, self.started.elapsed().as_nanos() as u64)
+        (seq, self.started_unix_ns.saturating_add(self.started.elapsed().as_nanos() as u64))
     }
 
     fn write(&mut self, channel: u16, (sequence, t): (u32, u64), data: &Value) -> Result<(), TraceError> {
@@ -651,5 +665,25 @@ impl fmt::Display for TraceSummary {
             )?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Messages carry Unix epoch times (ns), not nanoseconds since the writer started.
+    #[test]
+    fn log_times_are_unix_epoch_times() {
+        let dir = tempfile::tempdir().unwrap();
+        let before = unix_now_ns();
+        let mut w = TraceWriter::create(dir.path(), "job", TraceLevel::Full).unwrap();
+        let (_, t0) = w.stamp();
+        let (_, t1) = w.stamp();
+        let after = unix_now_ns();
+        // (1 ms of slack: the two clocks are read at different moments)
+        assert!(before <= t0 && t0 <= t1 && t1 <= after + 1_000_000, "{before} {t0} {t1} {after}");
+        assert!(t0 > 1_700_000_000 * 1_000_000_000, "{t0} is not a Unix time in ns (2023 or later)");
+        Box::new(w).abandon();
     }
 }

@@ -6,7 +6,9 @@
 //! `gamma` (‖Tzw‖∞) and `k_hinf` (‖K‖∞) — the names of the journal, the traces and
 //! [`crate::design::DesignOutcome`] (docs/ARCHITECTURE.md §5; builds before that wrote the SLICOT
 //! oracle's `closed_loop_hinf` / `controller_hinf`) — `closed_loop_peak_freq` (where ‖Tzw‖∞
-//! peaks), `closed_loop_stable`, `controller_stable`; non-finite numbers are written
+//! peaks), `closed_loop_peak_freqs` (every frequency where σmax(Tzw(iω)) is within
+//! `lti::NORM_TIE_RTOL`, 0.1 %, of ‖Tzw‖∞: ω = 0 and "inf" included; an optimal controller often
+//! equalises several peaks), `closed_loop_stable`, `controller_stable`; non-finite numbers are written
 //! as the strings "inf" / "-inf" / "nan" (as `design::float_serde`), a frequency that does not
 //! exist (unstable loop) as null.
 //!
@@ -17,7 +19,7 @@ use std::process::ExitCode;
 
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, stability_margin, Controller, HinfParams, Plant,
-    DEFAULT_HINF_TOL,
+    DEFAULT_HINF_TOL, NORM_TIE_RTOL,
 };
 use anyhow::Context;
 use serde_json::{json, Value};
@@ -40,12 +42,15 @@ pub struct CheckArgs {
 }
 
 /// Everything `check` reports.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct CheckReport {
     alpha_cl: f64,
     alpha_k: Option<f64>,
     gamma: f64,
     peak_freq: f64,
+    /// Every frequency where σmax is within `NORM_TIE_RTOL` of the peak (ascending; empty if
+    /// the loop is unstable).
+    peak_freqs: Vec<f64>,
     k_hinf: f64,
     /// Stability margins (`lti::stability_margin`) of A_cl and Ak: stable means α below minus it.
     margin_cl: f64,
@@ -87,11 +92,13 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
     let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));
+    let peak_freqs = crate::lti::near_peak_frequencies(&cl, &h, NORM_TIE_RTOL);
     let r = CheckReport {
         alpha_cl,
         alpha_k,
         gamma: h.value,
         peak_freq: h.peak_freq,
+        peak_freqs,
         k_hinf: hk.value,
         margin_cl,
         margin_k,
@@ -119,6 +126,7 @@ fn to_json(r: &CheckReport) -> Value {
         "controller_spectral_abscissa": r.alpha_k.map(num),
         "gamma": num(r.gamma),
         "closed_loop_peak_freq": if r.peak_freq.is_nan() { Value::Null } else { num(r.peak_freq) },
+        "closed_loop_peak_freqs": r.peak_freqs.iter().map(|&w| num(w)).collect::<Vec<_>>(),
         "k_hinf": num(r.k_hinf),
         "closed_loop_stable": r.closed_loop_stable(),
         "controller_stable": r.controller_stable(),
@@ -129,13 +137,7 @@ fn to_json(r: &CheckReport) -> Value {
 
 fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     let yes_no = |b: bool| if b { "stable" } else { "UNSTABLE" };
-    let freq = if r.peak_freq.is_nan() {
-        "—".to_string()
-    } else if r.peak_freq.is_infinite() {
-        "ω → ∞".to_string()
-    } else {
-        format!("ω = {:.6} rad/s", r.peak_freq)
-    };
+    let freq = peak_text(r);
     let mut s = format!(
         "plant {} (n = {}), controller of order {}\n",
         crate::campaign::for_terminal(&plant.name),
@@ -164,9 +166,54 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     s
 }
 
+/// "ω = 0.720000 rad/s", or with several peaks within `NORM_TIE_RTOL` of the norm
+/// "ω = 0, 0.720000 and ∞ rad/s (σmax within 0.1 % of the peak at each)".
+fn peak_text(r: &CheckReport) -> String {
+    let one = |w: f64| {
+        if w.is_infinite() {
+            "∞".to_string()
+        } else if w == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{w:.6}")
+        }
+    };
+    match r.peak_freqs.as_slice() {
+        _ if r.peak_freq.is_nan() => "—".to_string(),
+        [] | [_] if r.peak_freq.is_infinite() => "ω → ∞".to_string(),
+        [] | [_] => format!("ω = {} rad/s", one(r.peak_freq)),
+        [init @ .., last] => format!(
+            "ω = {} and {} rad/s (σmax within {} % of the peak at each)",
+            init.iter().map(|&w| one(w)).collect::<Vec<_>>().join(", "),
+            one(*last),
+            NORM_TIE_RTOL * 100.0
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Several peaks at the norm are all named, ω = 0 and ∞ included.
+    #[test]
+    fn every_peak_is_named() {
+        let mut r = CheckReport {
+            alpha_cl: -1.0,
+            alpha_k: None,
+            gamma: 2.0,
+            peak_freq: 0.0,
+            peak_freqs: vec![0.0, 0.72, f64::INFINITY],
+            k_hinf: 1.0,
+            margin_cl: 1e-12,
+            margin_k: 1e-12,
+        };
+        assert_eq!(peak_text(&r), "ω = 0, 0.720000 and ∞ rad/s (σmax within 0.1 % of the peak at each)");
+        assert_eq!(to_json(&r)["closed_loop_peak_freqs"], json!([0.0, 0.72, "inf"]));
+        r.peak_freqs = vec![0.72];
+        r.peak_freq = 0.72;
+        assert_eq!(peak_text(&r), "ω = 0.720000 rad/s");
+    }
 
     #[test]
     fn json_keys_and_infinities() {
@@ -175,6 +222,7 @@ mod tests {
             alpha_k: None,
             gamma: f64::INFINITY,
             peak_freq: f64::NAN,
+            peak_freqs: vec![],
             k_hinf: 1.5,
             margin_cl: 1e-12,
             margin_k: 1e-12,
@@ -192,6 +240,7 @@ mod tests {
             alpha_k: Some(-1.0),
             gamma: 2.0,
             peak_freq: f64::INFINITY,
+            peak_freqs: vec![f64::INFINITY],
             k_hinf: 1.5,
             margin_cl: 1e-12,
             margin_k: 1e-12,

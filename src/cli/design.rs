@@ -6,10 +6,16 @@
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
 //!
-//! Every outcome writes the returned controller. Exit codes: 0 for a stabilising controller
-//! (converged, stopped by a limit, budget exhausted, stabilised only), 4 when it is NOT
-//! STABILISED, 130/143/129 after Ctrl-C/SIGTERM/SIGHUP (the run is cancelled; the best
-//! controller so far is still written). `--out` is checked (not a directory, writable, with a
+//! Only a stabilising controller (closed loop stable and, with the strong objective, the
+//! controller too, both with the verification margin of `lti::is_stable_with_margin`) is written
+//! to `--out`; a run that found none writes nothing there, and with `--out-unverified` writes the
+//! controller it ended with next to it as `<stem>.unverified.<ext>`, a name that says what it is.
+//! With the strong objective, a plant that no stable controller stabilises (the parity
+//! interlacing property fails) is refused at once, naming the zeros and poles that prove it.
+//! Exit codes: 0 for a stabilising controller (converged, stopped by a limit, budget exhausted,
+//! stabilised only), 4 when it is NOT STABILISED or the plant is not strongly stabilisable,
+//! 130/143/129 after Ctrl-C/SIGTERM/SIGHUP (the run is cancelled; the best controller so far is
+//! still written if it stabilises). `--out` is checked (not a directory, writable, with a
 //! probe file of a unique name, so that concurrent runs writing one file do not trip) before
 //! the design starts.
 use std::path::{Path, PathBuf};
@@ -147,9 +153,40 @@ pub struct DesignArgs {
     #[arg(long)]
     pub json: bool,
     /// Where to write the controller: JSON {AK, BK, CK, DK}, or a MATLAB level-5 file with the
-    /// variables AK BK CK DK when the name ends in `.mat`.
+    /// variables AK BK CK DK when the name ends in `.mat`. Only a stabilising controller is
+    /// written here.
     #[arg(long)]
     pub out: PathBuf,
+    /// When the run finds no stabilising controller, write the one it ended with anyway, as
+    /// `<stem>.unverified.<ext>` next to --out (never to --out itself).
+    #[arg(long)]
+    pub out_unverified: bool,
+}
+
+/// Where `--out-unverified` writes a controller that does not stabilise: `K.json` →
+/// `K.unverified.json`.
+fn unverified_path(out: &Path) -> PathBuf {
+    let stem = out.file_stem().map_or_else(|| "controller".into(), |s| s.to_string_lossy().into_owned());
+    let name = match out.extension() {
+        Some(ext) => format!("{stem}.unverified.{}", ext.to_string_lossy()),
+        None => format!("{stem}.unverified"),
+    };
+    out.with_file_name(name)
+}
+
+/// Whether `o`'s controller stabilises `plant` as the objective asks: the closed loop and (strong
+/// objective) the controller stable with the verification margin — the test `campaign report`
+/// applies to a journaled controller.
+fn stabilising(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> bool {
+    if matches!(o.status, DesignStatus::NotStabilised { .. }) {
+        return false;
+    }
+    let k = &o.controller;
+    let loop_stable = crate::lti::closed_loop(plant, k)
+        .is_ok_and(|cl| crate::lti::is_stable_with_margin(crate::lti::spectral_abscissa(cl.a.as_ref()), cl.a.as_ref()));
+    let k_stable = k.order() == 0
+        || crate::lti::is_stable_with_margin(crate::lti::spectral_abscissa(k.ak.as_ref()), k.ak.as_ref());
+    loop_stable && (k_stable || opts.objective == ObjectiveKind::Plain)
 }
 
 pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
@@ -163,11 +200,16 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     // Bad options and an unusable --out are errors before any work (and before any file is made).
     crate::design::validate(&plant, &opts, init.as_ref())
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
+    if let Err(e) = crate::design::strongly_stabilisable(&plant, &opts) {
+        eprintln!("error: {} (order {}, strong objective): {e}", for_terminal(&plant.name), a.order);
+        return Ok(ExitCode::from(EXIT_NOT_STABILISED));
+    }
     check_writable(&a.out).with_context(|| format!("--out {}", a.out.display()))?;
     let cancel = signals::install();
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
+    let good = stabilising(&plant, &opts, &outcome);
     // A stabilising result has a finite γ; NaN or ∞ would be a failed computation called success.
     let stabilising = !matches!(outcome.status, DesignStatus::NotStabilised { .. } | DesignStatus::Interrupted);
     if stabilising && !(outcome.gamma.is_finite() && outcome.objective.is_finite()) {
@@ -180,16 +222,43 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
             outcome.objective
         );
     }
-    if crate::lti::is_mat_path(&a.out) {
-        outcome.controller.save(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
-    } else {
-        let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
-        write_atomic(&a.out, text.as_bytes()).with_context(|| format!("writing {}", a.out.display()))?;
+    let written = match (good, a.out_unverified) {
+        (true, _) => Some(a.out.clone()),
+        (false, true) => Some(unverified_path(&a.out)),
+        (false, false) => None,
+    };
+    if let Some(path) = &written {
+        if crate::lti::is_mat_path(path) {
+            outcome.controller.save(path).with_context(|| format!("writing {}", path.display()))?;
+        } else {
+            let text = serde_json::to_string_pretty(&outcome.controller)? + "\n";
+            write_atomic(path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        }
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        print!("{}", summary(&plant, &opts, &outcome, &a.out));
+        print!("{}", summary(&plant, &opts, &outcome));
+    }
+    let what = match (&written, good) {
+        (Some(p), true) => format!("controller written to {}", p.display()),
+        (Some(p), false) => {
+            format!(
+                "NOT STABILISING controller written to {} (--out-unverified); {} untouched",
+                p.display(),
+                a.out.display()
+            )
+        }
+        (None, _) => format!(
+            "no controller written: it does not stabilise ({} untouched; --out-unverified writes it to {})",
+            a.out.display(),
+            unverified_path(&a.out).display()
+        ),
+    };
+    if a.json {
+        eprintln!("{what}");
+    } else {
+        println!("{what}");
     }
     Ok(match outcome.status {
         DesignStatus::Interrupted => ExitCode::from(signals::exit_code()),
@@ -261,7 +330,7 @@ fn status_text(s: &DesignStatus) -> String {
     }
 }
 
-fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -> String {
+fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     let mode = match opts.objective {
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
         ObjectiveKind::Plain => "plain H∞".to_string(),
@@ -315,7 +384,6 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome, out: &Path) -
     if let Some(c) = &o.certificate {
         s += &format!("certificate: dnorm = {:.2e}, evaldist = {:.2e}\n", c.dnorm, c.evaldist);
     }
-    s += &format!("controller written to {}\n", out.display());
     s
 }
 
@@ -335,6 +403,13 @@ mod tests {
         .unwrap();
         let a = cli.design_args().expect("a design command");
         assert_eq!(options(a).unwrap(), DesignOptions { order: 2, ..DesignOptions::default() });
+    }
+
+    #[test]
+    fn an_unverified_controller_gets_a_name_that_says_so() {
+        assert_eq!(unverified_path(Path::new("out/K.json")), Path::new("out/K.unverified.json"));
+        assert_eq!(unverified_path(Path::new("K.mat")), Path::new("K.unverified.mat"));
+        assert_eq!(unverified_path(Path::new("K")), Path::new("K.unverified"));
     }
 
     /// Every flag the option table names is a flag of `campaign design`.

@@ -115,7 +115,11 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
         o.insert(
             "full_order_gamma".into(),
             match &full {
-                Ok(f) => json!({"gamma": f.gamma, "regularisation": f.regularisation, "method": f.describe()}),
+                Ok(f) => json!({
+                    "gamma": crate::design::f64_to_json(f.gamma),
+                    "regularisation": f.regularisation.map(crate::design::f64_to_json),
+                    "method": f.describe()
+                }),
                 Err(e) => json!({"error": e}),
             },
         );
@@ -129,14 +133,18 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
     println!("  file:        {}", term(&path.display().to_string()));
     println!("  source:      {}", term(&p.citation));
     println!("  sizes:       n = {}, w: m1 = {}, u: m2 = {}, z: p1 = {}, y: p2 = {}", d.n, d.m1, d.m2, d.p1, d.p2);
-    println!("  open loop:   {} (spectral abscissa {:.6e})", if s.stable() { "stable" } else { "unstable" }, s.alpha);
+    println!(
+        "  open loop:   {} (spectral abscissa {})",
+        if s.stable() { "stable" } else { "unstable" },
+        super::fmt_num(s.alpha, 6)
+    );
     println!("  D22:         {}", if p.d22_is_zero() { "zero" } else { "non-zero" });
     match &full {
         Ok(f) => println!("  full-order optimal γ: {:.6} ({})", f.gamma, f.describe()),
         Err(e) => println!("  full-order optimal γ: not computed: {e}"),
     }
     if let Some(g) = paper_full {
-        println!("  paper's full-order γ: {g}");
+        println!("  paper's full-order γ: {}", super::fmt_num(g, 6));
     }
     if let Some(check) = &p.check {
         println!("  file's check block:   {check}");

@@ -34,6 +34,26 @@ fn read_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
     }
 }
 
+/// The text of a float in every file the program writes (JSON strings, CSV cells): a finite
+/// value as Rust prints it (shortest round-trip form), others as "inf", "-inf", "nan".
+pub fn f64_text(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        non_finite_word(x).to_string()
+    }
+}
+
+fn non_finite_word(x: f64) -> &'static str {
+    if x.is_nan() {
+        "nan"
+    } else if x > 0.0 {
+        "inf"
+    } else {
+        "-inf"
+    }
+}
+
 /// `#[serde(with = "serde_f64_or_string")]` for an `f64` that may be non-finite.
 pub mod serde_f64_or_string {
     use super::*;
@@ -42,12 +62,8 @@ pub mod serde_f64_or_string {
     pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
         if x.is_finite() {
             s.serialize_f64(*x)
-        } else if x.is_nan() {
-            s.serialize_str("nan")
-        } else if *x > 0.0 {
-            s.serialize_str("inf")
         } else {
-            s.serialize_str("-inf")
+            s.serialize_str(non_finite_word(*x))
         }
     }
 

@@ -26,7 +26,7 @@ mod search;
 pub(crate) mod starts;
 
 pub use central_start::{central_starts, reduce as reduce_controller, CENTRAL_MAX_STATES, CENTRAL_REGULARISATIONS};
-pub use float_serde::{f64_from_json, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
+pub use float_serde::{f64_from_json, f64_text, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
 pub use objective::{
     ComponentCache, Components, DesignObjective, ObjectivePhase, ObserverAdapter, COMPONENT_CACHE_LEN,
     MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
@@ -42,6 +42,6 @@ pub use outcome::{
     NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary, StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
-pub use run::{run, run_with_control, validate};
+pub use run::{run, run_with_control, strongly_stabilisable, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};

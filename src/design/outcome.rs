@@ -71,17 +71,21 @@ impl DesignStatus {
     }
 }
 
-/// Per-phase counters.
+/// Per-phase counters. Written with the outcome's key names (`iterations`, `evaluations`,
+/// `design_cpu_s`: one set of names in `design --json` and the journal); the names of older
+/// builds (`iters`, `evals`, `cpu_s`) are still read.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PhaseStats {
     /// Which phase.
     pub phase: Phase,
     /// Iterations (over all starts).
+    #[serde(rename = "iterations", alias = "iters")]
     pub iters: usize,
     /// Objective evaluations.
+    #[serde(rename = "evaluations", alias = "evals")]
     pub evals: usize,
-    /// CPU seconds.
-    #[serde(with = "serde_f64_or_string")]
+    /// CPU seconds of the phase (as counted by the design's budget).
+    #[serde(rename = "design_cpu_s", alias = "cpu_s", with = "serde_f64_or_string")]
     pub cpu_s: f64,
 }
 
@@ -242,7 +246,7 @@ pub struct DesignOutcome {
     #[serde(with = "serde_f64_or_string")]
     pub objective: f64,
     /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞) (at least
-    /// ‖Tzw‖∞ within the norms' relative tolerance `hinf_tol`): the controller-norm penalty, not
+    /// ‖Tzw‖∞ within [`crate::lti::NORM_TIE_RTOL`], 0.1 %): the controller-norm penalty, not
     /// the closed loop, sets the objective (strong stabilisation only; a smaller ε would let γ go
     /// lower).
     #[serde(default)]
@@ -343,6 +347,10 @@ pub enum DesignError {
     /// A numerical failure of the optimiser that left no trustworthy point.
     #[error("numerical failure: {0}")]
     Numerical(crate::optim::OptimError),
+    /// The strong objective on a plant no stable controller stabilises (the parity interlacing
+    /// property fails, `lti::parity_interlacing`): refused before any search.
+    #[error("{0}")]
+    NotStronglyStabilisable(crate::lti::PipViolation),
 }
 
 /// Why an initial controller (warm start, `--init`) cannot start a design run. Part of the
@@ -375,5 +383,18 @@ mod tests {
         for p in [Phase::Stabilisation, Phase::Optimisation, Phase::GradientSampling] {
             assert_eq!(serde_json::to_value(p).unwrap(), p.name());
         }
+    }
+
+    /// `design --json` and the journal name the per-phase counters as the outcome does; lines
+    /// of older builds (`iters`, `evals`, `cpu_s`) still read.
+    #[test]
+    fn phase_counters_use_the_outcomes_key_names() {
+        let s = PhaseStats { phase: Phase::Optimisation, iters: 3, evals: 5, cpu_s: 0.25 };
+        let v = serde_json::to_value(&s).unwrap();
+        let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+        assert_eq!(keys, ["design_cpu_s", "evaluations", "iterations", "phase"]);
+        let old: PhaseStats =
+            serde_json::from_str(r#"{"phase":"optimisation","iters":3,"evals":5,"cpu_s":0.25}"#).unwrap();
+        assert_eq!(old, s);
     }
 }

@@ -26,7 +26,6 @@ mod norms;
 mod synthesis;
 mod system;
 
-pub(crate) use kernels::freq_response;
 pub use kernels::freq_response::ResponseSlot;
 pub use kernels::step_stats;
 pub(crate) use system::export;
@@ -61,6 +60,10 @@ pub use norms::hinf::{
     hinf_lower_bound, hinf_lower_bound_sharing, hinf_norm, HinfNorm, HinfParams, DEFAULT_HINF_TOL,
     MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
+pub use norms::sigma::{
+    frequency_band, near_peak_frequencies, sigma_curve, NORM_TIE_RTOL, SIGMA_BASE_POINTS, SIGMA_MAX_POINTS,
+    SIGMA_STEP_RTOL,
+};
 pub use synthesis::balanced_truncation::{
     balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values,
     Reduced, ReductionError, HSV_RTOL,
@@ -70,6 +73,7 @@ pub use synthesis::full_order::{
     full_order_gamma, full_order_gamma_discrete, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma,
     FullOrderOptions, Regularisation, FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
+pub use synthesis::strong_stabilisability::{parity_interlacing, ParityInterlacing, PipViolation, PIP_MAX_N, PIP_RTOL};
 pub use system::closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use system::controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};
 pub use system::export::{export_code, ExportTarget};

@@ -1,20 +1,27 @@
-//! γ against the controller order for one plant: our best re-verified γ per n_K, the paper's
-//! HIFOO values, and the full-order bound as a horizontal line; a log axis when the values span
-//! more than a decade.
+//! γ against the controller order for one plant: our best re-verified γ per n_K (strong
+//! objective; the plain objective's as a second series when the campaign ran it), the paper's
+//! HIFOO values, and the full-order bound as a horizontal line labelled with its value; a log
+//! axis when the values span more than a decade, with tick labels over its whole range
+//! ([`log_ticks`]).
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, DrawError, Figure, FONT_FAMILY};
+use super::render::{
+    colour, draw_legend, log_ticks, msg, padded_range, spans_decades, tick, DrawError, Figure, FONT_FAMILY,
+};
 
 /// Data of one γ-vs-order figure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GammaOrderFigure {
     /// Plant name.
     pub plant: String,
-    /// (n_K, our best verified γ), finite values only.
+    /// (n_K, our best verified γ), finite values only: the strong objective's.
     pub ours: Vec<(usize, f64)>,
+    /// (n_K, our best verified γ of the plain objective, K may be unstable); empty unless the
+    /// campaign ran it.
+    pub plain: Vec<(usize, f64)>,
     /// (n_K, the paper's HIFOO γ).
     pub paper: Vec<(usize, f64)>,
     /// The full-order bound γ_opt (None if unknown), and whether it is the paper's value.
@@ -24,7 +31,7 @@ pub struct GammaOrderFigure {
 impl GammaOrderFigure {
     /// Every γ shown (ours, paper, bound).
     fn values(&self) -> impl Iterator<Item = f64> + '_ {
-        self.ours.iter().chain(&self.paper).map(|p| p.1).chain(self.full_order.map(|f| f.0))
+        self.ours.iter().chain(&self.plain).chain(&self.paper).map(|p| p.1).chain(self.full_order.map(|f| f.0))
     }
 
     /// Whether the y axis is logarithmic.
@@ -38,7 +45,7 @@ impl GammaOrderFigure {
         Y: AsRangedCoord<Value = f64>,
         Y::CoordDescType: ValueFormatter<f64>,
     {
-        let orders = self.ours.iter().chain(&self.paper).map(|p| p.0);
+        let orders = self.ours.iter().chain(&self.plain).chain(&self.paper).map(|p| p.0);
         let (kmin, kmax) = orders.fold((usize::MAX, 0), |(l, h), k| (l.min(k), h.max(k)));
         let (kmin, kmax) = if kmin > kmax { (0, 1) } else { (kmin, kmax) };
         let x = (kmin as f64 - 0.5)..(kmax as f64 + 0.5);
@@ -68,13 +75,33 @@ impl GammaOrderFigure {
             .draw()
             .map_err(msg)?;
         if let Some((g, from_paper)) = self.full_order {
-            let label = if from_paper { "full-order bound (paper's value)" } else { "full-order bound γ_opt" };
+            let label = if from_paper {
+                format!("full-order bound {} (paper's value)", tick(g))
+            } else {
+                format!("full-order bound γ_opt = {}", tick(g))
+            };
             let style = ShapeStyle::from(&colour::BOUND).stroke_width(2);
             chart
                 .draw_series(DashedLineSeries::new(vec![(kmin as f64 - 0.5, g), (kmax as f64 + 0.5, g)], 10, 6, style))
                 .map_err(msg)?
                 .label(label)
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+            // the value on the line itself, at its left end, just above it
+            chart
+                .draw_series(std::iter::once(
+                    Text::new(
+                        format!("γ_opt = {}", tick(g)),
+                        (kmin as f64 - 0.45, g),
+                        (FONT_FAMILY, 16).into_font().color(&colour::BOUND).pos(
+                            plotters::style::text_anchor::Pos::new(
+                                plotters::style::text_anchor::HPos::Left,
+                                plotters::style::text_anchor::VPos::Bottom,
+                            ),
+                        ),
+                    )
+                    .into_dyn(),
+                ))
+                .map_err(msg)?;
         }
         let line = |pts: &[(usize, f64)]| -> Vec<(f64, f64)> { pts.iter().map(|&(k, g)| (k as f64, g)).collect() };
         let paper = line(&self.paper);
@@ -91,6 +118,21 @@ impl GammaOrderFigure {
                         + TriangleMarker::new((0, 0), 7, c.filled())
                 });
         }
+        let plain = line(&self.plain);
+        if !plain.is_empty() {
+            let c = colour::CONTROLLER;
+            chart.draw_series(LineSeries::new(plain.clone(), c.stroke_width(2))).map_err(msg)?;
+            chart.draw_series(plain.iter().map(|&p| Rectangle::new([p, p], c.filled()))).map_err(msg)?;
+            chart
+                .draw_series(plain.iter().map(|&p| Cross::new(p, 7, c.stroke_width(3))))
+                .map_err(msg)?
+                .label("ours, plain objective (K may be unstable)")
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x + 12, y))
+                        + PathElement::new(vec![(-12, 0), (12, 0)], c.stroke_width(2))
+                        + Cross::new((0, 0), 6, c.stroke_width(3))
+                });
+        }
         let ours = line(&self.ours);
         if !ours.is_empty() {
             let c = colour::OURS;
@@ -98,7 +140,7 @@ impl GammaOrderFigure {
             chart
                 .draw_series(ours.iter().map(|&p| Circle::new(p, 6, c.filled())))
                 .map_err(msg)?
-                .label("ours (best verified)")
+                .label(if self.plain.is_empty() { "ours (best verified)" } else { "ours, strong (K stable)" })
                 .legend(move |(x, y)| {
                     EmptyElement::at((x + 12, y))
                         + PathElement::new(vec![(-12, 0), (12, 0)], c.stroke_width(2))
@@ -115,7 +157,12 @@ impl Figure for GammaOrderFigure {
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
         if self.log_axis() {
             let (a, b) = padded_range(lo, hi, true);
-            self.draw_with(root, (a..b).log_scale())
+            let ticks = log_ticks(a, b);
+            if ticks.len() >= 2 {
+                self.draw_with(root, (a..b).log_scale().with_key_points(ticks))
+            } else {
+                self.draw_with(root, (a..b).log_scale())
+            }
         } else {
             let (a, b) = padded_range(lo, hi, false);
             self.draw_with(root, a..b)

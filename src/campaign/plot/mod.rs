@@ -2,8 +2,9 @@
 //!
 //! * `gamma-vs-order_<plant>` — [`GammaOrderFigure`]: our best verified γ per n_K, the paper's HIFOO
 //!   values and the full-order bound;
-//! * `convergence_<plant>_nK<k>` — [`ConvergenceFigure`]: the objective of the best job of each
-//!   (plant, order) against CPU time from its MCAP trace, phases and restarts marked;
+//! * `convergence_<plant>_nK<k>` — [`ConvergenceFigure`]: the best objective so far of the best
+//!   job of each (plant, order) against CPU time from its MCAP trace, a thinned sample of its
+//!   local searches behind it (`_plain` appended for the plain objective's best job);
 //! * `sigma_<plant>_nK<k>` — [`SigmaFigure`]: σmax of T_zw(iω) and of K(iω) for the best controller of
 //!   each (plant, order), peak marked.
 //!
@@ -11,7 +12,7 @@
 //! and the reference table. Drawing is `plotters` with a bundled font (`render.rs`), so nothing
 //! outside Rust crates is needed.
 
-pub(crate) mod convergence;
+pub mod convergence;
 pub(crate) mod gamma_order;
 pub(crate) mod render;
 pub(crate) mod sigma;
@@ -24,11 +25,12 @@ use super::reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
 use super::reference::{RefMethod, ReferenceRow};
 use super::report::ReportError;
 use super::trace::{read_iterations, TraceError};
+use crate::design::ObjectiveKind;
 use crate::lti::{Controller, LtiError, Plant};
 
 pub use convergence::ConvergenceFigure;
 pub use gamma_order::GammaOrderFigure;
-pub use render::{png_bytes, svg_text, write_by_extension, write_png_and_svg, DrawError, Figure, SIZE};
+pub use render::{log_ticks, png_bytes, svg_text, write_by_extension, write_png_and_svg, DrawError, Figure, SIZE};
 pub use sigma::SigmaFigure;
 
 /// Errors making a figure, naming the file.
@@ -98,8 +100,13 @@ pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[Ref
     names
         .into_iter()
         .map(|(p, fp)| {
-            let ours =
-                best.iter().filter(|r| r.plant == p && r.gamma.is_finite()).map(|r| (r.order, r.gamma)).collect();
+            let series = |o: ObjectiveKind| -> Vec<(usize, f64)> {
+                best.iter()
+                    .filter(|r| r.plant == p && r.objective == o && r.gamma.is_finite())
+                    .map(|r| (r.order, r.gamma))
+                    .collect()
+            };
+            let (ours, plain) = (series(ObjectiveKind::Strong), series(ObjectiveKind::Plain));
             let mut paper: Vec<(usize, f64)> = reference
                 .iter()
                 .filter(|r| r.is_for(fp) && r.method == RefMethod::Hifoo)
@@ -107,7 +114,7 @@ pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[Ref
                 .collect();
             paper.sort_by_key(|x| x.0);
             let full_order = full.iter().find(|f| f.plant == p && f.gamma.is_finite()).map(|f| (f.gamma, f.from_paper));
-            GammaOrderFigure { plant: p.to_string(), ours, paper, full_order }
+            GammaOrderFigure { plant: p.to_string(), ours, plain, paper, full_order }
         })
         .collect()
 }
@@ -135,15 +142,18 @@ pub fn write_plots(
         keep(write_png_and_svg(&fig, &dir.join(format!("gamma-vs-order_{}", file_part(&fig.plant)))), &mut out);
     }
     for row in &best {
-        let tag = format!("{}_nK{}", file_part(&row.plant), row.order);
+        // a plain row's figures are told apart by the objective (a strong row keeps its old name)
+        let plain = row.objective == ObjectiveKind::Plain;
+        let tag = format!("{}_nK{}{}", file_part(&row.plant), row.order, if plain { "_plain" } else { "" });
         let Some(job) = row.job_id.as_deref() else {
             out.skipped.push(format!("{} n_K = {}: no verified controller", row.plant, row.order));
             continue;
         };
         let title = format!(
-            "{}, n_K = {} (ε = {}, seed {})",
+            "{}, n_K = {}{} (ε = {}, seed {})",
             row.plant,
             row.order,
+            if plain { ", plain" } else { "" },
             row.eps.unwrap_or(f64::NAN),
             row.seed.unwrap_or(0)
         );

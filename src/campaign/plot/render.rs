@@ -137,6 +137,29 @@ pub fn spans_decades(lo: f64, hi: f64) -> bool {
     lo > 0.0 && hi / lo > 10.0
 }
 
+/// Tick positions for a log axis over `[lo, hi]` (0 < lo < hi) that label the whole range, not
+/// only its powers of ten: 1, 2, 5 × 10ᵏ, or every integer multiple 1…9 × 10ᵏ when that gives fewer
+/// than four ticks (γ from 2.5 to 40 got one label, 10, from plotters' own choice); at most ~12.
+pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |mults: &[f64]| -> Vec<f64> {
+        let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (k0..=k1)
+            .flat_map(|k| mults.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|&t| t >= lo * (1.0 - 1e-12) && t <= hi * (1.0 + 1e-12))
+            .collect()
+    };
+    let coarse: Vec<f64> = within(&[1.0]);
+    let mid = within(&[1.0, 2.0, 5.0]);
+    let fine = within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    [fine, mid, coarse.clone()].into_iter().find(|t| t.len() >= 4 && t.len() <= 12).unwrap_or_else(|| {
+        if coarse.len() > 12 {
+            coarse
+        } else {
+            within(&[1.0, 2.0, 5.0])
+        }
+    })
+}
+
 /// A tick or value label: at most 4 significant figures, trailing zeros dropped (`0.5`, `1.25`,
 /// `0.0003512`), scientific outside 10⁻³ … 10⁵ (`1.0e-6`).
 pub fn tick(x: f64) -> String {

@@ -2,19 +2,19 @@
 //! log-log, with the H∞ peak of T_zw marked (the level-set value and frequency from
 //! `lti::hinf_norm`, not the grid's maximum).
 //!
-//! The frequency grid is logarithmic, from a decade below the slowest to a decade above the
-//! fastest closed-loop or controller mode (|λ|, zero modes ignored), widened to contain the
-//! peak, with the peak frequency itself added to the grid.
+//! The frequency band runs from a decade below the slowest to a decade above the fastest
+//! closed-loop or controller mode (|λ|, zero modes ignored), widened to contain the peak
+//! (`lti::frequency_band`); each curve is `lti::sigma_curve`'s adaptive grid (200 log-spaced
+//! points, refined where σmax bends or peaks, at most 3000), so the curves are smooth at their
+//! peaks and the SVG stays small; the peak frequency itself is on the closed loop's grid.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, draw_legend, msg, tick, DrawError, Figure, FONT_FAMILY};
-use crate::lti::freq_response::FreqResponse;
-use crate::lti::{closed_loop, hinf_norm, Controller, HinfParams, LtiError, Plant, StateSpace};
-
-/// Points of the frequency grid.
-pub const GRID_POINTS: usize = 600;
+use super::render::{colour, draw_legend, log_ticks, msg, tick, DrawError, Figure, FONT_FAMILY};
+use crate::lti::{
+    closed_loop, frequency_band, hinf_norm, sigma_curve, Controller, HinfParams, LtiError, Plant, StateSpace,
+};
 
 /// Data of one σ-plot.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,16 +29,6 @@ pub struct SigmaFigure {
     pub peak: (f64, f64),
 }
 
-/// |λ| of the nonzero eigenvalues of `a`.
-fn mode_magnitudes(a: faer::MatRef<'_, f64>) -> Vec<f64> {
-    crate::lti::eigenvalues_of(a)
-        .unwrap_or_default()
-        .into_iter()
-        .map(|l| l.norm())
-        .filter(|m| *m > 0.0 && m.is_finite())
-        .collect()
-}
-
 impl SigmaFigure {
     /// Computes the curves of `k` on `plant`. Errors if the closed loop cannot be formed; an
     /// unstable closed loop is drawn all the same (its peak is then +∞ and not marked).
@@ -46,27 +36,10 @@ impl SigmaFigure {
         let cl = closed_loop(plant, k)?;
         let ks = StateSpace::new(k.ak.clone(), k.bk.clone(), k.ck.clone(), k.dk.clone())?;
         let h = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set");
-        let mut mags = mode_magnitudes(cl.a.as_ref());
-        mags.extend(mode_magnitudes(k.ak.as_ref()));
-        let (mut lo, mut hi) = mags.iter().fold((f64::INFINITY, 0f64), |(l, h), &m| (l.min(m), h.max(m)));
-        if !(lo <= hi) {
-            (lo, hi) = (1.0, 1.0);
-        }
-        if h.peak_freq.is_finite() && h.peak_freq > 0.0 {
-            lo = lo.min(h.peak_freq);
-            hi = hi.max(h.peak_freq);
-        }
-        let (l0, l1) = ((lo / 10.0).log10().floor(), (hi * 10.0).log10().ceil());
-        let mut grid: Vec<f64> =
-            (0..GRID_POINTS).map(|i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (GRID_POINTS - 1) as f64)).collect();
-        if h.peak_freq.is_finite() && h.peak_freq > 0.0 {
-            grid.push(h.peak_freq);
-            grid.sort_by(f64::total_cmp);
-        }
-        let mut fr_cl = FreqResponse::new(&cl);
-        let mut fr_k = FreqResponse::new(&ks);
-        let closed_loop = grid.iter().map(|&w| (w, fr_cl.sigma_max(w))).collect();
-        let controller = grid.iter().map(|&w| (w, fr_k.sigma_max(w))).collect();
+        let peak = [h.peak_freq];
+        let band = frequency_band(&[&cl, &ks], &peak);
+        let closed_loop = sigma_curve(&cl, band, &peak);
+        let controller = sigma_curve(&ks, band, &[]);
         Ok(SigmaFigure { title, closed_loop, controller, peak: (h.value, h.peak_freq) })
     }
 
@@ -82,6 +55,34 @@ impl SigmaFigure {
         }
         let (w0, w1) = (self.closed_loop.first()?.0, self.closed_loop.last()?.0);
         Some((w.clamp(w0, w1), g))
+    }
+}
+
+/// The points of a log-log curve worth drawing: a point is kept when it moves at least about a
+/// pixel (1/800 of the axes' log spans) from the last one kept, and so is every local maximum and
+/// the last point. The adaptive grid is denser than the pixels where the curve is steep, and a
+/// thick line through sub-pixel segments draws hairy edges.
+fn for_screen(points: impl Iterator<Item = (f64, f64)>, x: (f64, f64), y: (f64, f64)) -> Vec<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = points.collect();
+    let (dx, dy) = ((x.1 / x.0).ln() / 800.0, (y.1 / y.0).ln() / 800.0);
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(pts.len());
+    for (i, &p) in pts.iter().enumerate() {
+        let peak = i > 0 && i + 1 < pts.len() && p.1 >= pts[i - 1].1 && p.1 >= pts[i + 1].1;
+        let far = out.last().is_none_or(|&(x0, y0)| (p.0 / x0).ln().abs() >= dx || (p.1 / y0).ln().abs() >= dy);
+        if far || peak || i + 1 == pts.len() {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// The σ axis's ticks: [`log_ticks`], or its two ends when the range is too narrow for any.
+fn y_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let t = log_ticks(lo, hi);
+    if t.len() >= 2 {
+        t
+    } else {
+        vec![lo, hi]
     }
 }
 
@@ -102,7 +103,7 @@ impl Figure for SigmaFigure {
             .margin(16)
             .x_label_area_size(54)
             .y_label_area_size(90)
-            .build_cartesian_2d((w0..w1).log_scale(), (lo..hi).log_scale())
+            .build_cartesian_2d((w0..w1).log_scale(), (lo..hi).log_scale().with_key_points(y_ticks(lo, hi)))
             .map_err(msg)?;
         chart
             .configure_mesh()
@@ -114,15 +115,15 @@ impl Figure for SigmaFigure {
             .axis_desc_style((FONT_FAMILY, 17))
             .draw()
             .map_err(msg)?;
-        let cl_style = colour::OURS.stroke_width(3);
+        let cl_style = colour::OURS.stroke_width(2);
         chart
-            .draw_series(LineSeries::new(Self::positive(&self.closed_loop), cl_style))
+            .draw_series(LineSeries::new(for_screen(Self::positive(&self.closed_loop), (w0, w1), (lo, hi)), cl_style))
             .map_err(msg)?
             .label("σ_max(T_zw(iω)), closed loop")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], cl_style));
         let k_style = colour::CONTROLLER.stroke_width(2);
         chart
-            .draw_series(LineSeries::new(Self::positive(&self.controller), k_style))
+            .draw_series(LineSeries::new(for_screen(Self::positive(&self.controller), (w0, w1), (lo, hi)), k_style))
             .map_err(msg)?
             .label("σ_max(K(iω)), controller")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], k_style));

@@ -8,3 +8,4 @@
 pub(crate) mod discrete;
 pub(crate) mod gradient;
 pub(crate) mod hinf;
+pub(crate) mod sigma;

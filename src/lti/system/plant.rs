@@ -229,10 +229,17 @@ impl Plant {
     }
 
     /// Parses and validates a plant from JSON text; `file` names it in errors.
+    ///
+    /// As in a MAT-file, `name` and `dims` may be left out: the file's stem names the plant and
+    /// the dimensions are inferred from the blocks (an empty `[]` block is then a zero block).
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let err = |kind| PlantError { file: file.as_ref().to_path_buf(), kind };
-        let doc: Value = serde_json::from_str(text)
+        let mut doc: Value = serde_json::from_str(text)
             .map_err(|e| err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() }))?;
+        if let Value::Object(o) = &mut doc {
+            let stem = file.as_ref().file_stem().map_or_else(|| "plant".into(), |s| s.to_string_lossy().into_owned());
+            complete_document(o, &stem);
+        }
         Self::from_json_value(&doc).map_err(err)
     }
 
@@ -432,18 +439,44 @@ fn read_dims(v: Option<&Value>) -> Result<Dims, PlantErrorKind> {
 const PLANT_HINT: &str =
     " (a plant .mat file holds A B1 B2 C1 C2 D11 D12 D21 D22 as real full numeric arrays; character, cell, struct and sparse variables are not read)";
 
-/// Infers one dimension from the first non-empty variable that carries it.
-fn infer(vars: &BTreeMap<String, MatVar>, dim: &str) -> usize {
+/// Infers one dimension from the first block with entries that carries it (`shape` gives a
+/// block's rows and columns, `None` when absent).
+fn infer(shape: &impl Fn(&str) -> Option<(usize, usize)>, dim: &str) -> usize {
     for (key, r, c) in MATRICES {
-        let Some(v) = vars.get(key).filter(|v| !v.is_empty()) else { continue };
+        let Some((rows, cols)) = shape(key).filter(|(r, c)| r * c > 0) else { continue };
         if r == dim {
-            return v.rows;
+            return rows;
         }
         if c == dim {
-            return v.cols;
+            return cols;
         }
     }
     0
+}
+
+/// Completes a plant document the way a MAT-file needs and a JSON file may ask for: without
+/// `name`, the file's `stem` names the plant; without `dims`, they are inferred from the blocks'
+/// sizes (n = rows of A, m1 = columns of B1, else of D11 or D21, and so on) and every block with
+/// no entries (`[]`) becomes a zero block of the size the others imply. A document with `dims`
+/// keeps its blocks as they are (and is checked against them).
+fn complete_document(doc: &mut Map<String, Value>, stem: &str) {
+    if !doc.contains_key("name") {
+        doc.insert("name".into(), stem.into());
+    }
+    if doc.contains_key("dims") {
+        return;
+    }
+    let shape = |key: &str| doc.get(key).and_then(json_shape);
+    let dims: BTreeMap<&str, usize> =
+        ["n", "m1", "m2", "p1", "p2"].into_iter().map(|d| (d, infer(&shape, d))).collect();
+    let empty: Vec<_> =
+        MATRICES.into_iter().filter(|(key, _, _)| shape(key).is_some_and(|(rows, cols)| rows * cols == 0)).collect();
+    for (key, r, c) in empty {
+        let (rows, cols) = (dims[r], dims[c]);
+        let zero = Value::Array((0..rows).map(|_| Value::Array(vec![json_number(0.0); cols])).collect());
+        doc.insert(key.into(), zero);
+    }
+    doc.insert("dims".into(), serde_json::to_value(&dims).expect("dims serialise"));
 }
 
 fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind> {
@@ -477,23 +510,17 @@ fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
             Some(v) => first_non_finite(key, v)?,
         }
     }
-    let dims: BTreeMap<&str, usize> = ["n", "m1", "m2", "p1", "p2"].into_iter().map(|d| (d, infer(&vars, d))).collect();
     let name = read_char_var(bytes, "name").filter(|s| !s.trim().is_empty()).unwrap_or_else(|| stem.to_string());
     let mut doc = Map::new();
     doc.insert("name".into(), name.into());
     doc.insert("description".into(), format!("read from the MATLAB file {stem}.mat").into());
-    doc.insert("dims".into(), serde_json::to_value(&dims).expect("dims serialise"));
-    for (key, r, c) in MATRICES {
+    for (key, _, _) in MATRICES {
         let v = &vars[key];
-        let value = if v.is_empty() {
-            // an empty variable is a zero block of the inferred size
-            let (rows, cols) = (dims[r], dims[c]);
-            Value::Array((0..rows).map(|_| Value::Array(vec![json_number(0.0); cols])).collect())
-        } else {
-            var_to_json(v)
-        };
+        // an empty variable is a zero block of the inferred size (`complete_document`)
+        let value = if v.is_empty() { Value::Array(Vec::new()) } else { var_to_json(v) };
         doc.insert(key.into(), value);
     }
+    complete_document(&mut doc, stem);
     Ok(Value::Object(doc))
 }
 

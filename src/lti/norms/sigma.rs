@@ -1,0 +1,239 @@
+//! σmax(G(iω)) along the frequency axis: the band worth looking at, an adaptive curve (dense
+//! where the curve bends or peaks, so a plot is smooth at its peaks with few points elsewhere)
+//! and every frequency where σmax comes within a relative tolerance of the H∞ norm (an optimal
+//! controller often equalises several peaks: ω = 0, a resonance and ω → ∞ at once).
+
+use super::hinf::HinfNorm;
+use crate::lti::kernels::freq_response::FreqResponse;
+use crate::lti::kernels::spectral::eigenvalues;
+use crate::lti::StateSpace;
+
+/// Relative tolerance within which two computed norms count as the same value: peaks of σmax
+/// within it of ‖G‖∞ are all reported as peaks ([`near_peak_frequencies`]), ε‖K‖∞ within it of
+/// ‖Tzw‖∞ makes the controller-norm term active (`design`), and replicates within it of the best
+/// γ count as reaching it (`campaign`). 0.1 %: what a person reading 4 significant figures sees
+/// as one number.
+pub const NORM_TIE_RTOL: f64 = 1e-3;
+
+/// Points of the first, uniform (in log ω) pass of [`sigma_curve`].
+pub const SIGMA_BASE_POINTS: usize = 200;
+/// Largest number of points [`sigma_curve`] returns.
+pub const SIGMA_MAX_POINTS: usize = 3000;
+/// Largest relative change of σmax between neighbouring points [`sigma_curve`] leaves unrefined.
+pub const SIGMA_STEP_RTOL: f64 = 0.02;
+
+/// The frequency band (rad/s) of the systems' dynamics: from a decade below the slowest to a
+/// decade above the fastest mode (|λ| of the nonzero eigenvalues of each A), widened to hold
+/// every finite positive frequency of `extra`; whole decades; (0.1, 10) with no modes.
+pub fn frequency_band(systems: &[&StateSpace], extra: &[f64]) -> (f64, f64) {
+    let mags = systems
+        .iter()
+        .flat_map(|s| eigenvalues(s.a.as_ref()).unwrap_or_default())
+        .map(|l| l.norm())
+        .filter(|m| *m > 0.0 && m.is_finite())
+        .chain(extra.iter().copied().filter(|w| *w > 0.0 && w.is_finite()));
+    let (lo, hi) = mags.fold((f64::INFINITY, 0f64), |(l, h), m| (l.min(m), h.max(m)));
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (1.0, 1.0) };
+    (10f64.powf((lo / 10.0).log10().floor()), 10f64.powf((hi * 10.0).log10().ceil()))
+}
+
+/// (ω, σmax(G(iω))) on `band`, ascending in ω: [`SIGMA_BASE_POINTS`] log-spaced points, then
+/// midpoints (in log ω) inserted next to every point where σmax changes by more than
+/// [`SIGMA_STEP_RTOL`] to a neighbour or has a local maximum, until no interval needs it or
+/// [`SIGMA_MAX_POINTS`] are reached. `extra` frequencies inside the band (a peak) are added.
+pub fn sigma_curve(sys: &StateSpace, band: (f64, f64), extra: &[f64]) -> Vec<(f64, f64)> {
+    let mut fr = FreqResponse::new(sys);
+    let (l0, l1) = (band.0.log10(), band.1.log10());
+    let n = SIGMA_BASE_POINTS;
+    let mut pts: Vec<(f64, f64)> = (0..n)
+        .map(|i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (n - 1) as f64))
+        .chain(extra.iter().copied().filter(|w| *w > band.0 && *w < band.1))
+        .map(|w| (w, fr.sigma_max(w)))
+        .collect();
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let rel = |a: f64, b: f64| (a - b).abs() / a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+    for _ in 0..12 {
+        let k = pts.len();
+        let mut split = vec![false; k.saturating_sub(1)];
+        for i in 0..k.saturating_sub(1) {
+            if rel(pts[i].1, pts[i + 1].1) > SIGMA_STEP_RTOL {
+                split[i] = true;
+            }
+        }
+        for i in 1..k.saturating_sub(1) {
+            if pts[i].1 > pts[i - 1].1 && pts[i].1 > pts[i + 1].1 {
+                split[i - 1] = true;
+                split[i] = true;
+            }
+        }
+        // intervals too narrow to split (a jump, not a bend) are left alone
+        for (i, s) in split.iter_mut().enumerate() {
+            *s &= pts[i + 1].0 / pts[i].0 > 1.0 + 1e-9;
+        }
+        let wanted = split.iter().filter(|s| **s).count();
+        if wanted == 0 || k + wanted > SIGMA_MAX_POINTS {
+            break;
+        }
+        let mut next = Vec::with_capacity(k + wanted);
+        for i in 0..k {
+            next.push(pts[i]);
+            if i + 1 < k && split[i] {
+                let w = (pts[i].0 * pts[i + 1].0).sqrt();
+                next.push((w, fr.sigma_max(w)));
+            }
+        }
+        pts = next;
+    }
+    pts
+}
+
+/// Every frequency where σmax(G(iω)) is within a relative `rtol` of `norm.value` (‖G‖∞ of a
+/// stable `sys`), ascending: ω = 0 and ω = +∞ (σmax(D)) when they qualify, and each local
+/// maximum of the [`sigma_curve`] on the system's [`frequency_band`], refined by golden-section
+/// search in log ω; `norm.peak_freq` is always one of them. Empty for an unstable system.
+pub fn near_peak_frequencies(sys: &StateSpace, norm: &HinfNorm, rtol: f64) -> Vec<f64> {
+    let peak = norm.value;
+    if !peak.is_finite() {
+        return Vec::new();
+    }
+    let level = peak * (1.0 - rtol);
+    let mut fr = FreqResponse::new(sys);
+    let mut found: Vec<f64> = Vec::new();
+    for w in [0.0, f64::INFINITY] {
+        if fr.sigma_max(w) >= level {
+            found.push(w);
+        }
+    }
+    let extra = [norm.peak_freq];
+    let curve = sigma_curve(sys, frequency_band(&[sys], &extra), &extra);
+    for i in 1..curve.len().saturating_sub(1) {
+        if curve[i].1 >= curve[i - 1].1 && curve[i].1 >= curve[i + 1].1 {
+            let (w, s) = golden_max(&mut fr, curve[i - 1].0, curve[i + 1].0);
+            if s.max(curve[i].1) >= level {
+                found.push(if s >= curve[i].1 { w } else { curve[i].0 });
+            }
+        }
+    }
+    if !norm.peak_freq.is_nan() {
+        found.push(norm.peak_freq);
+    }
+    found.sort_by(f64::total_cmp);
+    // one frequency per peak: neighbours within 1 % (or both near 0) are the same peak
+    let mut out: Vec<f64> = Vec::new();
+    for w in found {
+        match out.last() {
+            Some(&last) if w == last || (w.is_finite() && (w - last).abs() <= 1e-2 * w.max(last)) => {
+                // keep the reported peak frequency when it is one of the two
+                if w == norm.peak_freq {
+                    *out.last_mut().expect("non-empty") = w;
+                }
+            }
+            _ => out.push(w),
+        }
+    }
+    out
+}
+
+/// The maximum of σmax on [a, b] (0 < a < b) by golden-section search in log ω.
+fn golden_max(fr: &mut FreqResponse, a: f64, b: f64) -> (f64, f64) {
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = (a.ln(), b.ln());
+    let mut x1 = hi - g * (hi - lo);
+    let mut x2 = lo + g * (hi - lo);
+    let (mut f1, mut f2) = (fr.sigma_max(x1.exp()), fr.sigma_max(x2.exp()));
+    for _ in 0..60 {
+        if hi - lo < 1e-10 {
+            break;
+        }
+        if f1 >= f2 {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - g * (hi - lo);
+            f1 = fr.sigma_max(x1.exp());
+        } else {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + g * (hi - lo);
+            f2 = fr.sigma_max(x2.exp());
+        }
+    }
+    if f1 >= f2 {
+        (x1.exp(), f1)
+    } else {
+        (x2.exp(), f2)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lti::{hinf_norm, HinfParams};
+    use faer::Mat;
+
+    fn ss(a: Mat<f64>, b: Mat<f64>, c: Mat<f64>, d: Mat<f64>) -> StateSpace {
+        StateSpace::new(a, b, c, d).unwrap()
+    }
+
+    /// G(s) = 1 + 2ζωn s/(s² + 2ζωn s + ωn²)·k with a resonance: the band holds ωn, the curve is
+    /// refined around the peak (its points closer there than the uniform pass) and the peak is
+    /// found at ωn, |G(iωn)| = 1 + k.
+    #[test]
+    fn the_curve_is_dense_at_a_resonance_and_its_peak_is_found() {
+        let (wn, z, k) = (3.0, 0.01, 1.0);
+        let a = Mat::from_fn(2, 2, |i, j| [[0.0, 1.0], [-wn * wn, -2.0 * z * wn]][i][j]);
+        let b = Mat::from_fn(2, 1, |i, _| [0.0, 1.0][i]);
+        let c = Mat::from_fn(1, 2, |_, j| [0.0, 2.0 * z * wn * k][j]);
+        let d = Mat::from_fn(1, 1, |_, _| 1.0);
+        let g = ss(a, b, c, d);
+        let band = frequency_band(&[&g], &[]);
+        assert_eq!(band, (0.1, 100.0));
+        let curve = sigma_curve(&g, band, &[]);
+        assert!(curve.len() > SIGMA_BASE_POINTS && curve.len() <= SIGMA_MAX_POINTS);
+        assert!(curve.windows(2).all(|w| w[0].0 < w[1].0));
+        let step = |w0: f64| {
+            let i = curve.iter().position(|p| p.0 >= w0).unwrap();
+            curve[i + 1].0 / curve[i].0
+        };
+        let uniform = (1000f64).powf(1.0 / (SIGMA_BASE_POINTS - 1) as f64);
+        assert!(step(wn) < 1.0 + (uniform - 1.0) / 4.0, "not refined at the peak: {}", step(wn));
+        let h = hinf_norm(&g, &HinfParams::default()).unwrap();
+        assert!((h.value - (1.0 + k)).abs() < 1e-6, "{h:?}");
+        let peaks = near_peak_frequencies(&g, &h, NORM_TIE_RTOL);
+        assert_eq!(peaks.len(), 1, "{peaks:?}");
+        assert!((peaks[0] - wn).abs() < 1e-3 * wn, "{peaks:?}");
+    }
+
+    /// σmax equal to the norm at ω = 0, at a resonance and as ω → ∞, lower in between: the
+    /// diagonal system diag(1 − x(s), x(s)) with the band-pass x = 2ζωn s/(s² + 2ζωn s + ωn²),
+    /// whose value on the imaginary axis runs on the circle |x − ½| = ½ from 0 (ω = 0) through
+    /// 1 (ω = ωn) back to 0 (ω → ∞): σmax = max(|1 − x|, |x|) is 1 at the three and below 1
+    /// elsewhere.
+    #[test]
+    fn every_frequency_at_the_peak_is_reported() {
+        let (wn, z) = (0.72, 0.05);
+        let t = 2.0 * z * wn;
+        let a = Mat::from_fn(4, 4, |i, j| match (i, j) {
+            (0, 1) | (2, 3) => 1.0,
+            (1, 0) | (3, 2) => -wn * wn,
+            (1, 1) | (3, 3) => -t,
+            _ => 0.0,
+        });
+        let b = Mat::from_fn(4, 2, |i, j| if (i, j) == (1, 0) || (i, j) == (3, 1) { 1.0 } else { 0.0 });
+        let c = Mat::from_fn(2, 4, |i, j| match (i, j) {
+            (0, 1) => -t,
+            (1, 3) => t,
+            _ => 0.0,
+        });
+        let d = Mat::from_fn(2, 2, |i, j| if (i, j) == (0, 0) { 1.0 } else { 0.0 });
+        let g = ss(a, b, c, d);
+        let h = hinf_norm(&g, &HinfParams::default()).unwrap();
+        assert!((h.value - 1.0).abs() < 1e-6, "{h:?}");
+        let peaks = near_peak_frequencies(&g, &h, NORM_TIE_RTOL);
+        assert_eq!(peaks.len(), 3, "{peaks:?}");
+        assert_eq!(peaks[0], 0.0);
+        assert!((peaks[1] - wn).abs() < 1e-3, "{peaks:?}");
+        assert!(peaks[2].is_infinite());
+        // a tighter tolerance than the ends' distance keeps them: they are exactly 1
+        assert_eq!(near_peak_frequencies(&g, &h, 1e-9).len(), 3);
+    }
+}
