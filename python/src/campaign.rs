@@ -7,8 +7,8 @@ use pyo3::prelude::*;
 use serde_json::{json, Value};
 
 use hinfix::campaign::{
-    campaign_dir, expand, journals_in, read_journal, records_for, report, run_jobs, trace_observers, Campaign,
-    DesignRunner, ExecuteOptions, ProgressDisplay, Reporter, RunnerTag,
+    campaign_dir, design_job, expand, journals_in, read_journal, records_for, report, run_jobs, trace_observers,
+    Campaign, ExecuteOptions, ProgressDisplay, Reporter, RunnerTag,
 };
 
 use crate::errors::{bad_input, failure};
@@ -45,7 +45,7 @@ pub fn run_campaign(
                 reporter.on_event(ev)
             }
         };
-        let outcome = run_jobs(&jobs, &dir, &DesignRunner, &observers, &opts, on_event).map_err(|e| e.to_string())?;
+        let outcome = run_jobs(&jobs, &dir, &design_job, &observers, &opts, on_event).map_err(|e| e.to_string())?;
         let records = records_for(&jobs, &outcome.records);
         let rep = report(&dir, &campaign, &records).map_err(|e| e.to_string())?;
         let s = &outcome.stats;
