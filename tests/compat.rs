@@ -67,7 +67,8 @@ fn as_schema_2(old: &Value) -> Value {
             o.remove(*k);
         }
     }
-    // the per-phase counters are written with the outcome's key names since issue 35
+    // the per-phase counters are written with the outcome's key names (`iterations`,
+    // `evaluations`, `design_cpu_s`); older lines said `iters`, `evals`, `cpu_s`
     if let Some(Value::Array(phases)) = o.get_mut("phases") {
         for p in phases.iter_mut().filter_map(Value::as_object_mut) {
             for (old, new) in [("iters", "iterations"), ("evals", "evaluations"), ("cpu_s", "design_cpu_s")] {
