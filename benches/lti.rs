@@ -131,7 +131,7 @@ fn plant(name: &str) -> Plant {
 /// Objective+gradient evaluations per second at controller `k` (performance phase, strong
 /// stabilisation, ε = 1e-3), with a small perturbation per evaluation so no cache can help.
 fn evals_per_second(name: &str, plant: &Plant, k: &Controller, seconds: f64) {
-    let shape = ControllerShape { nk: k.order(), m: k.outputs(), p: k.inputs() };
+    let shape = ControllerShape { nk: k.order(), m: k.outputs(), p: k.inputs(), domain: Default::default() };
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
     let mut obj = DesignObjective::new(plant, shape, ObjectivePhase::Performance, true, 1e-3, DEFAULT_HINF_TOL, cache);
     let x0 = controller_to_x(k);

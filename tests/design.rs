@@ -426,7 +426,7 @@ fn ac10_order1_default_search_with_scaled_cycles_gets_far_below_the_unscaled_one
 #[test]
 fn variable_scaling_modes_are_bit_identical_on_a_plant_with_alike_channels() {
     let p = plant("HE1");
-    assert!(variable_scaling(&p, ControllerShape { nk: 1, m: p.dims.m2, p: p.dims.p2 }).is_none());
+    assert!(variable_scaling(&p, ControllerShape::for_plant(&p, 1)).is_none());
     let base = DesignOptions { order: 1, eps: 1e-3, seed: 3, cpumax: 1e6, maxevals: Some(2000), ..Default::default() };
     let runs: Vec<_> = [VariableScaling::Off, VariableScaling::Alternate, VariableScaling::Always]
         .map(|mode| run(&p, &DesignOptions { variable_scaling: mode, ..base.clone() }, None, &mut NoDesignObserver))

@@ -106,6 +106,7 @@ const KEYS: &[&str] = &[
     "D12",
     "D21",
     "D22",
+    "Ts",
     "source",
     "citation",
     "order",

@@ -38,6 +38,7 @@ fn random_plant(n: usize, seed: u64) -> Plant {
         notes: String::new(),
         check: None,
         dims: Dims { n, m1, m2, p1, p2 },
+        domain: Default::default(),
         a,
         b1: m(n, m1, 1.0),
         b2: m(n, m2, 1.0),
@@ -104,7 +105,7 @@ fn closed_loop_gradient_is_interrupted() {
 }
 
 fn perf_objective(plant: &Plant, stop: Option<Rc<dyn Fn() -> bool>>) -> DesignObjective<'_> {
-    let shape = ControllerShape { nk: 0, m: plant.dims.m2, p: plant.dims.p2 };
+    let shape = ControllerShape { nk: 0, m: plant.dims.m2, p: plant.dims.p2, domain: Default::default() };
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
     DesignObjective::new(plant, shape, ObjectivePhase::Performance, true, 1e-3, DEFAULT_HINF_TOL, cache)
         .with_interrupt(stop)

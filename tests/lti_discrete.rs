@@ -19,8 +19,8 @@ use std::path::PathBuf;
 
 use faer::{c64, Mat};
 use hinfix::lti::{
-    full_order_gamma_discrete, hinf_norm_discrete, spectral_radius, Dims, FullOrderOptions, HinfParams, Plant,
-    StateSpace, DEFAULT_HINF_TOL,
+    full_order_gamma_discrete, full_order_gamma_with, hinf_norm_discrete, spectral_radius, Dims, FullOrderOptions,
+    HinfParams, Plant, StateSpace, TimeDomain, DEFAULT_HINF_TOL,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -130,6 +130,7 @@ fn discrete_full_order_gamma_matches_sb10dd() {
             notes: String::new(),
             check: None,
             dims: Dims { n, m1, m2, p1, p2 },
+            domain: TimeDomain::Discrete { ts: 1.0 },
             a: mat(&case["A"], n, n),
             b1: mat(&case["B1"], n, m1),
             b2: mat(&case["B2"], n, m2),
@@ -142,6 +143,9 @@ fn discrete_full_order_gamma_matches_sb10dd() {
         };
         let want = case["gamma_opt"].as_f64().unwrap();
         let got = full_order_gamma_discrete(&plant, &FullOrderOptions::default()).unwrap();
+        // a plant in discrete time takes the same route through the general entry point
+        let general = full_order_gamma_with(&plant, &FullOrderOptions::default()).unwrap();
+        assert_eq!(general.gamma.to_bits(), got.gamma.to_bits(), "{name}");
         let rel = (got.gamma - want).abs() / want;
         worst = worst.max(rel);
         eprintln!("{name}: γ_opt {} vs SB10DD {want} (rel {rel:.1e})", got.gamma);

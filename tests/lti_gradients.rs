@@ -34,6 +34,7 @@ fn random_plant(rng: &mut ChaCha8Rng, n: usize, m1: usize, m2: usize, p1: usize,
         notes: String::new(),
         check: None,
         dims: Dims { n, m1, m2, p1, p2 },
+        domain: Default::default(),
         a,
         b1: randn(rng, n, m1, 1.0),
         b2: randn(rng, n, m2, 1.0),
@@ -52,6 +53,7 @@ fn random_controller(rng: &mut ChaCha8Rng, nk: usize, m: usize, p: usize) -> Con
         bk: randn(rng, nk, p, 0.3),
         ck: randn(rng, m, nk, 0.3),
         dk: randn(rng, m, p, 0.3),
+        domain: Default::default(),
     }
 }
 

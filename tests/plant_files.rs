@@ -246,7 +246,7 @@ fn unknown_name_lists_the_library() {
 #[test]
 fn unknown_top_level_key_is_rejected_by_name() {
     // A misspelt matrix (`d12`) or a key this version does not know was ignored.
-    for key in ["d12", "Ts", "comment"] {
+    for key in ["d12", "ts", "dt", "comment"] {
         let text = with(|o| {
             o.insert(key.into(), json!(1));
         });
@@ -260,6 +260,7 @@ fn unknown_top_level_key_is_rejected_by_name() {
         o.insert("check".into(), json!({"gamma": 1.0}));
         o.insert("order".into(), json!(2));
         o.insert("description".into(), json!("d"));
+        o.insert("Ts".into(), json!(0.5));
     });
     Plant::from_json_str(&text, "p.json").unwrap();
 }

@@ -28,7 +28,7 @@ fn ac10_measurements_are_scaled_apart_and_alike_plants_are_not_scaled() {
     for name in ["HE1", "Enns", "REA2", "AC8"] {
         assert_eq!(channel_scales(&plant(name)), None, "{name}");
     }
-    let shape = ControllerShape { nk: 1, m: 2, p: 2 };
+    let shape = ControllerShape { nk: 1, m: 2, p: 2, domain: Default::default() };
     let d = variable_scaling(&plant("AC10"), shape).unwrap();
     // [Ak; Bk (1×2); Ck (2×1); Dk (2×2) column-major]
     let want = [1.0, sy[0], sy[1], su[0], su[1], su[0] * sy[0], su[1] * sy[0], su[0] * sy[1], su[1] * sy[1]];
@@ -36,7 +36,7 @@ fn ac10_measurements_are_scaled_apart_and_alike_plants_are_not_scaled() {
 }
 
 fn objective<'p>(p: &'p Plant, phase: ObjectivePhase, d: Option<&[f64]>) -> DesignObjective<'p> {
-    let shape = ControllerShape { nk: 1, m: p.dims.m2, p: p.dims.p2 };
+    let shape = ControllerShape::for_plant(p, 1);
     let cache = Rc::new(RefCell::new(ComponentCache::default()));
     DesignObjective::new(p, shape, phase, true, 1e-3, DEFAULT_HINF_TOL, cache).with_scaling(d.map(Into::into))
 }
@@ -46,7 +46,7 @@ fn objective<'p>(p: &'p Plant, phase: ObjectivePhase, d: Option<&[f64]>) -> Desi
 #[test]
 fn scaled_objective_is_the_same_function_with_the_chain_rule_gradient() {
     let p = plant("REA2");
-    let shape = ControllerShape { nk: 1, m: p.dims.m2, p: p.dims.p2 };
+    let shape = ControllerShape::for_plant(&p, 1);
     // REA2 is not scaled by default (channels 4× apart); this d (s_u = [1/16, 1/4],
     // s_y = [1/2, 2]) tests the mapping.
     let d = [1.0, 0.5, 2.0, 0.0625, 0.25, 0.03125, 0.125, 0.125, 0.5];

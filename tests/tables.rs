@@ -137,8 +137,14 @@ fn a_plant_of_ones_own_gets_the_campaign_layout_and_the_two_objectives_side_by_s
     let best = vec![strong(1, 3.0), plain(1, 2.5, false), strong(2, 2.6), plain(2, 2.6, true), strong(3, 2.55)];
     let full =
         vec![FullOrderRow { plant: "two_mass".into(), gamma: 2.4, from_paper: false, controller_stable: Some(false) }];
-    let about =
-        CampaignAbout { names: vec!["own".into()], eps: vec![1e-3, 1e-2], seeds: 3, cpumax: vec![20.0], jobs: 30 };
+    let about = CampaignAbout {
+        names: vec!["own".into()],
+        eps: vec![1e-3, 1e-2],
+        seeds: 3,
+        cpumax: vec![20.0],
+        jobs: 30,
+        sampling_times: Default::default(),
+    };
     let tex = tables_tex_about(&best, &full, &reference(), &about);
     assert!(
         !tex.contains("paper (HIFOO)")

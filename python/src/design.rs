@@ -85,7 +85,7 @@ fn controller_from(k: &[In<'_>]) -> PyResult<Controller> {
             return Err(bad_input("init", format!("{what} is {}×{}, expected {}×{}", got.0, got.1, want.0, want.1)));
         }
     }
-    Ok(Controller { ak, bk, ck, dk })
+    Ok(Controller::continuous(ak, bk, ck, dk))
 }
 
 /// The names of the design options (the fields of `DesignOptions`), in the option table's order.

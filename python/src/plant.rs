@@ -25,6 +25,17 @@ pub fn plant_from(name: &str, mats: Vec<In<'_>>) -> PyResult<Plant> {
 pub fn load_plant<'py>(py: Python<'py>, name_or_path: &str) -> PyResult<(String, Vec<Bound<'py, PyArray2<f64>>>)> {
     let file = resolve_plant(name_or_path).map_err(|e| bad_input("load_plant", e))?;
     let plant = Plant::load(&file).map_err(|e| failure("load_plant", e))?;
+    if let Some(ts) = plant.domain.ts() {
+        // the Python package designs continuous-time plants only (its systems are built with dt = 0)
+        return Err(bad_input(
+            "load_plant",
+            format!(
+                "{}: a discrete-time plant (Ts = {ts} s); the Python package handles continuous-time plants only, \
+                 use the `campaign` command for discrete time",
+                file.display()
+            ),
+        ));
+    }
     let mats = plant.matrices().into_iter().map(|m| to_numpy(py, m)).collect();
     Ok((plant.name.clone(), mats))
 }

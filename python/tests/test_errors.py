@@ -27,6 +27,13 @@ def test_partition_errors(he1):
         hinfix.design(control.c2d(P, 0.1), nmeas, ncon, 1)
 
 
+def test_a_discrete_time_plant_file_is_refused_by_name():
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "discrete", "HE1_Ts0.1.json")
+    with pytest.raises(ValueError, match=r"HE1_Ts0\.1\.json: a discrete-time plant \(Ts = 0\.1 s\)"):
+        hinfix.load_plant(path)
+
+
 def test_option_errors_carry_the_crates_message(he1):
     P, nmeas, ncon = he1
     with pytest.raises(ValueError, match="ε must be finite and positive"):

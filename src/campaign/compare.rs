@@ -8,10 +8,12 @@
 //! full-order value is used and marked `from_paper`.
 
 use super::record::JobRecord;
+use std::collections::BTreeMap;
+
 use super::reduce::{BestRow, PlantMap};
 use super::reference::{RefMethod, ReferenceRow};
 use crate::design::ObjectiveKind;
-use crate::lti::{full_order_gamma, is_stable_with_margin, spectral_abscissa, CentralProblem, Plant};
+use crate::lti::{full_order_gamma, is_stable_with_margin, spectral_abscissa, CentralProblem, Plant, PlantImage};
 
 /// Largest plant order for which the full-order bound is computed here.
 pub const FULL_ORDER_MAX_N: usize = 60;
@@ -37,8 +39,13 @@ pub const FULL_ORDER_CENTRAL_LEVEL: f64 = 1.01;
 
 /// Whether the full-order central controller of `plant` at [`FULL_ORDER_CENTRAL_LEVEL`]·γ_opt is
 /// stable (with the verification margin); `None` if it cannot be built.
+///
+/// A discrete-time plant's is that of its bilinear image (`lti::PlantImage`: the map keeps the
+/// controller's stability).
 pub fn full_order_controller_stable(plant: &Plant) -> Option<bool> {
-    let c = CentralProblem::new(plant).ok()?;
+    let image = plant.domain.is_discrete().then(|| PlantImage::new(plant).ok()).flatten();
+    let continuous = image.as_ref().map_or(plant, |i| &i.plant);
+    let c = CentralProblem::new(continuous).ok()?;
     let k = c.controller(FULL_ORDER_CENTRAL_LEVEL * c.gamma_opt).ok()?;
     Some(k.order() == 0 || is_stable_with_margin(spectral_abscissa(k.ak.as_ref()), k.ak.as_ref()))
 }
@@ -57,6 +64,8 @@ pub struct CampaignAbout {
     pub cpumax: Vec<f64>,
     /// Journaled jobs.
     pub jobs: usize,
+    /// Sampling times of the discrete-time plants, by plant fingerprint (none: all continuous).
+    pub sampling_times: BTreeMap<String, f64>,
 }
 
 impl CampaignAbout {
@@ -82,7 +91,14 @@ impl CampaignAbout {
             seeds: seeds.len(),
             cpumax: sorted(records.iter().map(|r| r.cpumax).collect()),
             jobs: ids.len(),
+            sampling_times: BTreeMap::new(),
         }
+    }
+
+    /// With the sampling times of the discrete-time plants among `plants` (by fingerprint).
+    pub fn with_plants(mut self, plants: &PlantMap) -> Self {
+        self.sampling_times = plants.iter().filter_map(|(fp, p)| Some((fp.clone(), p.domain.ts()?))).collect();
+        self
     }
 }
 

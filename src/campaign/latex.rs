@@ -89,7 +89,7 @@ pub fn tables_tex_about(
         let f = full.iter().find(|f| f.plant == p);
         if !reference.iter().any(|r| r.is_for(fp)) || strong.is_empty() {
             let rows: Vec<&BestRow> = best.iter().filter(|r| r.plant == p).collect();
-            s.push_str(&campaign_table(p, &rows, f, about));
+            s.push_str(&campaign_table(p, fp, &rows, f, about));
         } else {
             s.push_str(&paper_table(p, fp, &strong, f, reference));
         }
@@ -224,17 +224,25 @@ fn about_text(about: &CampaignAbout) -> String {
 /// One plant's table in the campaign layout, for a plant without a published reference: per n_K
 /// (highest first) and objective the best re-verified controller's γ, its job's ε and seed,
 /// ‖K‖∞, α(A_K), the CPU seconds its job took to reach it and the objective; first the full-order
-/// row, the unconstrained bound, with whether its central controller is stable.
-pub fn campaign_table(p: &str, rows: &[&BestRow], f: Option<&FullOrderRow>, about: &CampaignAbout) -> String {
+/// row, the unconstrained bound, with whether its central controller is stable. A discrete-time
+/// plant (its fingerprint `fp` in `about.sampling_times`) gets ρ(A_K) for α(A_K) and its sampling
+/// time in the caption.
+pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrderRow>, about: &CampaignAbout) -> String {
+    let ts = about.sampling_times.get(fp).copied();
+    let (radius, domain) = match ts {
+        None => ("spectral abscissa $\\alpha(A_K)$", String::new()),
+        Some(ts) => ("spectral radius $\\rho(A_K)$", format!(" (discrete time, $T_s = {ts}$~s)")),
+    };
     let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
     let _ = writeln!(
         s,
-        "\\caption{{{}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and spectral abscissa $\\alpha(A_K)$, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.}}",
+        "\\caption{{{}{domain}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and {radius}, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.}}",
         escape(p),
         about_text(about)
     );
     let _ = writeln!(s, "\\label{{tab:hinfix-{}}}", label_key(p));
-    s.push_str("\\begin{tabular}{rlrrrrrr}\n\\toprule\n$n_K$ & objective & $\\gamma$ & $\\varepsilon$ & seed & $\\|K\\|_\\infty$ & $\\alpha(A_K)$ & CPU s \\\\\n\\midrule\n");
+    let column = if ts.is_some() { "$\\rho(A_K)$" } else { "$\\alpha(A_K)$" };
+    let _ = writeln!(s, "\\begin{{tabular}}{{rlrrrrrr}}\n\\toprule\n$n_K$ & objective & $\\gamma$ & $\\varepsilon$ & seed & $\\|K\\|_\\infty$ & {column} & CPU s \\\\\n\\midrule");
     if let Some(f) = f {
         let k = match f.controller_stable {
             Some(true) => format!("; central $K$ at ${FULL_ORDER_CENTRAL_LEVEL}\\gamma$ stable"),
@@ -263,7 +271,8 @@ pub fn campaign_table(p: &str, rows: &[&BestRow], f: Option<&FullOrderRow>, abou
             r.eps.map_or("--".into(), eps_tex),
             r.seed.map_or("--".into(), |x| x.to_string()),
             opt(r.k_hinf),
-            opt(r.alpha_k),
+            // ρ(A_K) of a strongly stable controller is often within 1e-4 of 1: six decimals
+            r.alpha_k.map_or("--".to_string(), |a| if ts.is_some() { format!("{:.6}", a + 1.0) } else { sig4_inf(a) }),
             r.cpu_to_best_s.map_or("--".into(), |t| format!("{t:.1}"))
         );
     }

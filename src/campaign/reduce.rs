@@ -1,8 +1,8 @@
 //! Reduction of journal records to "best γ per (plant, order)", counting only controllers that
 //! are re-verified by recomputation: the controller's shape is checked against the job's order
 //! and the plant's channels (the journal's `order` and `options.order` must agree too), the
-//! closed loop is formed again (`lti::closed_loop`), both α(A_cl) and α(Ak) are checked to be
-//! below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F)), and
+//! closed loop is formed again (`lti::closed_loop`), both α(A_cl) and α(Ak) (in discrete time
+//! ρ − 1, `lti::stability_measure`) are checked to be below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F)), and
 //! γ = ‖Tzw‖∞ is recomputed. The reported γ is always the recomputed one, never the journal's.
 //! A job of the plain objective (no stability asked of K) counts with an unstable controller
 //! too: its row says whether the controller is stable (`controller_stable`), which is what the
@@ -22,7 +22,7 @@ use std::sync::Arc;
 use super::record::JobRecord;
 use crate::design::ObjectiveKind;
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, is_stable_with_margin, spectral_abscissa, stability_margin,
+    closed_loop, controller_hinf_grad, hinf_norm_in, is_stable_with_margin, stability_margin, stability_measure,
     HinfParams, Plant, DEFAULT_HINF_TOL,
 };
 
@@ -84,18 +84,19 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
         Ok(cl) => cl,
         Err(e) => return Verdict::Rejected(format!("closed loop: {e}")),
     };
-    let alpha_cl = spectral_abscissa(cl.a.as_ref());
+    let (domain, s) = (plant.domain, plant.domain.stability_symbol());
+    let alpha_cl = stability_measure(domain, cl.a.as_ref());
     if !is_stable_with_margin(alpha_cl, cl.a.as_ref()) {
         let margin = stability_margin(cl.a.as_ref());
-        return Verdict::Rejected(format!("closed loop not stable (α = {alpha_cl}, must be below −{margin:.1e})"));
+        return Verdict::Rejected(format!("closed loop not stable ({s} = {alpha_cl}, must be below −{margin:.1e})"));
     }
-    let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
+    let alpha_k = (k.order() > 0).then(|| stability_measure(domain, k.ak.as_ref()));
     let controller_stable = alpha_k.is_none_or(|a| is_stable_with_margin(a, k.ak.as_ref()));
     if !controller_stable && record.options.objective == ObjectiveKind::Strong {
         let (a, margin) = (alpha_k.unwrap_or(f64::NAN), stability_margin(k.ak.as_ref()));
-        return Verdict::Rejected(format!("controller not stable (α_K = {a}, must be below −{margin:.1e})"));
+        return Verdict::Rejected(format!("controller not stable ({s} of A_K = {a}, must be below −{margin:.1e})"));
     }
-    let gamma = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set").value;
+    let gamma = hinf_norm_in(domain, &cl, &HinfParams::default()).expect("no stop hook is set").value;
     if !gamma.is_finite() {
         return Verdict::Rejected(format!("γ not finite ({gamma})"));
     }

@@ -150,7 +150,7 @@ pub fn write_reports(
     files.push(p);
 
     let p = out_dir.join("tables.tex");
-    let about = CampaignAbout::of(records);
+    let about = CampaignAbout::of(records).with_plants(plants);
     write_atomic(&p, latex::tables_tex_about(&best, &full, reference, &about).as_bytes())?;
     files.push(p);
 

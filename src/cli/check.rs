@@ -2,6 +2,11 @@
 //! closed-loop and controller spectral abscissas, ‖Tzw‖∞ with its peak frequency, ‖K‖∞, and both
 //! stability decisions; `--plot` also draws the σ-plot.
 //!
+//! For a discrete-time plant (and controller: the two must have the same `Ts`) stability is
+//! ρ < 1, the norm is on the unit circle and frequencies are in rad/s up to the Nyquist
+//! frequency π/Ts; the JSON then has `Ts` and `closed_loop_spectral_radius`,
+//! `controller_spectral_radius` in place of the two abscissas.
+//!
 //! JSON keys: `closed_loop_spectral_abscissa`, `controller_spectral_abscissa` (null for nk = 0),
 //! `gamma` (‖Tzw‖∞) and `k_hinf` (‖K‖∞) — the names of the journal, the traces and
 //! [`crate::design::DesignOutcome`] (docs/ARCHITECTURE.md §5; builds before that wrote the SLICOT
@@ -18,8 +23,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm, spectral_abscissa, stability_margin, Controller, HinfParams, Plant,
-    DEFAULT_HINF_TOL, NORM_TIE_RTOL,
+    closed_loop, controller_hinf_grad, hinf_norm_in, stability_margin, stability_measure, Controller, HinfNorm,
+    HinfParams, Plant, TimeDomain, DEFAULT_HINF_TOL, NORM_TIE_RTOL,
 };
 use anyhow::Context;
 use serde_json::{json, Value};
@@ -44,6 +49,8 @@ pub struct CheckArgs {
 /// Everything `check` reports.
 #[derive(Debug, Clone)]
 struct CheckReport {
+    domain: TimeDomain,
+    /// Stability measures (`lti::stability_measure`): α, or ρ − 1 in discrete time.
     alpha_cl: f64,
     alpha_k: Option<f64>,
     gamma: f64,
@@ -87,13 +94,17 @@ pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
 
 fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let cl = closed_loop(plant, k).context("forming the closed loop")?;
-    let alpha_cl = spectral_abscissa(cl.a.as_ref());
-    let h = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set");
-    let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
+    let domain = plant.domain;
+    let alpha_cl = stability_measure(domain, cl.a.as_ref());
+    let h = hinf_norm_in(domain, &cl, &HinfParams::default()).expect("no stop hook is set");
+    // in rad/s (a discrete norm's θ is in rad/sample)
+    let h = HinfNorm { value: h.value, peak_freq: domain.to_rad_per_s(h.peak_freq) };
+    let alpha_k = (k.order() > 0).then(|| stability_measure(domain, k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
     let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));
-    let peak_freqs = crate::lti::near_peak_frequencies(&cl, &h, NORM_TIE_RTOL);
+    let peak_freqs = crate::lti::near_peak_frequencies(domain, &cl, &h, NORM_TIE_RTOL);
     let r = CheckReport {
+        domain,
         alpha_cl,
         alpha_k,
         gamma: h.value,
@@ -121,9 +132,7 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
 use crate::design::f64_to_json as num;
 
 fn to_json(r: &CheckReport) -> Value {
-    json!({
-        "closed_loop_spectral_abscissa": num(r.alpha_cl),
-        "controller_spectral_abscissa": r.alpha_k.map(num),
+    let mut v = json!({
         "gamma": num(r.gamma),
         "closed_loop_peak_freq": if r.peak_freq.is_nan() { Value::Null } else { num(r.peak_freq) },
         "closed_loop_peak_freqs": r.peak_freqs.iter().map(|&w| num(w)).collect::<Vec<_>>(),
@@ -132,7 +141,20 @@ fn to_json(r: &CheckReport) -> Value {
         "controller_stable": r.controller_stable(),
         "closed_loop_stability_margin": num(r.margin_cl),
         "controller_stability_margin": r.alpha_k.map(|_| num(r.margin_k)),
-    })
+    });
+    let o = v.as_object_mut().expect("an object");
+    match r.domain {
+        TimeDomain::Continuous => {
+            o.insert("closed_loop_spectral_abscissa".into(), num(r.alpha_cl));
+            o.insert("controller_spectral_abscissa".into(), r.alpha_k.map(num).into());
+        }
+        TimeDomain::Discrete { ts } => {
+            o.insert("Ts".into(), num(ts));
+            o.insert("closed_loop_spectral_radius".into(), num(r.alpha_cl + 1.0));
+            o.insert("controller_spectral_radius".into(), r.alpha_k.map(|a| num(a + 1.0)).into());
+        }
+    }
+    v
 }
 
 fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
@@ -144,9 +166,17 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         plant.dims.n,
         k.order()
     );
+    // α, or ρ in discrete time (stable means ρ < 1 − margin)
+    let (name, shift, bound) = match r.domain {
+        TimeDomain::Continuous => ("α", 0.0, "α < −"),
+        TimeDomain::Discrete { .. } => ("ρ", 1.0, "ρ < 1 − "),
+    };
+    if r.domain.is_discrete() {
+        s += &format!("{}, frequencies in rad/s up to the Nyquist frequency\n", r.domain);
+    }
     s += &format!(
-        "closed loop: α(A_cl) = {:+.6e}   {} (stable means α < −{:.1e})\n",
-        r.alpha_cl,
+        "closed loop: {name}(A_cl) = {:+.6e}   {} (stable means {bound}{:.1e})\n",
+        r.alpha_cl + shift,
         yes_no(r.closed_loop_stable()),
         r.margin_cl
     );
@@ -154,8 +184,8 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     match r.alpha_k {
         Some(a) => {
             s += &format!(
-                "controller:  α(Ak)    = {:+.6e}   {} (stable means α < −{:.1e})\n",
-                a,
+                "controller:  {name}(Ak)    = {:+.6e}   {} (stable means {bound}{:.1e})\n",
+                a + shift,
                 yes_no(r.controller_stable()),
                 r.margin_k
             )
@@ -199,6 +229,7 @@ mod tests {
     #[test]
     fn every_peak_is_named() {
         let mut r = CheckReport {
+            domain: TimeDomain::Continuous,
             alpha_cl: -1.0,
             alpha_k: None,
             gamma: 2.0,
@@ -218,6 +249,7 @@ mod tests {
     #[test]
     fn json_keys_and_infinities() {
         let r = CheckReport {
+            domain: TimeDomain::Continuous,
             alpha_cl: 0.3,
             alpha_k: None,
             gamma: f64::INFINITY,
@@ -236,6 +268,7 @@ mod tests {
         assert_eq!(v["controller_stable"], json!(true));
         assert!(!serde_json::to_string(&v).unwrap().contains("Infinity"));
         let r = CheckReport {
+            domain: TimeDomain::Continuous,
             alpha_cl: -0.3,
             alpha_k: Some(-1.0),
             gamma: 2.0,

@@ -182,10 +182,10 @@ fn stabilising(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> bool {
         return false;
     }
     let k = &o.controller;
-    let loop_stable = crate::lti::closed_loop(plant, k)
-        .is_ok_and(|cl| crate::lti::is_stable_with_margin(crate::lti::spectral_abscissa(cl.a.as_ref()), cl.a.as_ref()));
-    let k_stable = k.order() == 0
-        || crate::lti::is_stable_with_margin(crate::lti::spectral_abscissa(k.ak.as_ref()), k.ak.as_ref());
+    let stable =
+        |a: faer::MatRef<'_, f64>| crate::lti::is_stable_with_margin(crate::lti::stability_measure(plant.domain, a), a);
+    let loop_stable = crate::lti::closed_loop(plant, k).is_ok_and(|cl| stable(cl.a.as_ref()));
+    let k_stable = k.order() == 0 || stable(k.ak.as_ref());
     loop_stable && (k_stable || opts.objective == ObjectiveKind::Plain)
 }
 
@@ -336,9 +336,10 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         ObjectiveKind::Plain => "plain H∞".to_string(),
     };
     let mut s = format!(
-        "{} (n = {}), order {}, {}, seed {}\n",
+        "{} (n = {}{}), order {}, {}, seed {}\n",
         for_terminal(&plant.name),
         plant.dims.n,
+        plant.domain.ts().map_or(String::new(), |ts| format!(", discrete time Ts = {ts} s")),
         opts.order,
         mode,
         opts.seed
@@ -359,9 +360,11 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
             fmt_num(opts.eps * o.k_hinf, 6)
         );
     }
-    s += &format!("α(A_cl) = {:+.4e}", o.alpha_cl);
+    // α, or in discrete time ρ (the outcome holds ρ − 1, `lti::stability_measure`)
+    let (name, shift) = if plant.domain.is_discrete() { ("ρ", 1.0) } else { ("α", 0.0) };
+    s += &format!("{name}(A_cl) = {:+.4e}", o.alpha_cl + shift);
     match o.alpha_k {
-        Some(a) => s += &format!("   α(Ak) = {a:+.4e}\n"),
+        Some(a) => s += &format!("   {name}(Ak) = {:+.4e}\n", a + shift),
         None => s += "   (static gain)\n",
     }
     let per_eval = if o.evaluations > 0 { o.design_cpu_s / o.evaluations as f64 } else { f64::NAN };

@@ -33,7 +33,8 @@ struct Summary {
 
 impl Summary {
     fn new(plant: Plant) -> Self {
-        let alpha = lti::spectral_abscissa(plant.a.as_ref());
+        // α, or ρ − 1 in discrete time
+        let alpha = lti::stability_measure(plant.domain, plant.a.as_ref());
         Summary { name: plant.name.clone(), plant, alpha }
     }
     fn stable(&self) -> bool {
@@ -41,12 +42,23 @@ impl Summary {
     }
     fn json(&self) -> Value {
         let d = self.plant.dims;
-        json!({
+        let mut v = json!({
             "name": self.name, "n": d.n, "m1": d.m1, "m2": d.m2, "p1": d.p1, "p2": d.p2,
             "open_loop_stable": self.stable(),
-            "open_loop_spectral_abscissa": crate::design::f64_to_json(self.alpha),
             "source": self.plant.citation,
-        })
+        });
+        self.insert_stability(v.as_object_mut().expect("an object"));
+        v
+    }
+    /// `open_loop_spectral_abscissa`, or in discrete time `Ts` and `open_loop_spectral_radius`.
+    fn insert_stability(&self, o: &mut serde_json::Map<String, Value>) {
+        match self.plant.domain.ts() {
+            None => o.insert("open_loop_spectral_abscissa".into(), crate::design::f64_to_json(self.alpha)),
+            Some(ts) => {
+                o.insert("Ts".into(), crate::design::f64_to_json(ts));
+                o.insert("open_loop_spectral_radius".into(), crate::design::f64_to_json(self.alpha + 1.0))
+            }
+        };
     }
 }
 
@@ -110,7 +122,7 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
         let o = doc.as_object_mut().expect("plant JSON is an object");
         o.insert("file".into(), path.display().to_string().into());
         o.insert("open_loop_stable".into(), s.stable().into());
-        o.insert("open_loop_spectral_abscissa".into(), crate::design::f64_to_json(s.alpha));
+        s.insert_stability(o);
         o.insert("d22_zero".into(), s.plant.d22_is_zero().into());
         o.insert(
             "full_order_gamma".into(),
@@ -133,11 +145,14 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
     println!("  file:        {}", term(&path.display().to_string()));
     println!("  source:      {}", term(&p.citation));
     println!("  sizes:       n = {}, w: m1 = {}, u: m2 = {}, z: p1 = {}, y: p2 = {}", d.n, d.m1, d.m2, d.p1, d.p2);
-    println!(
-        "  open loop:   {} (spectral abscissa {})",
-        if s.stable() { "stable" } else { "unstable" },
-        super::fmt_num(s.alpha, 6)
-    );
+    let (what, value) = match p.domain {
+        lti::TimeDomain::Continuous => ("spectral abscissa", s.alpha),
+        lti::TimeDomain::Discrete { .. } => ("spectral radius", s.alpha + 1.0),
+    };
+    if p.domain.is_discrete() {
+        println!("  time:        {}", p.domain);
+    }
+    println!("  open loop:   {} ({what} {})", if s.stable() { "stable" } else { "unstable" }, super::fmt_num(value, 6));
     println!("  D22:         {}", if p.d22_is_zero() { "zero" } else { "non-zero" });
     match &full {
         Ok(f) => println!("  full-order optimal γ: {:.6} ({})", f.gamma, f.describe()),

@@ -18,7 +18,7 @@
 
 use crate::lti::{
     balanced_truncation, coprime_factor_truncation, dc_gain, spectral_abscissa, CentralProblem, Controller, Plant,
-    StateSpace,
+    PlantImage, StateSpace,
 };
 
 use super::starts::{pad_controller, padding_diagonal};
@@ -34,12 +34,23 @@ pub const CENTRAL_MAX_STATES: usize = 100;
 
 /// The central-controller starts of order `nk` for the factors `factors` (module docs), in the
 /// order of `factors`, with the factor each came from.
+///
+/// A discrete-time plant's starts are those of its bilinear image (`lti::PlantImage`: the
+/// central controller and balanced truncation of the image are those of the plant) taken back
+/// to discrete time.
 pub fn central_starts(plant: &Plant, nk: usize, factors: &[f64]) -> Vec<(f64, Controller)> {
     if factors.is_empty() {
         return Vec::new();
     }
     if plant.dims.n > CENTRAL_MAX_STATES {
         return Vec::new();
+    }
+    if plant.domain.is_discrete() {
+        let Ok(image) = PlantImage::new(plant) else { return Vec::new() };
+        return central_starts(&image.plant, nk, factors)
+            .into_iter()
+            .filter_map(|(f, k)| Some((f, image.controller_back(&k)?)))
+            .collect();
     }
     let mut out = Vec::new();
     for eps in CENTRAL_REGULARISATIONS {
@@ -79,7 +90,7 @@ pub fn reduce(plant: &Plant, k: &Controller, nk: usize) -> Vec<Controller> {
     reduced
         .into_iter()
         .filter_map(|red| {
-            let kr = Controller { ak: red.a, bk: red.b, ck: red.c, dk: red.d };
+            let kr = Controller::continuous(red.a, red.b, red.c, red.d).in_domain(k.domain);
             if !kr.is_finite() {
                 None
             } else if kr.order() < nk {

@@ -15,6 +15,10 @@
 //! term attaining the max (ties: the plant term, HIFOO's "ties broken arbitrarily"); where f is
 //! not finite the gradient is NaN, which the optimiser's line search treats as a failed trial.
 //!
+//! In discrete time (a plant with a sampling time, docs/ALGORITHMS.md §10) α is replaced by the
+//! stability measure ρ − 1 (`lti::stability_measure`: negative iff stable, as α) and ‖·‖∞ is on
+//! the unit circle; the line-search screen (continuous-time only) is not used.
+//!
 //! For order 0 the controller term is dropped from f_s (a static gain has no dynamics) but kept
 //! in f_h as ε·σmax(Dk) (docs/ALGORITHMS.md §3.2).
 //!
@@ -36,8 +40,8 @@ use std::ops::ControlFlow;
 use std::rc::Rc;
 
 use crate::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, controller_abscissa_grad, controller_hinf_grad,
-    hinf_lower_bound_sharing, spectral_abscissa, Controller, ControllerGradient, HinfParams, Interrupt, LtiError,
+    closed_loop, closed_loop_hinf_grad, closed_loop_stability_grad, controller_hinf_grad, controller_stability_grad,
+    hinf_lower_bound_sharing, stability_measure, Controller, ControllerGradient, HinfParams, Interrupt, LtiError,
     Plant, ResponseSlot,
 };
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
@@ -81,9 +85,9 @@ pub struct Components {
     pub gamma: f64,
     /// ‖K‖∞.
     pub k_hinf: f64,
-    /// α(Acl).
+    /// α(Acl) (in discrete time ρ(Acl) − 1, `lti::stability_measure`).
     pub alpha_cl: f64,
-    /// α(Ak) (NaN for order 0).
+    /// α(Ak) (ρ(Ak) − 1 in discrete time; NaN for order 0).
     pub alpha_k: f64,
 }
 
@@ -250,13 +254,13 @@ impl<'p> DesignObjective<'p> {
         let nk = k.order();
         // α(Ak) is cheap (nk × nk); its gradient is needed only when it is in the objective.
         let (alpha_k, g_k) = if nk > 0 {
-            let (a, g) = controller_abscissa_grad(k);
+            let (a, g) = controller_stability_grad(k);
             (a, Some(g))
         } else {
             (f64::NAN, None)
         };
         c.alpha_k = alpha_k;
-        let (alpha_cl, g_cl) = match closed_loop_abscissa_grad(self.plant, k) {
+        let (alpha_cl, g_cl) = match closed_loop_stability_grad(self.plant, k) {
             Ok((a, g)) => (a, Some(g)),
             Err(_) => (f64::INFINITY, None),
         };
@@ -275,7 +279,7 @@ impl<'p> DesignObjective<'p> {
     fn performance(&self, k: &Controller, _grad: bool) -> (Components, Option<ControllerGradient>) {
         let mut c = Components::UNKNOWN;
         if k.order() > 0 {
-            c.alpha_k = spectral_abscissa(k.ak.as_ref());
+            c.alpha_k = stability_measure(k.domain, k.ak.as_ref());
         }
         let mut k_term = (f64::NEG_INFINITY, None);
         if self.strong {
@@ -430,7 +434,10 @@ impl Objective for DesignObjective<'_> {
     /// value returned is exact (docs/ALGORITHMS.md §8.4, "Line-search screen"); one that passes
     /// is evaluated by `eval_unless`, whose norm still stops once it reaches `threshold`.
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
-        if self.phase == ObjectivePhase::Performance && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION {
+        if self.phase == ObjectivePhase::Performance
+            && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION
+            && !self.plant.domain.is_discrete()
+        {
             let lb = self.performance_lower_bound(&self.controller(x), threshold);
             if lb >= threshold {
                 g.iter_mut().for_each(|v| *v = f64::NAN);
@@ -543,7 +550,9 @@ impl Observer for ObserverAdapter<'_, '_> {
         };
         if wants && c.alpha_cl.is_nan() && obj.phase == ObjectivePhase::Performance && !obj.stop_fired() {
             let k = obj.controller(rec.x);
-            c.alpha_cl = closed_loop(obj.plant, &k).map(|cl| spectral_abscissa(cl.a.as_ref())).unwrap_or(f64::INFINITY);
+            c.alpha_cl = closed_loop(obj.plant, &k)
+                .map(|cl| stability_measure(obj.plant.domain, cl.a.as_ref()))
+                .unwrap_or(f64::INFINITY);
             obj.cache.borrow_mut().update(rec.x, c);
         }
         let phase = match (self.phase, rec.solver) {

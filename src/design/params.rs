@@ -11,10 +11,11 @@
 
 use faer::Mat;
 
-use crate::lti::Controller;
+use crate::lti::{Controller, Plant, TimeDomain};
 
-/// Sizes of the controller being designed: order nk, m controls, p measurements.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Sizes of the controller being designed (order nk, m controls, p measurements) and its time
+/// domain (the plant's).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControllerShape {
     /// Order nk.
     pub nk: usize,
@@ -22,12 +23,19 @@ pub struct ControllerShape {
     pub m: usize,
     /// The plant's measurements p (columns of Dk; the controller's [`Controller::inputs`]).
     pub p: usize,
+    /// Continuous or discrete time.
+    pub domain: TimeDomain,
 }
 
 impl ControllerShape {
     /// The shape of an existing controller.
     pub fn of(k: &Controller) -> Self {
-        ControllerShape { nk: k.order(), m: k.outputs(), p: k.inputs() }
+        ControllerShape { nk: k.order(), m: k.outputs(), p: k.inputs(), domain: k.domain }
+    }
+
+    /// Controllers of order `nk` for `plant` (its m2 controls, p2 measurements and time domain).
+    pub fn for_plant(plant: &Plant, nk: usize) -> Self {
+        ControllerShape { nk, m: plant.dims.m2, p: plant.dims.p2, domain: plant.domain }
     }
 
     /// Number of variables (nk + m)(nk + p).
@@ -49,12 +57,14 @@ impl ControllerShape {
         let bk = block(nk, p);
         let ck = block(m, nk);
         let dk = block(m, p);
-        Controller { ak, bk, ck, dk }
+        Controller { ak, bk, ck, dk, domain: self.domain }
     }
 
-    /// Writes x = [vec Ak; vec Bk; vec Ck; vec Dk] of `k` (of this shape) into `out`.
+    /// Writes x = [vec Ak; vec Bk; vec Ck; vec Dk] of `k` (of this shape's sizes; its domain
+    /// is not looked at: a gradient is written the same way) into `out`.
     pub fn write_x(&self, k: &Controller, out: &mut [f64]) {
-        assert_eq!(ControllerShape::of(k), *self, "controller does not have this shape");
+        let sizes = |s: ControllerShape| (s.nk, s.m, s.p);
+        assert_eq!(sizes(ControllerShape::of(k)), sizes(*self), "controller does not have this shape");
         assert_eq!(out.len(), self.nvar(), "output length does not match the controller shape");
         let mut off = 0;
         for mat in [&k.ak, &k.bk, &k.ck, &k.dk] {
@@ -88,7 +98,7 @@ mod tests {
 
     #[test]
     fn layout_is_column_major_blocks() {
-        let shape = ControllerShape { nk: 2, m: 1, p: 3 };
+        let shape = ControllerShape { nk: 2, m: 1, p: 3, domain: TimeDomain::Continuous };
         assert_eq!(shape.nvar(), 3 * 5);
         let x: Vec<f64> = (0..shape.nvar()).map(|i| i as f64).collect();
         let k = shape.controller(&x);
@@ -104,7 +114,7 @@ mod tests {
     #[test]
     fn round_trip_all_orders() {
         for (nk, m, p) in [(0, 1, 1), (0, 2, 3), (1, 2, 1), (3, 2, 2), (4, 1, 5)] {
-            let shape = ControllerShape { nk, m, p };
+            let shape = ControllerShape { nk, m, p, domain: TimeDomain::Continuous };
             let x: Vec<f64> = (0..shape.nvar()).map(|i| (i as f64 * 0.37).sin()).collect();
             let k = x_to_controller(&x, shape);
             assert_eq!(ControllerShape::of(&k), shape);

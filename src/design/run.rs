@@ -8,8 +8,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    abscissa_of, closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles, is_stable, spectral_abscissa,
-    Controller, HinfParams, Interrupt, Plant, NORM_TIE_RTOL,
+    closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_in, hinf_norm_with_poles, is_stable,
+    stability_measure, stability_measure_of, Controller, HinfParams, Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
 
@@ -65,7 +65,7 @@ pub fn run_with_control(
 ) -> Result<DesignOutcome, DesignError> {
     validate(plant, opts, init)?;
     strongly_stabilisable(plant, opts)?;
-    let shape = ControllerShape { nk: opts.order, m: plant.dims.m2, p: plant.dims.p2 };
+    let shape = ControllerShape::for_plant(plant, opts.order);
     let strong = opts.objective == ObjectiveKind::Strong;
     let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
@@ -178,7 +178,14 @@ pub fn strongly_stabilisable(plant: &Plant, opts: &DesignOptions) -> Result<(), 
     if opts.objective != ObjectiveKind::Strong {
         return Ok(());
     }
-    match crate::lti::parity_interlacing(plant).and_then(|p| p.violation) {
+    // A discrete-time plant is strongly stabilisable iff its bilinear image is (stable
+    // controllers and stabilising ones correspond, `lti::PlantImage`); the violation then names
+    // the image's zeros and poles.
+    let image = match plant.domain {
+        TimeDomain::Continuous => None,
+        TimeDomain::Discrete { .. } => crate::lti::PlantImage::new(plant).ok().map(|i| i.plant),
+    };
+    match crate::lti::parity_interlacing(image.as_ref().unwrap_or(plant)).and_then(|p| p.violation) {
         Some(v) => Err(DesignError::NotStronglyStabilisable(v)),
         None => Ok(()),
     }
@@ -262,10 +269,14 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
         Ok(_) if stop.poll().is_err() => (f64::NAN, f64::NAN),
         Ok(cl) => match eigenvalues_of(cl.a.as_ref()) {
             Some(poles) => {
-                let a = abscissa_of(&poles);
+                let a = stability_measure_of(plant.domain, &poles);
                 let g = if is_stable(a) && cl.is_finite() {
-                    hinf_norm_with_poles(&cl, &poles, &HinfParams::new(opts.hinf_tol).with_stop(stop))
-                        .map_or(f64::NAN, |h| h.value)
+                    let params = HinfParams::new(opts.hinf_tol).with_stop(stop);
+                    let norm = match plant.domain {
+                        TimeDomain::Continuous => hinf_norm_with_poles(&cl, &poles, &params),
+                        TimeDomain::Discrete { .. } => hinf_norm_in(plant.domain, &cl, &params),
+                    };
+                    norm.map_or(f64::NAN, |h| h.value)
                 } else {
                     f64::INFINITY
                 };
@@ -276,7 +287,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
         Err(_) => (f64::INFINITY, f64::INFINITY),
     };
     let k_hinf = controller_hinf_grad(k, opts.hinf_tol).0.value;
-    let alpha_k = (k.order() > 0).then(|| spectral_abscissa(k.ak.as_ref()));
+    let alpha_k = (k.order() > 0).then(|| stability_measure(k.domain, k.ak.as_ref()));
     let objective = match opts.objective {
         _ if gamma.is_nan() => f64::NAN, // not computed (f64::max would drop it)
         ObjectiveKind::Strong => gamma.max(opts.eps * k_hinf),

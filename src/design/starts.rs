@@ -97,8 +97,12 @@ pub fn perturbed_starts(x_init: &[f64], nrand: usize, rng: &mut dyn RngCore) -> 
 
 /// The diagonal entry for padded modes: min(0, α(Acl), α(Ak)) − [`PAD_MARGIN`], ignoring
 /// non-finite abscissas (an unstable or ill-posed loop gives −PAD_MARGIN, as HIFOO's
-/// `diagpad0 = 0`).
+/// `diagpad0 = 0`). In discrete time 0 (modes at z = 0): their ρ − 1 = −1 is at or below that of
+/// any matrix, so the stabilisation objective is unchanged there too.
 pub fn padding_diagonal(plant: &Plant, k: &Controller) -> f64 {
+    if plant.domain.is_discrete() {
+        return 0.0;
+    }
     let alpha_cl = closed_loop(plant, k).map(|cl| spectral_abscissa(cl.a.as_ref())).unwrap_or(f64::INFINITY);
     let alpha_k = spectral_abscissa(k.ak.as_ref());
     let mut base = 0.0f64;
@@ -129,7 +133,7 @@ pub fn pad_controller(k: &Controller, nk: usize, diag: f64) -> Option<Controller
     });
     let bk = Mat::from_fn(nk, p, |i, j| if i < n0 { k.bk[(i, j)] } else { 0.0 });
     let ck = Mat::from_fn(m, nk, |i, j| if j < n0 { k.ck[(i, j)] } else { 0.0 });
-    Some(Controller { ak, bk, ck, dk: k.dk.clone() })
+    Some(Controller { ak, bk, ck, dk: k.dk.clone(), domain: k.domain })
 }
 
 #[cfg(test)]
@@ -184,6 +188,7 @@ mod tests {
             bk: Mat::from_fn(1, 2, |_, j| j as f64 + 1.0),
             ck: Mat::from_fn(1, 1, |_, _| 3.0),
             dk: Mat::from_fn(1, 2, |_, j| 0.5 * j as f64),
+            domain: crate::lti::TimeDomain::Continuous,
         };
         let kp = pad_controller(&k, 3, -4.0).unwrap();
         assert_eq!(kp.order(), 3);

@@ -23,6 +23,15 @@ pub enum LtiError {
     /// budget spent or run cancelled): there is no value.
     #[error("{0}")]
     Interrupted(#[from] super::Interrupted),
+    /// A plant and a controller in different time domains (continuous and discrete, or two
+    /// sampling times): they have no closed loop.
+    #[error("the plant is in {plant}, the controller in {controller}")]
+    DomainMismatch {
+        /// The plant's domain.
+        plant: super::TimeDomain,
+        /// The controller's domain.
+        controller: super::TimeDomain,
+    },
     /// Matrices whose shapes do not fit together.
     #[error("{what} is {}×{}, expected {}×{}", got.0, got.1, expected.0, expected.1)]
     Shape {

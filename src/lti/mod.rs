@@ -41,7 +41,6 @@ pub use kernels::lyapunov::{
 };
 pub(crate) use kernels::riccati::balance_scaling;
 pub use kernels::riccati::{care_residual, solve_care, CareSolution, RiccatiError};
-pub(crate) use kernels::spectral::abscissa_of;
 pub(crate) use kernels::spectral::eigenvalues as eigenvalues_of;
 pub use kernels::spectral::{
     is_schur_stable, is_schur_stable_with_margin, is_stable, is_stable_with_margin, spectral_abscissa,
@@ -51,9 +50,14 @@ pub use kernels::spectral::{
 pub use norms::discrete::{
     closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete, hinf_norm_grad_discrete,
 };
+pub(crate) use norms::domain::stability_measure_of;
+pub use norms::domain::{
+    closed_loop_hinf_grad, closed_loop_stability_grad, controller_hinf_grad, controller_stability_grad, hinf_norm_in,
+    stability_measure,
+};
 pub use norms::gradient::{
-    closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_radius_grad, controller_abscissa_grad,
-    controller_hinf_grad, controller_radius_grad, ControllerGradient,
+    closed_loop_abscissa_grad, closed_loop_radius_grad, controller_abscissa_grad, controller_radius_grad,
+    ControllerGradient,
 };
 pub(crate) use norms::hinf::hinf_norm_with_poles;
 pub use norms::hinf::{
@@ -73,6 +77,7 @@ pub use synthesis::full_order::{
     full_order_gamma, full_order_gamma_discrete, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma,
     FullOrderOptions, Regularisation, FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
+pub use synthesis::plant_image::{ImageError, PlantImage};
 pub use synthesis::strong_stabilisability::{parity_interlacing, ParityInterlacing, PipViolation, PIP_MAX_N, PIP_RTOL};
 pub use system::closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use system::controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};
@@ -80,3 +85,4 @@ pub use system::export::{export_code, ExportTarget};
 pub use system::plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
 pub use system::plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
 pub use system::state_space::StateSpace;
+pub use system::time_domain::{BadSamplingTime, TimeDomain};

@@ -1,5 +1,5 @@
 //! σ-plot of one controller on its plant: σmax(T_zw(iω)) and σmax(K(iω)) against ω (rad/s),
-//! log-log, with the H∞ peak of T_zw marked (the level-set value and frequency from
+//! log-log (in discrete time σmax at z = e^{iωTs}, ω up to the Nyquist frequency π/Ts), with the H∞ peak of T_zw marked (the level-set value and frequency from
 //! `lti::hinf_norm`, not the grid's maximum).
 //!
 //! The frequency band runs from a decade below the slowest to a decade above the fastest
@@ -13,7 +13,7 @@ use plotters::prelude::*;
 
 use super::render::{colour, draw_legend, log_ticks, msg, tick, DrawError, Figure, FONT_FAMILY};
 use crate::lti::{
-    closed_loop, frequency_band, hinf_norm, sigma_curve, Controller, HinfParams, LtiError, Plant, StateSpace,
+    closed_loop, frequency_band, hinf_norm_in, sigma_curve, Controller, HinfParams, LtiError, Plant, StateSpace,
 };
 
 /// Data of one σ-plot.
@@ -27,6 +27,9 @@ pub struct SigmaFigure {
     pub controller: Vec<(f64, f64)>,
     /// ‖T_zw‖∞ and the frequency where it is attained (may be 0 or +∞).
     pub peak: (f64, f64),
+    /// The sampling time of a discrete-time plant (the curves are then at z = e^{iωTs}, up to
+    /// the Nyquist frequency); `None` in continuous time.
+    pub ts: Option<f64>,
 }
 
 impl SigmaFigure {
@@ -35,12 +38,14 @@ impl SigmaFigure {
     pub fn new(plant: &Plant, k: &Controller, title: String) -> Result<Self, LtiError> {
         let cl = closed_loop(plant, k)?;
         let ks = StateSpace::new(k.ak.clone(), k.bk.clone(), k.ck.clone(), k.dk.clone())?;
-        let h = hinf_norm(&cl, &HinfParams::default()).expect("no stop hook is set");
-        let peak = [h.peak_freq];
-        let band = frequency_band(&[&cl, &ks], &peak);
-        let closed_loop = sigma_curve(&cl, band, &peak);
-        let controller = sigma_curve(&ks, band, &[]);
-        Ok(SigmaFigure { title, closed_loop, controller, peak: (h.value, h.peak_freq) })
+        let domain = plant.domain;
+        let h = hinf_norm_in(domain, &cl, &HinfParams::default()).expect("no stop hook is set");
+        let peak_freq = domain.to_rad_per_s(h.peak_freq);
+        let peak = [peak_freq];
+        let band = frequency_band(domain, &[&cl, &ks], &peak);
+        let closed_loop = sigma_curve(domain, &cl, band, &peak);
+        let controller = sigma_curve(domain, &ks, band, &[]);
+        Ok(SigmaFigure { title, closed_loop, controller, peak: (h.value, peak_freq), ts: domain.ts() })
     }
 
     fn positive(v: &[(f64, f64)]) -> impl Iterator<Item = (f64, f64)> + '_ {
@@ -107,7 +112,10 @@ impl Figure for SigmaFigure {
             .map_err(msg)?;
         chart
             .configure_mesh()
-            .x_desc("frequency ω (rad/s)")
+            .x_desc(match self.ts {
+                None => "frequency ω (rad/s)".to_string(),
+                Some(ts) => format!("frequency ω (rad/s), up to the Nyquist frequency π/Ts (Ts = {ts} s)"),
+            })
             .y_desc("largest singular value σ_max")
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
@@ -115,17 +123,18 @@ impl Figure for SigmaFigure {
             .axis_desc_style((FONT_FAMILY, 17))
             .draw()
             .map_err(msg)?;
+        let at = if self.ts.is_some() { "e^(iωTs)" } else { "iω" };
         let cl_style = colour::OURS.stroke_width(2);
         chart
             .draw_series(LineSeries::new(for_screen(Self::positive(&self.closed_loop), (w0, w1), (lo, hi)), cl_style))
             .map_err(msg)?
-            .label("σ_max(T_zw(iω)), closed loop")
+            .label(format!("σ_max(T_zw({at})), closed loop"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], cl_style));
         let k_style = colour::CONTROLLER.stroke_width(2);
         chart
             .draw_series(LineSeries::new(for_screen(Self::positive(&self.controller), (w0, w1), (lo, hi)), k_style))
             .map_err(msg)?
-            .label("σ_max(K(iω)), controller")
+            .label(format!("σ_max(K({at})), controller"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], k_style));
         if let Some(p) = self.peak_point() {
             let (g, w) = self.peak;

@@ -252,6 +252,17 @@ pub(crate) fn var_to_json(v: &MatVar) -> Value {
     )
 }
 
+/// A variable meant as a scalar (such as a sampling time `Ts`) as JSON: a number when it is 1×1
+/// and finite, else its array of rows (or, non-finite, its text), which the JSON checks then
+/// reject with the file's field named.
+pub(crate) fn scalar_var_to_json(v: &MatVar) -> Value {
+    match v.data.as_slice() {
+        [x] if x.is_finite() => json_number(*x),
+        [x] => Value::String(x.to_string()),
+        _ => var_to_json(v),
+    }
+}
+
 pub(crate) fn json_number(x: f64) -> Value {
     serde_json::Number::from_f64(x).map(Value::Number).expect("finite values were checked")
 }

@@ -94,6 +94,33 @@ impl Cayley {
     }
 }
 
+/// The discrete-time system whose image under the map of `flipped` (as [`Cayley::new`] chose it)
+/// is the continuous-time `image`: the inverse transform. With V = (I − Ac)⁻¹,
+///
+/// ```text
+/// A = 2V − I,   B = √2 V Bc,   C = √2 Cc V,   D = Dc + Cc V Bc,
+/// ```
+///
+/// (solve the forward formulas for A, B, C, D: W = (A + I)⁻¹ = (I − Ac)/2), then, for the flipped
+/// map, (−A, B, −C, D). `None` if I − Ac is singular (a pole of the image at s = 1, which is the
+/// map's singular point) or the result is not finite.
+pub(crate) fn from_continuous(image: &StateSpace, flipped: bool) -> Option<StateSpace> {
+    let n = image.order();
+    let m = Mat::from_fn(n, n, |i, j| if i == j { 1.0 } else { 0.0 } - image.a[(i, j)]);
+    let lu = m.partial_piv_lu();
+    let v = lu.inverse();
+    let sign = if flipped { -1.0 } else { 1.0 };
+    let r2 = std::f64::consts::SQRT_2;
+    let vb = &v * &image.b;
+    let sys = StateSpace {
+        a: Mat::from_fn(n, n, |i, j| sign * (2.0 * v[(i, j)] - if i == j { 1.0 } else { 0.0 })),
+        b: &vb * Scale(r2),
+        c: &image.c * &v * Scale(sign * r2),
+        d: &image.d + &image.c * &vb,
+    };
+    sys.is_finite().then_some(sys)
+}
+
 /// θ folded into [0, π] (G is real: G(e^{−iθ}) is the conjugate of G(e^{iθ})); NaN stays NaN.
 pub(crate) fn fold(theta: f64) -> f64 {
     let two_pi = 2.0 * std::f64::consts::PI;
@@ -156,6 +183,26 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The inverse map takes the image back to the system, on both branches of the map.
+    #[test]
+    fn the_inverse_map_takes_the_image_back() {
+        let near_minus_one = system([[-0.95, 0.2, 0.0], [0.0, 0.3, 0.1], [0.1, 0.0, 0.5]]);
+        let near_plus_one = system([[0.95, 0.2, 0.0], [0.0, -0.3, 0.1], [0.1, 0.0, 0.5]]);
+        for (sys, flipped) in [(near_minus_one, true), (near_plus_one, false)] {
+            let c = Cayley::new(&sys).unwrap();
+            assert_eq!(c.flipped, flipped);
+            let back = from_continuous(&c.sys, c.flipped).unwrap();
+            for (x, y) in [(&back.a, &sys.a), (&back.b, &sys.b), (&back.c, &sys.c), (&back.d, &sys.d)] {
+                let err = (x - y).norm_l2() / y.norm_l2().max(1.0);
+                assert!(err < 1e-13, "flipped = {flipped}: {err:e}");
+            }
+        }
+        // a pole of the image at s = 1 (the map's singular point) has no preimage
+        let mut s1 = system([[0.0; 3]; 3]);
+        s1.a = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 } else { 0.0 });
+        assert!(from_continuous(&s1, false).is_none());
     }
 
     #[test]

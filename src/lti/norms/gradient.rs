@@ -105,13 +105,15 @@ fn controller_eigen_grad(k: &Controller, f: &EigenFunction) -> (f64, ControllerG
     }
 }
 
-/// ‖Tzw‖∞ (+∞ if the loop is unstable, with a NaN gradient) and its gradient, computed as
+/// ‖Tzw‖∞ on the imaginary axis (+∞ if the loop is unstable, with a NaN gradient) and its
+/// gradient ([`closed_loop_hinf_grad`](crate::lti::closed_loop_hinf_grad) takes the plant's
+/// domain into account), computed as
 /// `params` ask ([`HinfParams`]: tolerance, peak hints of a nearby controller, a stop hook —
 /// `Err(LtiError::Interrupted)` once it fires —, a level at which to stop early — a value at or
 /// above `params.enough` is then an attained σmax(Tzw(iω)), a lower bound of the norm, returned
 /// with a NaN gradient —, and a [`ResponseSlot`](crate::lti::ResponseSlot) whose evaluator of this very closed loop is
 /// reused). `Err(IllPosed)` for an ill-posed loop.
-pub fn closed_loop_hinf_grad(
+pub(crate) fn closed_loop_hinf_grad_continuous(
     plant: &Plant,
     k: &Controller,
     params: &HinfParams<'_>,
@@ -135,8 +137,10 @@ pub(crate) fn closed_loop_grad_from(
     }
 }
 
-/// ‖K‖∞ of the controller itself (+∞ if Ak is not Hurwitz; σmax(Dk) for nk = 0) and its gradient.
-pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
+/// ‖K‖∞ of the controller itself on the imaginary axis (+∞ if Ak is not Hurwitz; σmax(Dk) for
+/// nk = 0) and its gradient; [`controller_hinf_grad`](crate::lti::controller_hinf_grad) takes
+/// the controller's domain into account.
+pub(crate) fn controller_hinf_grad_continuous(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
     controller_grad_from(k, hinf_with_vectors(&controller_system(k), &HinfParams::new(tol), None))
 }
 
@@ -154,7 +158,7 @@ pub(crate) fn controller_grad_from(
         return (HinfNorm::UNSTABLE, nan_like(k));
     };
     let [ak, bk, ck, dk] = matrix_gradients(&pv);
-    (norm, Controller { ak, bk, ck, dk })
+    (norm, Controller::continuous(ak, bk, ck, dk))
 }
 
 /// The gradients of σmax at the peak with respect to (A, B, C, D) of the system itself:
@@ -293,7 +297,7 @@ pub(crate) fn peak_vectors_at(sys: &StateSpace, z: Option<c64>) -> Option<PeakVe
 
 pub(crate) fn nan_like(k: &Controller) -> Controller {
     let f = |m: &Mat<f64>| Mat::from_fn(m.nrows(), m.ncols(), |_, _| f64::NAN);
-    Controller { ak: f(&k.ak), bk: f(&k.bk), ck: f(&k.ck), dk: f(&k.dk) }
+    Controller::continuous(f(&k.ak), f(&k.bk), f(&k.ck), f(&k.dk))
 }
 
 #[cfg(test)]

@@ -1,11 +1,13 @@
 //! The H∞ norm and the gradients with respect to the controller: `hinf.rs` (the level-set
 //! method: ‖G‖∞, its peak frequency, the cheap lower bound of the line-search screen) and
 //! `gradient.rs` (α and ‖·‖∞ of the closed loop and of the controller with their gradients in
-//! the controller's matrices). Hand-written: no Rust crate offers them.
+//! the controller's matrices), `discrete.rs` (the norm on the unit circle) and `domain.rs` (which
+//! of them a continuous- or discrete-time system takes). Hand-written: no Rust crate offers them.
 //!
 //! Imports `kernels` and `system`; never `synthesis`.
 
 pub(crate) mod discrete;
+pub(crate) mod domain;
 pub(crate) mod gradient;
 pub(crate) mod hinf;
 pub(crate) mod sigma;

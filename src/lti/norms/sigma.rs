@@ -2,11 +2,55 @@
 //! where the curve bends or peaks, so a plot is smooth at its peaks with few points elsewhere)
 //! and every frequency where σmax comes within a relative tolerance of the H∞ norm (an optimal
 //! controller often equalises several peaks: ω = 0, a resonance and ω → ∞ at once).
+//!
+//! Frequencies are in rad/s in both time domains. A discrete-time system's axis is the unit
+//! circle, z = e^{iωTs} for ω ∈ [0, π/Ts] (the Nyquist frequency ends it); σmax(G(e^{iθ})) is
+//! evaluated as σmax(Gc(iν)) of its bilinear image at the image frequency ν of θ = ωTs
+//! (`kernels/bilinear.rs`: the two are equal, docs/ALGORITHMS.md §10.2), which keeps the
+//! Hessenberg evaluator of the continuous case.
 
 use super::hinf::HinfNorm;
+use crate::lti::kernels::bilinear::Cayley;
 use crate::lti::kernels::freq_response::FreqResponse;
 use crate::lti::kernels::spectral::eigenvalues;
-use crate::lti::StateSpace;
+use crate::lti::{StateSpace, TimeDomain};
+
+/// σmax of a system along its domain's frequency axis, at ω in rad/s.
+struct AxisResponse {
+    fr: FreqResponse,
+    /// Discrete time: the sampling time and the bilinear map the evaluator is of.
+    discrete: Option<(f64, Cayley)>,
+}
+
+impl AxisResponse {
+    /// The evaluator of `sys` in `domain`; in discrete time `None` when the system has no
+    /// bilinear image (poles at both z = 1 and z = −1) or non-finite data.
+    fn new(domain: TimeDomain, sys: &StateSpace) -> Option<Self> {
+        match domain {
+            TimeDomain::Continuous => Some(AxisResponse { fr: FreqResponse::new(sys), discrete: None }),
+            TimeDomain::Discrete { ts } => {
+                let cayley = Cayley::new(sys).filter(|_| sys.is_finite())?;
+                Some(AxisResponse { fr: FreqResponse::new(&cayley.sys), discrete: Some((ts, cayley)) })
+            }
+        }
+    }
+
+    fn sigma_max(&mut self, w: f64) -> f64 {
+        match &self.discrete {
+            None => self.fr.sigma_max(w),
+            Some((ts, cayley)) => {
+                let nu = cayley.continuous_freq((w * ts).min(std::f64::consts::PI));
+                self.fr.sigma_max(nu)
+            }
+        }
+    }
+}
+
+/// The two ends of the domain's frequency axis in rad/s: 0 and +∞, or 0 and the Nyquist
+/// frequency π/Ts.
+fn axis_ends(domain: TimeDomain) -> [f64; 2] {
+    [0.0, domain.nyquist().unwrap_or(f64::INFINITY)]
+}
 
 /// Relative tolerance within which two computed norms count as the same value: peaks of σmax
 /// within it of ‖G‖∞ are all reported as peaks ([`near_peak_frequencies`]), ε‖K‖∞ within it of
@@ -23,26 +67,37 @@ pub const SIGMA_MAX_POINTS: usize = 3000;
 pub const SIGMA_STEP_RTOL: f64 = 0.02;
 
 /// The frequency band (rad/s) of the systems' dynamics: from a decade below the slowest to a
-/// decade above the fastest mode (|λ| of the nonzero eigenvalues of each A), widened to hold
-/// every finite positive frequency of `extra`; whole decades; (0.1, 10) with no modes.
-pub fn frequency_band(systems: &[&StateSpace], extra: &[f64]) -> (f64, f64) {
+/// decade above the fastest mode (|λ| of the nonzero eigenvalues of each A; in discrete time
+/// the mode's |ln λ|/Ts), widened to hold every finite positive frequency of `extra`; whole
+/// decades; (0.1, 10) with no modes. In discrete time the band ends at the Nyquist frequency
+/// π/Ts and starts at least three decades below it.
+pub fn frequency_band(domain: TimeDomain, systems: &[&StateSpace], extra: &[f64]) -> (f64, f64) {
+    let mode_freq = |l: faer::c64| match domain {
+        TimeDomain::Continuous => l.norm(),
+        TimeDomain::Discrete { ts } => faer::c64::new(l.norm().ln(), l.arg()).norm() / ts,
+    };
     let mags = systems
         .iter()
         .flat_map(|s| eigenvalues(s.a.as_ref()).unwrap_or_default())
-        .map(|l| l.norm())
+        .map(mode_freq)
         .filter(|m| *m > 0.0 && m.is_finite())
         .chain(extra.iter().copied().filter(|w| *w > 0.0 && w.is_finite()));
     let (lo, hi) = mags.fold((f64::INFINITY, 0f64), |(l, h), m| (l.min(m), h.max(m)));
     let (lo, hi) = if lo <= hi { (lo, hi) } else { (1.0, 1.0) };
-    (10f64.powf((lo / 10.0).log10().floor()), 10f64.powf((hi * 10.0).log10().ceil()))
+    let band = (10f64.powf((lo / 10.0).log10().floor()), 10f64.powf((hi * 10.0).log10().ceil()));
+    match domain.nyquist() {
+        None => band,
+        Some(nyquist) => (band.0.min(nyquist * 1e-3), nyquist),
+    }
 }
 
 /// (ω, σmax(G(iω))) on `band`, ascending in ω: [`SIGMA_BASE_POINTS`] log-spaced points, then
 /// midpoints (in log ω) inserted next to every point where σmax changes by more than
 /// [`SIGMA_STEP_RTOL`] to a neighbour or has a local maximum, until no interval needs it or
 /// [`SIGMA_MAX_POINTS`] are reached. `extra` frequencies inside the band (a peak) are added.
-pub fn sigma_curve(sys: &StateSpace, band: (f64, f64), extra: &[f64]) -> Vec<(f64, f64)> {
-    let mut fr = FreqResponse::new(sys);
+/// In discrete time σmax(G(e^{iωTs})); empty if the system has no bilinear image (module docs).
+pub fn sigma_curve(domain: TimeDomain, sys: &StateSpace, band: (f64, f64), extra: &[f64]) -> Vec<(f64, f64)> {
+    let Some(mut fr) = AxisResponse::new(domain, sys) else { return Vec::new() };
     let (l0, l1) = (band.0.log10(), band.1.log10());
     let n = SIGMA_BASE_POINTS;
     let mut pts: Vec<(f64, f64)> = (0..n)
@@ -87,25 +142,26 @@ pub fn sigma_curve(sys: &StateSpace, band: (f64, f64), extra: &[f64]) -> Vec<(f6
     pts
 }
 
-/// Every frequency where σmax(G(iω)) is within a relative `rtol` of `norm.value` (‖G‖∞ of a
-/// stable `sys`), ascending: ω = 0 and ω = +∞ (σmax(D)) when they qualify, and each local
-/// maximum of the [`sigma_curve`] on the system's [`frequency_band`], refined by golden-section
-/// search in log ω; `norm.peak_freq` is always one of them. Empty for an unstable system.
-pub fn near_peak_frequencies(sys: &StateSpace, norm: &HinfNorm, rtol: f64) -> Vec<f64> {
+/// Every frequency (rad/s) where σmax(G(iω)) is within a relative `rtol` of `norm.value` (‖G‖∞
+/// of a stable `sys`, with `norm.peak_freq` in rad/s), ascending: ω = 0 and ω = +∞ (σmax(D))
+/// — in discrete time the Nyquist frequency — when they qualify, and each local maximum of the
+/// [`sigma_curve`] on the system's [`frequency_band`], refined by golden-section search in log
+/// ω; `norm.peak_freq` is always one of them. Empty for an unstable system.
+pub fn near_peak_frequencies(domain: TimeDomain, sys: &StateSpace, norm: &HinfNorm, rtol: f64) -> Vec<f64> {
     let peak = norm.value;
     if !peak.is_finite() {
         return Vec::new();
     }
     let level = peak * (1.0 - rtol);
-    let mut fr = FreqResponse::new(sys);
+    let Some(mut fr) = AxisResponse::new(domain, sys) else { return vec![norm.peak_freq] };
     let mut found: Vec<f64> = Vec::new();
-    for w in [0.0, f64::INFINITY] {
+    for w in axis_ends(domain) {
         if fr.sigma_max(w) >= level {
             found.push(w);
         }
     }
     let extra = [norm.peak_freq];
-    let curve = sigma_curve(sys, frequency_band(&[sys], &extra), &extra);
+    let curve = sigma_curve(domain, sys, frequency_band(domain, &[sys], &extra), &extra);
     for i in 1..curve.len().saturating_sub(1) {
         if curve[i].1 >= curve[i - 1].1 && curve[i].1 >= curve[i + 1].1 {
             let (w, s) = golden_max(&mut fr, curve[i - 1].0, curve[i + 1].0);
@@ -135,7 +191,7 @@ pub fn near_peak_frequencies(sys: &StateSpace, norm: &HinfNorm, rtol: f64) -> Ve
 }
 
 /// The maximum of σmax on [a, b] (0 < a < b) by golden-section search in log ω.
-fn golden_max(fr: &mut FreqResponse, a: f64, b: f64) -> (f64, f64) {
+fn golden_max(fr: &mut AxisResponse, a: f64, b: f64) -> (f64, f64) {
     let g = (5f64.sqrt() - 1.0) / 2.0;
     let (mut lo, mut hi) = (a.ln(), b.ln());
     let mut x1 = hi - g * (hi - lo);
@@ -185,9 +241,9 @@ mod tests {
         let c = Mat::from_fn(1, 2, |_, j| [0.0, 2.0 * z * wn * k][j]);
         let d = Mat::from_fn(1, 1, |_, _| 1.0);
         let g = ss(a, b, c, d);
-        let band = frequency_band(&[&g], &[]);
+        let band = frequency_band(TimeDomain::Continuous, &[&g], &[]);
         assert_eq!(band, (0.1, 100.0));
-        let curve = sigma_curve(&g, band, &[]);
+        let curve = sigma_curve(TimeDomain::Continuous, &g, band, &[]);
         assert!(curve.len() > SIGMA_BASE_POINTS && curve.len() <= SIGMA_MAX_POINTS);
         assert!(curve.windows(2).all(|w| w[0].0 < w[1].0));
         let step = |w0: f64| {
@@ -198,7 +254,7 @@ mod tests {
         assert!(step(wn) < 1.0 + (uniform - 1.0) / 4.0, "not refined at the peak: {}", step(wn));
         let h = hinf_norm(&g, &HinfParams::default()).unwrap();
         assert!((h.value - (1.0 + k)).abs() < 1e-6, "{h:?}");
-        let peaks = near_peak_frequencies(&g, &h, NORM_TIE_RTOL);
+        let peaks = near_peak_frequencies(TimeDomain::Continuous, &g, &h, NORM_TIE_RTOL);
         assert_eq!(peaks.len(), 1, "{peaks:?}");
         assert!((peaks[0] - wn).abs() < 1e-3 * wn, "{peaks:?}");
     }
@@ -228,12 +284,12 @@ mod tests {
         let g = ss(a, b, c, d);
         let h = hinf_norm(&g, &HinfParams::default()).unwrap();
         assert!((h.value - 1.0).abs() < 1e-6, "{h:?}");
-        let peaks = near_peak_frequencies(&g, &h, NORM_TIE_RTOL);
+        let peaks = near_peak_frequencies(TimeDomain::Continuous, &g, &h, NORM_TIE_RTOL);
         assert_eq!(peaks.len(), 3, "{peaks:?}");
         assert_eq!(peaks[0], 0.0);
         assert!((peaks[1] - wn).abs() < 1e-3, "{peaks:?}");
         assert!(peaks[2].is_infinite());
         // a tighter tolerance than the ends' distance keeps them: they are exactly 1
-        assert_eq!(near_peak_frequencies(&g, &h, 1e-9).len(), 3);
+        assert_eq!(near_peak_frequencies(TimeDomain::Continuous, &g, &h, 1e-9).len(), 3);
     }
 }

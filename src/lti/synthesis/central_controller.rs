@@ -72,6 +72,10 @@ pub enum CentralError {
     /// A decomposition failed or produced non-finite values.
     #[error("linear algebra failure: {0}")]
     LinearAlgebra(&'static str),
+    /// The plant is in discrete time: take the central controller of its bilinear image
+    /// (`lti::PlantImage`) back.
+    #[error("the central controller is computed in continuous time; for a discrete-time plant use its bilinear image")]
+    DiscreteTime,
 }
 
 /// The normalised, regularised plant of the module docs, with γ_opt.
@@ -100,6 +104,9 @@ impl CentralProblem {
 
     /// As [`CentralProblem::new`] with an explicit (absolute) regularisation ε.
     pub fn with_regularisation(plant: &Plant, eps: f64) -> Result<Self, CentralError> {
+        if plant.domain.is_discrete() {
+            return Err(CentralError::DiscreteTime);
+        }
         let d = plant.dims;
         if d.m2 == 0 || d.p2 == 0 {
             return Err(FullOrderError::NoControl { m2: d.m2, p2: d.p2 }.into());
@@ -179,7 +186,7 @@ impl CentralProblem {
                 return Err(CentralError::LinearAlgebra("non-finite central controller"));
             }
         }
-        Ok(Controller { ak, bk, ck, dk })
+        Ok(Controller::continuous(ak, bk, ck, dk))
     }
 }
 

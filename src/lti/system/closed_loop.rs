@@ -43,7 +43,9 @@ use crate::lti::error::LtiError;
 /// ill-posed. At 1e12 the closed-loop matrices still carry about 4 correct digits.
 pub const MAX_LOOP_CONDITION: f64 = 1e12;
 
-/// Forms the closed loop (Acl, Bcl, Ccl, Dcl) of `plant` with controller `k` (u = K y).
+/// Forms the closed loop (Acl, Bcl, Ccl, Dcl) of `plant` with controller `k` (u = K y), in the
+/// plant's time domain (the formulas are the same in both; `Err(DomainMismatch)` unless the
+/// controller is in the plant's domain).
 pub fn closed_loop(plant: &Plant, k: &Controller) -> Result<StateSpace, LtiError> {
     Ok(ClosedLoop::new(plant, k)?.sys)
 }
@@ -60,8 +62,11 @@ pub(crate) struct ClosedLoop<'p> {
 }
 
 impl<'p> ClosedLoop<'p> {
-    /// Forms the closed loop; checks shapes and well-posedness.
+    /// Forms the closed loop; checks the time domains, the shapes and well-posedness.
     pub(crate) fn new(plant: &'p Plant, k: &Controller) -> Result<Self, LtiError> {
+        if plant.domain != k.domain {
+            return Err(LtiError::DomainMismatch { plant: plant.domain, controller: k.domain });
+        }
         let dims = plant.dims;
         let (n, m, p) = (dims.n, dims.m2, dims.p2);
         let nk = k.order();
@@ -140,12 +145,12 @@ impl<'p> ClosedLoop<'p> {
             r = mul(qm.as_ref(), &r);
         }
         let outer = |li: &[c64], rj: &[c64]| Mat::from_fn(li.len(), rj.len(), |i, j| (li[i] * rj[j]).re);
-        Controller {
-            ak: outer(&l[..nk], &r[..nk]),
-            bk: outer(&l[..nk], &r[nk..]),
-            ck: outer(&l[nk..], &r[..nk]),
-            dk: outer(&l[nk..], &r[nk..]),
-        }
+        Controller::continuous(
+            outer(&l[..nk], &r[..nk]),
+            outer(&l[..nk], &r[nk..]),
+            outer(&l[nk..], &r[..nk]),
+            outer(&l[nk..], &r[nk..]),
+        )
     }
 }
 

@@ -4,18 +4,22 @@
 //! xk' = Ak xk + Bk y,   u = Ck xk + Dk y        (positive feedback u = K y)
 //! ```
 //! with Ak nk×nk, Bk nk×p, Ck m×nk, Dk m×p (docs/ALGORITHMS.md §1). The file is a JSON object with
-//! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`). Any other
-//! key is an error naming it ([`ControllerErrorKind::UnknownKey`]).
+//! keys `AK, BK, CK, DK` as arrays of rows; for order 0, `AK, BK, CK` are empty (`[]`). An
+//! optional `Ts` is the sampling time of a discrete-time controller (xk⁺ = Ak xk + Bk y; absent
+//! or 0: continuous time, [`TimeDomain`]); it must be the plant's. Any other key is an error
+//! naming it ([`ControllerErrorKind::UnknownKey`]).
 
 use std::path::{Path, PathBuf};
 
 use faer::Mat;
 use serde_json::{Map, Value};
 
-use crate::lti::io::mat_file::{is_mat_path, read_mat_vars, var_to_json, write_mat, MatReadError};
+use crate::lti::io::mat_file::{is_mat_path, read_mat_vars, scalar_var_to_json, var_to_json, write_mat, MatReadError};
 use crate::lti::io::matrix_json::{json_shape, json_type, matrix_from_json, matrix_to_json, MatrixJsonError};
 
-/// Controller matrices (Ak, Bk, Ck, Dk).
+use super::time_domain::TimeDomain;
+
+/// Controller matrices (Ak, Bk, Ck, Dk) and the controller's time domain.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Controller {
     /// nk × nk.
@@ -26,6 +30,8 @@ pub struct Controller {
     pub ck: Mat<f64>,
     /// m × p.
     pub dk: Mat<f64>,
+    /// Continuous or discrete time (the file's `Ts`); a closed loop needs the plant's.
+    pub domain: TimeDomain,
 }
 
 /// As [`Controller::to_json`]: the `{AK, BK, CK, DK}` object of a controller file.
@@ -76,11 +82,17 @@ pub enum ControllerErrorKind {
     /// Not an object with AK, BK, CK, DK.
     #[error("the top level must be a JSON object with keys AK, BK, CK, DK")]
     NotObject,
-    /// A key other than AK, BK, CK, DK.
-    #[error("unknown key `{key}` (a controller file holds AK, BK, CK, DK)")]
+    /// A key other than AK, BK, CK, DK, Ts.
+    #[error("unknown key `{key}` (a controller file holds AK, BK, CK, DK and optionally Ts)")]
     UnknownKey {
         /// The key as written in the file.
         key: String,
+    },
+    /// The sampling time `Ts` is not a number ≥ 0.
+    #[error("field `Ts`: {problem}")]
+    BadSamplingTime {
+        /// What is wrong.
+        problem: String,
     },
     /// A matrix is wrong.
     #[error("matrix `{matrix}` {problem}")]
@@ -103,9 +115,20 @@ pub enum ControllerErrorKind {
 impl Controller {
     /// The zero controller of order `nk` for a plant with `m` control inputs u and `p`
     /// measurements y: Dk is m × p, so the controller has [`Self::outputs`] = m and
-    /// [`Self::inputs`] = p.
+    /// [`Self::inputs`] = p. Continuous time ([`Self::in_domain`] for another).
     pub fn zeros(nk: usize, m: usize, p: usize) -> Self {
-        Controller { ak: Mat::zeros(nk, nk), bk: Mat::zeros(nk, p), ck: Mat::zeros(m, nk), dk: Mat::zeros(m, p) }
+        Controller::continuous(Mat::zeros(nk, nk), Mat::zeros(nk, p), Mat::zeros(m, nk), Mat::zeros(m, p))
+    }
+
+    /// The continuous-time controller (Ak, Bk, Ck, Dk) (shapes not checked: [`Self::check_fits`]).
+    pub fn continuous(ak: Mat<f64>, bk: Mat<f64>, ck: Mat<f64>, dk: Mat<f64>) -> Self {
+        Controller { ak, bk, ck, dk, domain: TimeDomain::Continuous }
+    }
+
+    /// The same matrices in the time domain `domain`.
+    pub fn in_domain(mut self, domain: TimeDomain) -> Self {
+        self.domain = domain;
+        self
     }
 
     /// Order nk (number of controller states).
@@ -156,10 +179,10 @@ impl Controller {
         Self::from_json_value(&doc).map_err(err)
     }
 
-    /// Reads a controller from a parsed JSON value (`{AK, BK, CK, DK}`).
+    /// Reads a controller from a parsed JSON value (`{AK, BK, CK, DK}`, optionally `Ts`).
     pub fn from_json_value(doc: &Value) -> Result<Controller, ControllerErrorKind> {
         let obj = doc.as_object().ok_or(ControllerErrorKind::NotObject)?;
-        if let Some(key) = obj.keys().find(|k| !["AK", "BK", "CK", "DK"].contains(&k.as_str())) {
+        if let Some(key) = obj.keys().find(|k| !["AK", "BK", "CK", "DK", "Ts"].contains(&k.as_str())) {
             return Err(ControllerErrorKind::UnknownKey { key: key.clone() });
         }
         let mat = |key: &'static str, r: usize, c: usize| {
@@ -188,7 +211,15 @@ impl Controller {
                 problem: MatrixJsonError::Empty { rows: m, cols: p },
             });
         }
-        Ok(Controller { ak: mat("AK", nk, nk)?, bk: mat("BK", nk, p)?, ck: mat("CK", m, nk)?, dk: mat("DK", m, p)? })
+        let domain =
+            TimeDomain::from_json(obj.get("Ts")).map_err(|problem| ControllerErrorKind::BadSamplingTime { problem })?;
+        Ok(Controller {
+            ak: mat("AK", nk, nk)?,
+            bk: mat("BK", nk, p)?,
+            ck: mat("CK", m, nk)?,
+            dk: mat("DK", m, p)?,
+            domain,
+        })
     }
 
     /// Writes the controller to `path`: a MATLAB `.mat` file (`AK BK CK DK`) when the extension is
@@ -204,17 +235,22 @@ impl Controller {
         crate::fs_atomic::write_atomic(path, &bytes)
     }
 
-    /// The controller as `{AK, BK, CK, DK}`.
+    /// The controller as `{AK, BK, CK, DK}`, with `Ts` in discrete time.
     pub fn to_json(&self) -> Value {
-        serde_json::json!({
+        let mut doc = serde_json::json!({
             "AK": matrix_to_json(self.ak.as_ref()),
             "BK": matrix_to_json(self.bk.as_ref()),
             "CK": matrix_to_json(self.ck.as_ref()),
             "DK": matrix_to_json(self.dk.as_ref()),
-        })
+        });
+        if let Some(ts) = self.domain.ts() {
+            doc["Ts"] = ts.into();
+        }
+        doc
     }
 
-    /// Checks that the controller fits the plant: its outputs are the plant's m2 control inputs
+    /// Checks that the controller fits the plant: it is in the plant's time domain (same `Ts`),
+    /// its outputs are the plant's m2 control inputs
     /// and its inputs the plant's p2 measurements (Dk is m2 × p2), and its four blocks agree on
     /// the order nk (Ak nk × nk, Bk nk × p2, Ck m2 × nk): the fields are public, so a controller
     /// need not come from a checked file.
@@ -222,6 +258,9 @@ impl Controller {
         let (m, p, nk) = (plant.dims.m2, plant.dims.p2, self.order());
         let blocks = [("AK", &self.ak, (nk, nk)), ("BK", &self.bk, (nk, p)), ("CK", &self.ck, (m, nk))];
         let mismatch = |problem| Err(ControllerErrorKind::Mismatch { plant: plant.name.clone(), problem });
+        if self.domain != plant.domain {
+            return mismatch(format!("the controller is in {}, the plant in {}", self.domain, plant.domain));
+        }
         if self.outputs() != m || self.inputs() != p {
             return mismatch(format!("DK is {}×{}, the plant needs m2×p2 = {m}×{p}", self.outputs(), self.inputs()));
         }
@@ -268,13 +307,20 @@ fn controller_from_mat(bytes: &[u8]) -> Result<Controller, ControllerErrorKind> 
         }
         doc.insert(key.into(), var_to_json(v));
     }
+    if let Some(ts) = vars.get("Ts") {
+        doc.insert("Ts".into(), scalar_var_to_json(ts));
+    }
     // `[]` (a 0×0 AK, BK, CK of a static gain) is accepted for any block without entries.
     Controller::from_json_value(&Value::Object(doc))
 }
 
-/// The controller as a MAT-file `AK BK CK DK`.
+/// The controller as a MAT-file `AK BK CK DK` (and `Ts` in discrete time).
 pub fn controller_to_mat(k: &Controller) -> Vec<u8> {
-    let vars = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
+    let ts = k.domain.ts().map(|ts| Mat::from_fn(1, 1, |_, _| ts));
+    let mut vars = vec![("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
+    if let Some(ts) = &ts {
+        vars.push(("Ts", ts.as_ref()));
+    }
     write_mat(&vars, "hinfix controller (u = K y: xk' = AK xk + BK y, u = CK xk + DK y)")
 }
 

@@ -11,6 +11,10 @@
 //! *negative* feedback in both; keep u = K y with `feedback(G, K, +1)` (MATLAB) or
 //! `control.feedback(G, K, sign=1)` (python), or pass `-K`.
 //!
+//! A discrete-time controller (xk⁺ = AK xk + BK y) is built with its sampling time: MATLAB's
+//! `ss(AK, BK, CK, DK, Ts)`, python-control's `control.ss(AK, BK, CK, DK, dt=Ts)`; the plant must
+//! then be discrete with the same Ts for `lft` to accept the pair.
+//!
 //! Numbers are printed with Rust's shortest round-trip representation, so the pasted matrices
 //! are bit-for-bit the controller's.
 
@@ -58,25 +62,34 @@ pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String
     let (nk, m, p) = (k.order(), k.outputs(), k.inputs());
     let mats = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
     let mut s = String::new();
+    let update = if k.domain.is_discrete() { "xk[t+1] = AK xk[t] + BK y[t]" } else { "xk' = AK xk + BK y" };
+    let ts = k.domain.ts().map(number);
     match target {
         ExportTarget::Matlab => {
             s += &format!(
                 "% hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
             );
-            s += "% Sign convention: POSITIVE feedback u = K y (xk' = AK xk + BK y, u = CK xk + DK y).\n";
+            s += &format!("% Sign convention: POSITIVE feedback u = K y ({update}, u = CK xk + DK y).\n");
             s += "% Closed loop with the plant P = ss(A, [B1 B2], [C1; C2], [D11 D12; D21 D22]):\n";
             s += "%   Tzw = lft(P, K);                 % lft keeps u = K y\n";
             s += "%   L = feedback(P22, K, +1);        % feedback() is negative by default: use +1 (or -K)\n";
             for (name, mat) in mats {
                 s += &format!("{name} = {};\n", matlab_matrix(mat));
             }
-            s += "K = ss(AK, BK, CK, DK);\n";
+            match &ts {
+                None => s += "K = ss(AK, BK, CK, DK);\n",
+                Some(ts) => {
+                    s += &format!(
+                        "Ts = {ts};  % sampling time (s): a discrete-time controller\nK = ss(AK, BK, CK, DK, Ts);\n"
+                    )
+                }
+            }
         }
         ExportTarget::Python => {
             s += &format!(
                 "# hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
             );
-            s += "# Sign convention: POSITIVE feedback u = K y (xk' = AK xk + BK y, u = CK xk + DK y).\n";
+            s += &format!("# Sign convention: POSITIVE feedback u = K y ({update}, u = CK xk + DK y).\n");
             s += "# Closed loop with P = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]), np.block([[D11, D12], [D21, D22]])):\n";
             s += "#   Tzw = P.lft(K)                          # lower LFT, keeps u = K y\n";
             s +=
@@ -85,7 +98,10 @@ pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String
             for (name, mat) in mats {
                 s += &format!("{name} = {}\n", python_matrix(mat));
             }
-            s += "K = control.ss(AK, BK, CK, DK)\n";
+            match &ts {
+                None => s += "K = control.ss(AK, BK, CK, DK)\n",
+                Some(ts) => s += &format!("Ts = {ts}  # sampling time (s): a discrete-time controller\nK = control.ss(AK, BK, CK, DK, dt=Ts)\n"),
+            }
         }
     }
     s
@@ -101,12 +117,12 @@ mod tests {
         for x in [0.1, -1.0 / 3.0, 1e-300, 123456789.0, -0.0] {
             assert_eq!(number(x).parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x}");
         }
-        let k = Controller {
-            ak: Mat::zeros(0, 0),
-            bk: Mat::zeros(0, 2),
-            ck: Mat::zeros(1, 0),
-            dk: Mat::from_fn(1, 2, |_, j| j as f64 + 0.5),
-        };
+        let k = Controller::continuous(
+            Mat::zeros(0, 0),
+            Mat::zeros(0, 2),
+            Mat::zeros(1, 0),
+            Mat::from_fn(1, 2, |_, j| j as f64 + 0.5),
+        );
         let m = export_code(&k, ExportTarget::Matlab, "k.json");
         assert!(
             m.contains("BK = zeros(0, 2);") && m.contains("CK = zeros(1, 0);") && m.contains("DK = [0.5, 1.5];"),
@@ -116,5 +132,16 @@ mod tests {
         let p = export_code(&k, ExportTarget::Python, "k.json");
         assert!(p.contains("BK = np.zeros((0, 2))") && p.contains("DK = np.array([[0.5, 1.5]])"), "{p}");
         assert!(p.contains("K = control.ss(AK, BK, CK, DK)") && p.contains("sign=1"));
+        assert!(!m.contains("Ts") && !p.contains("dt="));
+    }
+
+    /// A discrete-time controller carries its sampling time into both languages.
+    #[test]
+    fn a_discrete_controller_is_built_with_its_sampling_time() {
+        let k = Controller::zeros(1, 1, 1).in_domain(crate::lti::TimeDomain::Discrete { ts: 0.01 });
+        let m = export_code(&k, ExportTarget::Matlab, "k.json");
+        assert!(m.contains("Ts = 0.01;") && m.contains("K = ss(AK, BK, CK, DK, Ts);") && m.contains("xk[t+1]"), "{m}");
+        let p = export_code(&k, ExportTarget::Python, "k.json");
+        assert!(p.contains("Ts = 0.01") && p.contains("K = control.ss(AK, BK, CK, DK, dt=Ts)"), "{p}");
     }
 }

@@ -10,7 +10,9 @@
 //! A plant file is a JSON object with `name`, optional `description`, `source` (a citation string
 //! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices
 //! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows; optional `notes` and `check` are
-//! kept as provenance, and an optional `order` must equal `dims.n`. No entry may exceed 1e50
+//! kept as provenance, and an optional `order` must equal `dims.n`. An optional `Ts` is the
+//! sampling time in seconds of a discrete-time plant (absent or 0: continuous time,
+//! [`TimeDomain`]). No entry may exceed 1e50
 //! in absolute value, and a non-zero matrix needs an entry of 1e-50 or more
 //! (`matrix_json::check_magnitudes`). Any other top-level
 //! key is an error naming it ([`PlantErrorKind::UnknownKey`]): a misspelt `D12` or a key this version does
@@ -26,9 +28,11 @@ use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
 use crate::lti::io::mat_file::{
-    json_number, read_char_var, read_mat_vars, var_to_json, write_mat, MatReadError, MatVar,
+    json_number, read_char_var, read_mat_vars, scalar_var_to_json, var_to_json, write_mat, MatReadError, MatVar,
 };
 use crate::lti::io::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
+
+use super::time_domain::TimeDomain;
 
 /// Sizes of a generalised plant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -62,6 +66,8 @@ pub struct Plant {
     pub check: Option<Value>,
     /// Sizes.
     pub dims: Dims,
+    /// Continuous or discrete time (the file's `Ts`).
+    pub domain: TimeDomain,
     /// State matrix (n × n).
     pub a: Mat<f64>,
     /// Disturbance input matrix (n × m1).
@@ -171,9 +177,9 @@ pub(crate) const MATRICES: [(&str, &str, &str); 9] = [
     ("D22", "p2", "m2"),
 ];
 
-/// Every top-level key of a plant file: the provenance fields, `dims`, `order` and the nine
-/// matrices.
-pub(crate) const PLANT_KEYS: [&str; 16] = [
+/// Every top-level key of a plant file: the provenance fields, `dims`, `order`, the sampling time
+/// `Ts` and the nine matrices.
+pub(crate) const PLANT_KEYS: [&str; 17] = [
     "name",
     "description",
     "source",
@@ -181,6 +187,7 @@ pub(crate) const PLANT_KEYS: [&str; 16] = [
     "check",
     "order",
     "dims",
+    "Ts",
     "A",
     "B1",
     "B2",
@@ -268,6 +275,7 @@ impl Plant {
                 return Err(bad("order", &format!("is {order}, but dims.n is {}", dims.n)));
             }
         }
+        let domain = TimeDomain::from_json(obj.get("Ts")).map_err(|problem| bad("Ts", &problem))?;
         let mut mats: Vec<Mat<f64>> = Vec::with_capacity(9);
         for (key, r, c) in MATRICES {
             let (rows, cols) = (dims.get(r), dims.get(c));
@@ -298,6 +306,7 @@ impl Plant {
             notes,
             check: obj.get("check").cloned(),
             dims,
+            domain,
             a: next(),
             b1: next(),
             b2: next(),
@@ -343,6 +352,9 @@ impl Plant {
         o.insert("source".into(), self.source.clone());
         o.insert("notes".into(), self.notes.clone().into());
         o.insert("dims".into(), serde_json::to_value(self.dims).expect("dims serialise"));
+        if let Some(ts) = self.domain.ts() {
+            o.insert("Ts".into(), ts.into());
+        }
         for ((key, _, _), m) in MATRICES.iter().zip(self.matrices()) {
             o.insert((*key).into(), matrix_to_json(m));
         }
@@ -373,8 +385,10 @@ impl Plant {
         (0..d.nrows()).all(|i| (0..d.ncols()).all(|j| d[(i, j)] == 0.0))
     }
 
-    /// A content fingerprint (SHA-256, hex) of the dims and the matrices' exact bits: the
-    /// plant's identity in job ids, independent of formatting and provenance text.
+    /// A content fingerprint (SHA-256, hex) of the dims, the matrices' exact bits and, for a
+    /// discrete-time plant, its sampling time: the plant's identity in job ids, independent of
+    /// formatting and provenance text. (A continuous-time plant's fingerprint does not mention
+    /// the domain, so it is the one fingerprints had before sampling times existed.)
     pub fn fingerprint(&self) -> String {
         let mut h = Sha256::new();
         for d in [self.dims.n, self.dims.m1, self.dims.m2, self.dims.p1, self.dims.p2] {
@@ -386,6 +400,10 @@ impl Plant {
                     h.update(m[(i, j)].to_bits().to_le_bytes());
                 }
             }
+        }
+        if let Some(ts) = self.domain.ts() {
+            h.update(b"Ts");
+            h.update(ts.to_bits().to_le_bytes());
         }
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
@@ -520,6 +538,9 @@ fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
         let value = if v.is_empty() { Value::Array(Vec::new()) } else { var_to_json(v) };
         doc.insert(key.into(), value);
     }
+    if let Some(ts) = vars.get("Ts") {
+        doc.insert("Ts".into(), scalar_var_to_json(ts));
+    }
     complete_document(&mut doc, stem);
     Ok(Value::Object(doc))
 }
@@ -530,9 +551,14 @@ fn plant_from_mat(bytes: &[u8], path: &Path) -> Result<Plant, PlantErrorKind> {
     Plant::from_json_value(&plant_document(bytes, &stem)?)
 }
 
-/// The plant as a MAT-file (the nine matrices; `name` is not written, the file stem names it).
+/// The plant as a MAT-file (the nine matrices, and `Ts` for a discrete-time plant; `name` is not
+/// written, the file stem names it).
 pub fn plant_to_mat(p: &Plant) -> Vec<u8> {
     let names = MATRICES.map(|(k, _, _)| k);
-    let vars: Vec<(&str, MatRef<'_, f64>)> = names.into_iter().zip(p.matrices()).collect();
+    let mut vars: Vec<(&str, MatRef<'_, f64>)> = names.into_iter().zip(p.matrices()).collect();
+    let ts = p.domain.ts().map(|ts| Mat::from_fn(1, 1, |_, _| ts));
+    if let Some(ts) = &ts {
+        vars.push(("Ts", ts.as_ref()));
+    }
     write_mat(&vars, &format!("hinfix plant {}", p.name))
 }

@@ -17,16 +17,13 @@
 
 use std::fmt;
 
-use faer::Mat;
-
-use crate::lti::kernels::bilinear::Cayley;
+use super::plant_image::{ImageError, PlantImage};
 use crate::lti::system::plant::Plant;
-use crate::lti::system::state_space::StateSpace;
 use crate::numeric::all_finite;
 
 mod bracketing;
 mod gamma_test;
-mod linalg;
+pub(super) mod linalg;
 mod regularisation;
 
 pub use bracketing::{GAMMA_MAX, GAMMA_RTOL};
@@ -202,43 +199,27 @@ pub fn full_order_gamma(plant: &Plant) -> Result<FullOrderGamma, FullOrderError>
 /// to the axis, so the two infima are equal. The result's notes and regularisation refer to the
 /// image (its D12 and D21 are P12 and P21 at z = ∓1, not the discrete D12 and D21).
 /// `Err(LinearAlgebra)` if A has eigenvalues at both z = 1 and z = −1 (no image).
+///
+/// The plant's matrices are taken as discrete-time ones whatever its `domain`;
+/// [`full_order_gamma_with`] comes here for a plant whose domain is discrete.
 pub fn full_order_gamma_discrete(plant: &Plant, opts: &FullOrderOptions) -> Result<FullOrderGamma, FullOrderError> {
-    let image = bilinear_plant(plant)?;
+    let image = PlantImage::new(plant)
+        .map_err(|e| match e {
+            ImageError::NonFinite => FullOrderError::NonFinite,
+            ImageError::NoImage => {
+                FullOrderError::LinearAlgebra("bilinear transform: A has eigenvalues at both z = 1 and z = −1")
+            }
+        })?
+        .plant;
     full_order_gamma_with(&image, opts)
 }
 
-/// The bilinear image of a discrete-time plant, as one system (A, [B1 B2], [C1; C2], D).
-fn bilinear_plant(plant: &Plant) -> Result<Plant, FullOrderError> {
-    let d = plant.dims;
-    let (cols, rows) = (linalg::concat_cols, linalg::concat_rows);
-    let b = cols(plant.b1.as_ref(), plant.b2.as_ref());
-    let c = rows(plant.c1.as_ref(), plant.c2.as_ref());
-    let top = cols(plant.d11.as_ref(), plant.d12.as_ref());
-    let dd = rows(top.as_ref(), cols(plant.d21.as_ref(), plant.d22.as_ref()).as_ref());
-    let sys = StateSpace { a: plant.a.clone(), b, c, d: dd };
-    if !sys.is_finite() {
-        return Err(FullOrderError::NonFinite);
-    }
-    let image = Cayley::new(&sys)
-        .ok_or(FullOrderError::LinearAlgebra("bilinear transform: A has eigenvalues at both z = 1 and z = −1"))?
-        .sys;
-    let block = |m: &Mat<f64>, r0: usize, c0: usize, r: usize, c: usize| m.as_ref().submatrix(r0, c0, r, c).to_owned();
-    Ok(Plant {
-        a: image.a,
-        b1: block(&image.b, 0, 0, d.n, d.m1),
-        b2: block(&image.b, 0, d.m1, d.n, d.m2),
-        c1: block(&image.c, 0, 0, d.p1, d.n),
-        c2: block(&image.c, d.p1, 0, d.p2, d.n),
-        d11: block(&image.d, 0, 0, d.p1, d.m1),
-        d12: block(&image.d, 0, d.m1, d.p1, d.m2),
-        d21: block(&image.d, d.p1, 0, d.p2, d.m1),
-        d22: block(&image.d, d.p1, d.m1, d.p2, d.m2),
-        ..plant.clone()
-    })
-}
-
-/// γ_opt of the plant with explicit options.
+/// γ_opt of the plant with explicit options (of its bilinear image for a discrete-time plant,
+/// [`full_order_gamma_discrete`]).
 pub fn full_order_gamma_with(plant: &Plant, opts: &FullOrderOptions) -> Result<FullOrderGamma, FullOrderError> {
+    if plant.domain.is_discrete() {
+        return full_order_gamma_discrete(plant, opts);
+    }
     let d = plant.dims;
     if d.m2 == 0 || d.p2 == 0 {
         return Err(FullOrderError::NoControl { m2: d.m2, p2: d.p2 });

@@ -1,0 +1,114 @@
+//! The domain-dependent quantities of a design in one place: stability and the H∞ norm in
+//! continuous or discrete time ([`TimeDomain`], docs/ALGORITHMS.md §3.1, §10).
+//!
+//! The *stability measure* of a state matrix A is
+//!
+//! ```text
+//! s(A) = α(A) = max Re λ(A)        (continuous time)
+//! s(A) = ρ(A) − 1 = max |λ(A)| − 1  (discrete time)
+//! ```
+//!
+//! negative exactly when the system is stable, in both domains. The stabilisation objective,
+//! the optimiser's test ([`is_stable`](crate::lti::is_stable): s < 0) and the verification
+//! margin ([`is_stable_with_margin`](crate::lti::is_stable_with_margin): s < −margin, i.e.
+//! ρ < 1 − margin in discrete time, as `is_schur_stable_with_margin`) are then written once for
+//! both. The gradient of ρ − 1 is that of ρ (§10.1).
+
+use super::discrete::{closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete};
+use super::gradient::{
+    closed_loop_abscissa_grad, closed_loop_hinf_grad_continuous, closed_loop_radius_grad, controller_abscissa_grad,
+    controller_hinf_grad_continuous, controller_radius_grad, ControllerGradient,
+};
+use super::hinf::{hinf_norm, HinfNorm, HinfParams};
+use crate::lti::error::LtiError;
+use crate::lti::interrupt::Interrupted;
+use crate::lti::kernels::spectral::{abscissa_of, radius_of, spectral_abscissa, spectral_radius};
+use crate::lti::system::controller::Controller;
+use crate::lti::system::plant::Plant;
+use crate::lti::system::state_space::StateSpace;
+use crate::lti::system::time_domain::TimeDomain;
+use faer::{c64, MatRef};
+
+/// The stability measure s(A) of the module docs: α(A), or ρ(A) − 1 in discrete time (−∞ and −1
+/// for a 0×0 matrix; +∞ if the eigenvalues fail).
+pub fn stability_measure(domain: TimeDomain, a: MatRef<'_, f64>) -> f64 {
+    match domain {
+        TimeDomain::Continuous => spectral_abscissa(a),
+        TimeDomain::Discrete { .. } => spectral_radius(a) - 1.0,
+    }
+}
+
+/// The stability measure of a matrix with eigenvalues `poles` (as [`stability_measure`]; the
+/// empty list gives −∞, or −1 in discrete time).
+pub(crate) fn stability_measure_of(domain: TimeDomain, poles: &[c64]) -> f64 {
+    match domain {
+        TimeDomain::Continuous => abscissa_of(poles),
+        TimeDomain::Discrete { .. } => radius_of(poles) - 1.0,
+    }
+}
+
+/// s(Acl) of the closed loop in the plant's domain and its gradient with respect to the
+/// controller (as [`closed_loop_abscissa_grad`]).
+pub fn closed_loop_stability_grad(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
+    match plant.domain {
+        TimeDomain::Continuous => closed_loop_abscissa_grad(plant, k),
+        TimeDomain::Discrete { .. } => closed_loop_radius_grad(plant, k).map(|(rho, g)| (rho - 1.0, g)),
+    }
+}
+
+/// s(Ak) of the controller in its domain and its gradient (as [`controller_abscissa_grad`]).
+pub fn controller_stability_grad(k: &Controller) -> (f64, ControllerGradient) {
+    match k.domain {
+        TimeDomain::Continuous => controller_abscissa_grad(k),
+        TimeDomain::Discrete { .. } => {
+            let (rho, g) = controller_radius_grad(k);
+            (rho - 1.0, g)
+        }
+    }
+}
+
+/// ‖sys‖∞ of a system of the domain `domain`: on the imaginary axis ([`hinf_norm`]) or on the
+/// unit circle ([`hinf_norm_discrete`]; its peak frequency is then in rad/sample,
+/// [`TimeDomain::to_rad_per_s`] turns it into rad/s).
+pub fn hinf_norm_in(domain: TimeDomain, sys: &StateSpace, params: &HinfParams<'_>) -> Result<HinfNorm, Interrupted> {
+    match domain {
+        TimeDomain::Continuous => hinf_norm(sys, params),
+        TimeDomain::Discrete { .. } => hinf_norm_discrete(sys, params),
+    }
+}
+
+/// ‖Tzw‖∞ of the closed loop in the plant's domain (+∞ if the loop is unstable, with a NaN
+/// gradient) and its gradient with respect to (Ak, Bk, Ck, Dk), computed as `params` ask
+/// ([`HinfParams`]: tolerance, peak hints of a nearby controller — in rad/sample in discrete
+/// time —, a stop hook — `Err(LtiError::Interrupted)` once it fires —, a level at which to stop
+/// early — a value at or above `params.enough` is then an attained σmax, a lower bound of the
+/// norm, returned with a NaN gradient —, and a [`ResponseSlot`](crate::lti::ResponseSlot) whose
+/// evaluator of this very closed loop is reused, continuous time only). `Err(IllPosed)` for an
+/// ill-posed loop, `Err(DomainMismatch)` for a controller of another domain. In discrete time
+/// the norm is on the unit circle
+/// ([`closed_loop_hinf_grad_discrete`](crate::lti::closed_loop_hinf_grad_discrete)).
+pub fn closed_loop_hinf_grad(
+    plant: &Plant,
+    k: &Controller,
+    params: &HinfParams<'_>,
+) -> Result<(HinfNorm, ControllerGradient), LtiError> {
+    match plant.domain {
+        TimeDomain::Continuous => closed_loop_hinf_grad_continuous(plant, k, params),
+        TimeDomain::Discrete { .. } => {
+            if k.domain != plant.domain {
+                return Err(LtiError::DomainMismatch { plant: plant.domain, controller: k.domain });
+            }
+            closed_loop_hinf_grad_discrete(plant, k, params)
+        }
+    }
+}
+
+/// ‖K‖∞ of the controller itself in its domain (+∞ if it is not stable; σmax(Dk) for nk = 0)
+/// and its gradient: on the imaginary axis, or on the unit circle
+/// ([`controller_hinf_grad_discrete`](crate::lti::controller_hinf_grad_discrete)).
+pub fn controller_hinf_grad(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
+    match k.domain {
+        TimeDomain::Continuous => controller_hinf_grad_continuous(k, tol),
+        TimeDomain::Discrete { .. } => controller_hinf_grad_discrete(k, tol),
+    }
+}
