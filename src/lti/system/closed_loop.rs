@@ -153,7 +153,8 @@ impl<'p> ClosedLoop<'p> {
     /// Gradient with respect to (Ak, Bk, Ck, Dk) of an f whose closed-loop matrix gradients are
     /// the real matrices `g` = (G_A, G_B, G_C, G_D), shaped as the closed loop's (Acl, Bcl, Ccl,
     /// Dcl): ∂f/∂X = Pᵀ Γ Qᵀ with Γ = L_A C̄ᵀ + L_B D̄21ᵀ and [L_A L_B] = B̄ᵀ [G_A G_B] + D̄12ᵀ
-    /// [G_C G_D] (module docs), for gradients that are not rank-one (the H2 norm's).
+    /// [G_C G_D] (module docs; docs/ALGORITHMS.md §13.3), for gradients that are not rank-one (the
+    /// H2 norm's).
     pub(crate) fn chain_rule_dense(&self, g: &StateSpace) -> Controller {
         let pl = self.plant;
         let (n, nk, m2, p2) = (pl.dims.n, self.nk, pl.dims.m2, pl.dims.p2);
