@@ -28,7 +28,7 @@ use rand_distr::StandardNormal;
 use serde_json::Value;
 
 mod common;
-use common::add_modal_pair;
+use common::{add_modal_pair, json_matrix as mat, json_system};
 
 /// Relative agreement required with the reference values.
 const REL_TOL: f64 = 1e-8;
@@ -48,14 +48,6 @@ fn sigma_at(sys: &StateSpace, theta: f64) -> f64 {
     g.singular_values().unwrap().into_iter().fold(0.0, f64::max)
 }
 
-fn mat(v: &Value, rows: usize, cols: usize) -> Mat<f64> {
-    Mat::from_fn(rows, cols, |i, j| v[i][j].as_f64().unwrap())
-}
-
-fn len(v: &Value) -> usize {
-    v.as_array().unwrap().len()
-}
-
 #[test]
 fn discrete_cases_match_slicot() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/discrete/cases.json");
@@ -68,10 +60,7 @@ fn discrete_cases_match_slicot() {
         let name = case["name"].as_str().unwrap();
         let kind = case["kind"].as_str().unwrap();
         *kinds.entry(kind).or_insert(0) += 1;
-        let (n, p, m) = (len(&case["A"]), len(&case["D"]), len(&case["D"][0]));
-        let sys =
-            StateSpace::new(mat(&case["A"], n, n), mat(&case["B"], n, m), mat(&case["C"], p, n), mat(&case["D"], p, m))
-                .unwrap();
+        let sys = json_system(case);
         let want_rho = case["spectral_radius"].as_f64().unwrap();
         let rho = spectral_radius(sys.a.as_ref());
         let rel_rho = (rho - want_rho).abs() / want_rho;

@@ -1,12 +1,15 @@
 //! Central finite-difference checks of every gradient (α_cl, α_K, ‖Tzw‖∞, ‖K‖∞) at seeded random
 //! points, with D22 = 0 and D22 ≠ 0, nk = 0 and nk > 0; the same in discrete time (ρ_cl, ρ_K and
-//! the norms on the unit circle); plus the ill-posed loop.
+//! the norms on the unit circle); the H2 norm (continuous and discrete, of a system and of the
+//! loop) and 1/r_C(Acl); plus the ill-posed loop.
 
 use faer::Mat;
 use hinfix::lti::{
-    closed_loop, closed_loop_abscissa_grad, closed_loop_hinf_grad, closed_loop_hinf_grad_discrete,
-    closed_loop_radius_grad, controller_abscissa_grad, controller_hinf_grad, controller_hinf_grad_discrete,
-    controller_radius_grad, hinf_norm, hinf_norm_discrete, hinf_norm_grad_discrete, spectral_abscissa, spectral_radius,
+    closed_loop, closed_loop_abscissa_grad, closed_loop_h2_grad, closed_loop_h2_grad_discrete, closed_loop_hinf_grad,
+    closed_loop_hinf_grad_discrete, closed_loop_inverse_stability_radius_grad, closed_loop_radius_grad,
+    controller_abscissa_grad, controller_hinf_grad, controller_hinf_grad_discrete, controller_radius_grad,
+    h2_feedthrough_parameterisation, h2_norm, h2_norm_discrete, h2_norm_grad, h2_norm_grad_discrete, hinf_norm,
+    hinf_norm_discrete, hinf_norm_grad_discrete, inverse_stability_radius, spectral_abscissa, spectral_radius,
     Controller, Dims, HinfParams, LtiError, Plant, StateSpace,
 };
 use rand::{Rng, SeedableRng};
@@ -83,9 +86,11 @@ fn block(k: &Controller, b: usize) -> &Mat<f64> {
     [&k.ak, &k.bk, &k.ck, &k.dk][b]
 }
 
-/// Compares an analytic gradient with central differences of `f`.
-fn check_fd(label: &str, k: &Controller, g: &Controller, mut f: impl FnMut(&Controller) -> f64) {
+/// Compares an analytic gradient with central differences of `f`; returns the largest
+/// |fd − g| / max(1, ‖g‖∞).
+fn check_fd(label: &str, k: &Controller, g: &Controller, mut f: impl FnMut(&Controller) -> f64) -> f64 {
     let gmax = entries(k).iter().map(|&(b, i, j)| block(g, b)[(i, j)].abs()).fold(1.0, f64::max);
+    let mut worst = 0.0f64;
     for (b, i, j) in entries(k) {
         let mut kp = k.clone();
         block_mut(&mut kp, b)[(i, j)] += H;
@@ -97,7 +102,9 @@ fn check_fd(label: &str, k: &Controller, g: &Controller, mut f: impl FnMut(&Cont
             (fd - an).abs() <= FD_REL * gmax,
             "{label}: block {b} entry ({i},{j}): finite difference {fd} vs gradient {an} (scale {gmax})"
         );
+        worst = worst.max((fd - an).abs() / gmax);
     }
+    worst
 }
 
 #[test]
@@ -201,6 +208,127 @@ fn discrete_time_gradients_match_finite_differences() {
         assert_eq!((gs.a, gs.b, gs.c, gs.d), (g.ak, g.bk, g.ck, g.dk), "{label}");
     }
     assert!(checked_hinf >= 6, "too few stable random discrete loops ({checked_hinf})");
+}
+
+/// The continuous H2 norm of strictly proper loops (D22 = 0: D11 = D12·X·D21, D12 of deficient
+/// rank where m2 > 1, and Dk on the affine set of `h2_feedthrough_parameterisation`; D22 ≠ 0:
+/// D11 = 0, D21 = 0), its chain rule checked
+/// on all of (Ak, Bk, Ck, Dk) against the strictly proper part's norm and along the affine set
+/// against the loop's own value; 1/r_C(Acl); and the discrete H2 norm of the same plants with A
+/// and Ak scaled into the unit disc (any feedthrough).
+#[test]
+fn h2_and_stability_radius_gradients_match_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(20261207);
+    let params = HinfParams::new(FD_HINF_TOL);
+    let (mut checked_h2, mut checked_affine, mut checked_radius) = (0, 0, 0);
+    let mut worst = [0.0f64; 4]; // ‖Tzw‖₂, along z, 1/r_C, discrete ‖Tzw‖₂
+    for case in 0..12 {
+        let d22 = case % 2 == 1;
+        let nk = [0, 1, 2, 3][case / 3 % 4];
+        let (n, m1, m2, p1, p2) = [(4, 2, 1, 2, 1), (5, 2, 2, 3, 2), (6, 1, 2, 2, 3)][case % 3];
+        let mut plant = random_plant(&mut rng, n, m1, m2, p1, p2, d22);
+        let mut k = random_controller(&mut rng, nk, m2, p2);
+        let label = format!("case {case} (n={n}, nk={nk}, D22≠0: {d22})");
+        let affine = if d22 {
+            plant.d11 = Mat::zeros(p1, m1);
+            plant.d21 = Mat::zeros(p2, m1);
+            None
+        } else {
+            if m2 > 1 {
+                plant.d12.col_mut(m2 - 1).fill(0.0); // rank D12 < m2: free parameters
+            }
+            plant.d11 = &plant.d12 * randn(&mut rng, m2, p2, 1.0) * &plant.d21;
+            let aff = h2_feedthrough_parameterisation(&plant).unwrap();
+            let z: Vec<f64> = (0..aff.dim()).map(|_| 0.3 * rng.sample::<f64, _>(StandardNormal)).collect();
+            k.dk = aff.dk(&z).unwrap();
+            Some((aff, z))
+        };
+        let strictly_proper = |kk: &Controller| {
+            let cl = closed_loop(&plant, kk).unwrap();
+            h2_norm(&StateSpace { d: Mat::zeros(cl.d.nrows(), cl.d.ncols()), ..cl })
+        };
+        let (h2, g) = closed_loop_h2_grad(&plant, &k).unwrap();
+        if spectral_abscissa(closed_loop(&plant, &k).unwrap().a.as_ref()) < 0.0 {
+            assert!(h2.is_finite() && (h2 - strictly_proper(&k)).abs() <= 1e-14 * h2, "{label}: ‖Tzw‖₂ {h2}");
+            worst[0] = worst[0].max(check_fd(&format!("{label} ‖Tzw‖₂"), &k, &g, strictly_proper));
+            checked_h2 += 1;
+            // Along the affine set the loop's own value (its feedthrough test included) is finite,
+            // and ∂f/∂zᵢ = ⟨Eᵢ, ∂f/∂Dk⟩.
+            if let Some((aff, z)) = affine.filter(|(aff, _)| aff.dim() > 0) {
+                let dz = aff.components(g.dk.as_ref()).unwrap();
+                for (i, &dzi) in dz.iter().enumerate() {
+                    let at = |t: f64| {
+                        let mut zz = z.clone();
+                        zz[i] += t;
+                        let kk = Controller { dk: aff.dk(&zz).unwrap(), ..k.clone() };
+                        closed_loop_h2_grad(&plant, &kk).unwrap().0
+                    };
+                    let fd = (at(H) - at(-H)) / (2.0 * H);
+                    assert!((fd - dzi).abs() <= FD_REL * dzi.abs().max(1.0), "{label}: ∂/∂z{i}: {fd} vs {dzi}");
+                    worst[1] = worst[1].max((fd - dzi).abs() / dzi.abs().max(1.0));
+                }
+                checked_affine += 1;
+            }
+        } else {
+            assert_eq!(h2, f64::INFINITY, "{label}");
+            assert!(g.dk[(0, 0)].is_nan());
+        }
+        let (r, g) = closed_loop_inverse_stability_radius_grad(&plant, &k, &params).unwrap();
+        if r.value.is_finite() {
+            let err = check_fd(&format!("{label} 1/r_C (peak ω = {})", r.peak_freq), &k, &g, |kk| {
+                inverse_stability_radius(closed_loop(&plant, kk).unwrap().a.as_ref(), &params).unwrap().value
+            });
+            worst[2] = worst[2].max(err);
+            checked_radius += 1;
+        }
+
+        let sign = if case % 4 < 2 { 1.0 } else { -1.0 };
+        plant.a = schur(&plant.a, 0.5, sign);
+        if nk > 0 {
+            k.ak = schur(&k.ak, 0.7, -sign);
+        }
+        let (h2, g) = closed_loop_h2_grad_discrete(&plant, &k).unwrap();
+        if spectral_radius(closed_loop(&plant, &k).unwrap().a.as_ref()) < 1.0 {
+            let err = check_fd(&format!("{label} discrete ‖Tzw‖₂ = {h2}"), &k, &g, |kk| {
+                h2_norm_discrete(&closed_loop(&plant, kk).unwrap())
+            });
+            worst[3] = worst[3].max(err);
+        } else {
+            assert_eq!(h2, f64::INFINITY, "{label}");
+        }
+    }
+    eprintln!(
+        "checked {checked_h2} H2 loops ({checked_affine} along z), {checked_radius} 1/r_C: worst |fd − g|/max(1, ‖g‖∞) \
+         ‖Tzw‖₂ {:.1e}, along z {:.1e}, 1/r_C {:.1e}, discrete ‖Tzw‖₂ {:.1e}",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+    assert!(checked_h2 >= 6 && checked_radius >= 6, "too few stable random loops ({checked_h2}, {checked_radius})");
+    assert!(checked_affine >= 2, "too few loops with free feedthrough parameters ({checked_affine})");
+}
+
+/// The H2 norm's gradient with respect to a system's own (A, B, C, D), continuous (D = 0, whose
+/// block is zero: the norm is +∞ off it) and discrete, through the controller-shaped check.
+#[test]
+fn system_h2_gradients_match_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(20261208);
+    let as_controller = |s: StateSpace| Controller::continuous(s.a, s.b, s.c, s.d);
+    let as_system = |k: &Controller| StateSpace { a: k.ak.clone(), b: k.bk.clone(), c: k.ck.clone(), d: k.dk.clone() };
+    for (n, m, p) in [(1, 1, 1), (3, 2, 1), (6, 2, 3), (12, 1, 2)] {
+        let plant = random_plant(&mut rng, n, m, 0, p, 0, false);
+        let sys = StateSpace { a: plant.a.clone(), b: plant.b1.clone(), c: plant.c1.clone(), d: Mat::zeros(p, m) };
+        let (h2, g) = h2_norm_grad(&sys);
+        assert!(h2.is_finite() && h2 == h2_norm(&sys));
+        let strictly_proper = |kk: &Controller| h2_norm(&StateSpace { d: Mat::zeros(p, m), ..as_system(kk) });
+        let err = check_fd(&format!("n={n} ‖G‖₂"), &as_controller(sys.clone()), &as_controller(g), strictly_proper);
+        let dsys = StateSpace { a: schur(&sys.a, 0.8, -1.0), d: randn(&mut rng, p, m, 1.0), ..sys };
+        let (h2, g) = h2_norm_grad_discrete(&dsys);
+        assert!(h2.is_finite() && h2 == h2_norm_discrete(&dsys));
+        let derr =
+            check_fd(&format!("n={n} discrete ‖G‖₂"), &as_controller(dsys.clone()), &as_controller(g), |kk| {
+                h2_norm_discrete(&as_system(kk))
+            });
+        eprintln!("n={n}: worst |fd − g|/max(1, ‖g‖∞) ‖G‖₂ {err:.1e}, discrete {derr:.1e}");
+    }
 }
 
 /// From closed-loop order 30 on, the H∞ gradient's vectors come from the norm's Hessenberg form

@@ -1,6 +1,7 @@
 //! Linear time-invariant systems: plants, controllers, closed loops, spectral abscissa, the H∞
-//! norm, their gradients with respect to the controller, and the full-order H∞ bound; in
-//! discrete time the spectral radius and the H∞ norm on the unit circle with their gradients.
+//! and H2 norms, the complex stability radius, their gradients with respect to the controller,
+//! and the full-order H∞ bound; in discrete time the spectral radius and the H∞ and H2 norms on
+//! the unit circle with their gradients.
 //!
 //! The parts, each in its folder, from the bottom up (a part imports only parts below it,
 //! `tests/module_graph.rs`; docs/ARCHITECTURE.md §1):
@@ -10,7 +11,8 @@
 //!   library, controller export as code;
 //! * `kernels/`: eigenvalues, the Hessenberg QR, the frequency response, the Hamiltonian level
 //!   sets, Lyapunov and Riccati equations;
-//! * `norms/`: the H∞ norm and the gradients (hand-written: no Rust crate offers them);
+//! * `norms/`: the H∞ and H2 norms, the stability radius and the gradients (hand-written: no
+//!   Rust crate offers them);
 //! * `synthesis/`: the full-order γ_opt, the central controller, balanced truncation.
 //!
 //! `error.rs` ([`LtiError`]) and `interrupt.rs` ([`Interrupt`]) are shared by all parts. Linear
@@ -59,6 +61,10 @@ pub use norms::gradient::{
     closed_loop_abscissa_grad, closed_loop_radius_grad, controller_abscissa_grad, controller_radius_grad,
     ControllerGradient,
 };
+pub use norms::h2::{
+    closed_loop_h2_grad, closed_loop_h2_grad_discrete, h2_feedthrough_parameterisation, h2_norm, h2_norm_discrete,
+    h2_norm_grad, h2_norm_grad_discrete, DkAffine, FeedthroughError, H2_FEEDTHROUGH_RTOL,
+};
 pub(crate) use norms::hinf::hinf_norm_with_poles;
 pub use norms::hinf::{
     hinf_lower_bound, hinf_lower_bound_sharing, hinf_norm, HinfNorm, HinfParams, DEFAULT_HINF_TOL,
@@ -68,6 +74,7 @@ pub use norms::sigma::{
     frequency_band, near_peak_frequencies, sigma_curve, NORM_TIE_RTOL, SIGMA_BASE_POINTS, SIGMA_MAX_POINTS,
     SIGMA_STEP_RTOL,
 };
+pub use norms::stability_radius::{closed_loop_inverse_stability_radius_grad, inverse_stability_radius};
 pub use synthesis::balanced_truncation::{
     balanced_truncation, balanced_truncation_stable, coprime_factor_truncation, dc_gain, hankel_singular_values,
     Reduced, ReductionError, HSV_RTOL,

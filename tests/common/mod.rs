@@ -248,3 +248,16 @@ pub fn add_modal_pair(
         }
     }
 }
+
+/// A matrix of a JSON fixture: an array of `rows` rows of `cols` numbers.
+pub fn json_matrix(v: &serde_json::Value, rows: usize, cols: usize) -> faer::Mat<f64> {
+    faer::Mat::from_fn(rows, cols, |i, j| v[i][j].as_f64().unwrap())
+}
+
+/// The system (A, B, C, D) of a fixture case with those four JSON matrices (shapes from A and D).
+pub fn json_system(case: &serde_json::Value) -> hinfix::lti::StateSpace {
+    let len = |v: &serde_json::Value| v.as_array().unwrap().len();
+    let (n, p, m) = (len(&case["A"]), len(&case["D"]), len(&case["D"][0]));
+    let mat = |k: &str, r, c| json_matrix(&case[k], r, c);
+    hinfix::lti::StateSpace::new(mat("A", n, n), mat("B", n, m), mat("C", p, n), mat("D", p, m)).unwrap()
+}

@@ -130,8 +130,18 @@ pub(crate) fn closed_loop_grad_from(
     k: &Controller,
     peak: Option<(HinfNorm, Option<PeakVectors>)>,
 ) -> (HinfNorm, ControllerGradient) {
+    grad_at_peak(k, peak, |pv| cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v))))
+}
+
+/// The norm and the gradient `chain` makes of the vectors at its peak; NaN gradients without
+/// vectors (a value at or above `params.enough`), +∞ for `None` (unstable).
+pub(crate) fn grad_at_peak(
+    k: &Controller,
+    peak: Option<(HinfNorm, Option<PeakVectors>)>,
+    chain: impl FnOnce(&PeakVectors) -> Controller,
+) -> (HinfNorm, ControllerGradient) {
     match peak {
-        Some((norm, Some(pv))) => (norm, cl.chain_rule(&pv.a, &pv.b, Some((&pv.u, &pv.v)))),
+        Some((norm, Some(pv))) => (norm, chain(&pv)),
         Some((norm, None)) => (norm, nan_like(k)),
         None => (HinfNorm::UNSTABLE, nan_like(k)),
     }

@@ -27,9 +27,11 @@
 //! ∂f/∂X = Pᵀ Γ Qᵀ,   Γ = [B̄ᵀ D̄12ᵀ] [G_A G_B; G_C G_D] [C̄ᵀ; D̄21ᵀ],
 //! ```
 //!
-//! whose blocks for D22 = 0 (P = Q = I) are HIFOO's four formulas. Every gradient this
-//! crate needs is a rank-one complex outer product (α: ū vᵀ/(uᴴv); ‖·‖∞: ā bᵀ etc.), so Γ is
-//! assembled from two short vectors instead of (n+nk)² matrices ([`ClosedLoop::chain_rule`]).
+//! whose blocks for D22 = 0 (P = Q = I) are HIFOO's four formulas. The gradients of α and ‖·‖∞
+//! are rank-one complex outer products (α: ū vᵀ/(uᴴv); ‖·‖∞: ā bᵀ etc.), so Γ is assembled
+//! from two short vectors instead of (n+nk)² matrices ([`ClosedLoop::chain_rule`]); the H2
+//! norm's gradients are full matrices (2QP, 2QB, 2CP, docs/ALGORITHMS.md §13.1) and take
+//! [`ClosedLoop::chain_rule_dense`], the same formula on matrices.
 
 use faer::linalg::solvers::DenseSolveCore;
 use faer::{c64, Mat, MatRef};
@@ -151,6 +153,38 @@ impl<'p> ClosedLoop<'p> {
             outer(&l[nk..], &r[..nk]),
             outer(&l[nk..], &r[nk..]),
         )
+    }
+
+    /// Gradient with respect to (Ak, Bk, Ck, Dk) of an f whose closed-loop matrix gradients are
+    /// the real matrices `g` = (G_A, G_B, G_C, G_D), shaped as the closed loop's (Acl, Bcl, Ccl,
+    /// Dcl): ∂f/∂X = Pᵀ Γ Qᵀ with Γ = L_A C̄ᵀ + L_B D̄21ᵀ and [L_A L_B] = B̄ᵀ [G_A G_B] + D̄12ᵀ
+    /// [G_C G_D] (module docs; docs/ALGORITHMS.md §13.3), for gradients that are not rank-one (the
+    /// H2 norm's).
+    pub(crate) fn chain_rule_dense(&self, g: &StateSpace) -> Controller {
+        let pl = self.plant;
+        let (n, nk, m2, p2) = (pl.dims.n, self.nk, pl.dims.m2, pl.dims.p2);
+        // B̄ᵀ M = [M₂; B2ᵀ M₁] (M₁ the plant's n rows, M₂ the controller's nk rows).
+        let lift = |gx: &Mat<f64>, gy: &Mat<f64>| {
+            let mut l = Mat::<f64>::zeros(nk + m2, gx.ncols());
+            l.as_mut().subrows_mut(0, nk).copy_from(gx.as_ref().subrows(n, nk));
+            l.as_mut()
+                .subrows_mut(nk, m2)
+                .copy_from(pl.b2.transpose() * gx.as_ref().subrows(0, n) + pl.d12.transpose() * gy);
+            l
+        };
+        let (la, lb) = (lift(&g.a, &g.c), lift(&g.b, &g.d));
+        // M C̄ᵀ = [M₂, M₁ C2ᵀ] and N D̄21ᵀ = [0, N D21ᵀ] (columns: the controller's nk, then p2).
+        let mut gamma = Mat::<f64>::zeros(nk + m2, nk + p2);
+        gamma.as_mut().subcols_mut(0, nk).copy_from(la.as_ref().subcols(n, nk));
+        gamma
+            .as_mut()
+            .subcols_mut(nk, p2)
+            .copy_from(la.as_ref().subcols(0, n) * pl.c2.transpose() + &lb * pl.d21.transpose());
+        if let Some((pm, qm)) = &self.pq {
+            gamma = pm.transpose() * &gamma * qm.transpose();
+        }
+        let block = |i: usize, j: usize, r: usize, c: usize| gamma.as_ref().submatrix(i, j, r, c).to_owned();
+        Controller::continuous(block(0, 0, nk, nk), block(0, nk, nk, p2), block(nk, 0, m2, nk), block(nk, nk, m2, p2))
     }
 }
 
