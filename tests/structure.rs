@@ -219,3 +219,19 @@ fn no_structure_and_all_free_are_the_unstructured_design() {
         }
     }
 }
+
+/// The worked examples of docs/ALGORITHMS.md §1.1 parse with the shapes they are written for.
+#[test]
+fn the_documented_examples_parse() {
+    use hinfix::lti::TimeDomain;
+    let shape = |nk, m, p| ControllerShape { nk, m, p, domain: TimeDomain::Continuous };
+    let pid = r#"{"AK": [[0.0, 0.0], [0.0, -10.0]], "BK": [[1.0], [1.0]], "CK": [[null, null]], "DK": [[null]]}"#;
+    let dec = r#"{"AK": [[null, 0.0], [0.0, null]], "BK": [[null, 0.0], [0.0, null]],
+       "CK": [[null, 0.0], [0.0, null]], "DK": [[null, 0.0], [0.0, null]]}"#;
+    let stat = r#"{"DK": [[null, 0.0, null], [0.0, null, 0.0]]}"#;
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/ALGORITHMS.md")).unwrap();
+    for (text, sh, nfree) in [(pid, shape(2, 1, 1), 3), (dec, shape(2, 2, 2), 8), (stat, shape(0, 2, 3), 3)] {
+        assert!(docs.contains(text.lines().next().unwrap().trim()), "not in the docs: {text}");
+        assert_eq!(Structure::from_json(text, "doc", sh).unwrap().nfree(), nfree, "{text}");
+    }
+}
