@@ -235,3 +235,40 @@ fn the_documented_examples_parse() {
         assert_eq!(Structure::from_json(text, "doc", sh).unwrap().nfree(), nfree, "{text}");
     }
 }
+
+/// `campaign design --structure`: a JSON and a .mat structure give controller files whose fixed
+/// entries are their values; a bad file is an error naming the file and the block.
+#[test]
+fn the_cli_designs_with_a_structure_file() {
+    use hinfix::lti::write_mat;
+    let bin = env!("CARGO_BIN_EXE_campaign");
+    let p = plant("HE1"); // m2 = 2, p2 = 1
+    let shape = ControllerShape::for_plant(&p, 0);
+    let json = temp_file("cli.json", r#"{"DK": [[null], [0.0]]}"#);
+    let dk = faer::Mat::from_fn(2, 1, |i, _| if i == 0 { f64::NAN } else { 0.0 });
+    let mat = temp_file("cli.mat", "");
+    std::fs::write(&mat, write_mat(&[("DK", dk.as_ref())], "structure")).unwrap();
+    for s_path in [&json, &mat] {
+        let out = s_path.with_extension("K.json");
+        let run = std::process::Command::new(bin)
+            .args(["design", "--plant", "HE1", "--order", "0", "--maxevals", "300", "--structure"])
+            .arg(s_path)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let k = Controller::load(&out).unwrap();
+        let s = Structure::load(s_path, shape).unwrap();
+        assert_fixed_kept(&s, &k);
+    }
+    let bad = temp_file("cli-bad.json", r#"{"DK": [[null, 1.0], [0.0]]}"#);
+    let run = std::process::Command::new(bin)
+        .args(["design", "--plant", "HE1", "--order", "0", "--maxevals", "300", "--structure"])
+        .arg(&bad)
+        .args(["--out", "/tmp/hinfix-structure-never-written.json"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && err.contains("cli-bad.json") && err.contains("block DK"), "{err}");
+}

@@ -23,6 +23,7 @@
 //! `{"AK": [[null, 0.0], …], "BK": …, "CK": …, "DK": …}` in which `null` is a free entry and a
 //! number an entry fixed at that value (bit for bit in the result); each block given has the
 //! shape of --order, a block left out is free, and a structure with no free entry is an error.
+//! A `.mat` file with variables AK, BK, CK, DK is read the same way, NaN = free.
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -154,6 +155,7 @@ pub struct DesignArgs {
     pub init: Option<PathBuf>,
     /// Controller structure, JSON {"AK": [[null, 0.0], …], "BK": …, "CK": …, "DK": …}: null = free,
     /// a number = fixed at that value; blocks of the shapes of --order, a block left out is free.
+    /// Or a .mat file with variables AK BK CK DK, NaN = free.
     /// Initial, open-loop and central starts are projected onto it (fixed entries overwritten).
     #[arg(long, value_name = "S.json")]
     pub structure: Option<PathBuf>,

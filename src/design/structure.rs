@@ -13,13 +13,14 @@
 //! File format (JSON): `{"AK": [[null, 0.0], …], "BK": …, "CK": …, "DK": …}`, rows of entries,
 //! `null` = free, a number = fixed at that value. Each block given must have the shape of the
 //! order designed (nk×nk, nk×p2, m2×nk, m2×p2); a block left out is entirely free (so an
-//! order-0 structure may give only `DK`). Any other key is an error.
+//! order-0 structure may give only `DK`). Any other key is an error. A MATLAB .mat file with
+//! variables AK, BK, CK, DK is read the same way, NaN = free.
 
 use std::path::Path;
 
 use serde_json::Value;
 
-use crate::lti::Controller;
+use crate::lti::{is_mat_path, read_mat_vars, Controller};
 
 use super::params::{controller_to_x, ControllerShape};
 
@@ -174,9 +175,12 @@ impl Structure {
     /// Reads a structure file (module docs) for controllers of `shape`.
     pub fn load(path: &Path, shape: ControllerShape) -> Result<Self, StructureError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| StructureError::Io { file: file.clone(), message: e.to_string() })?;
-        let s = Self::from_json(&text, &file, shape)?;
+        let io = |e: std::io::Error| StructureError::Io { file: file.clone(), message: e.to_string() };
+        let s = if is_mat_path(path) {
+            Self::from_mat_bytes(&std::fs::read(path).map_err(io)?, &file, shape)?
+        } else {
+            Self::from_json(&std::fs::read_to_string(path).map_err(io)?, &file, shape)?
+        };
         if s.nfree() == 0 {
             return Err(StructureError::NothingFree { file });
         }
@@ -188,6 +192,53 @@ impl Structure {
     pub fn from_json(text: &str, file: &str, shape: ControllerShape) -> Result<Self, StructureError> {
         let syntax = |message: String| StructureError::Syntax { file: file.into(), message };
         let v: Value = serde_json::from_str(text).map_err(|e| syntax(format!("not valid JSON: {e}")))?;
+        Self::from_value(v, file, shape)
+    }
+
+    /// Parses a MATLAB level-5 .mat file (`bytes`) with variables AK, BK, CK, DK (any of them;
+    /// a variable left out is free): NaN = free, a finite number = fixed; `file` names it in
+    /// errors. An empty variable (`[]`) stands for a block with no entries.
+    pub fn from_mat_bytes(bytes: &[u8], file: &str, shape: ControllerShape) -> Result<Self, StructureError> {
+        let vars =
+            read_mat_vars(bytes).map_err(|e| StructureError::Syntax { file: file.into(), message: e.to_string() })?;
+        let dims = block_dims(shape);
+        let mut map = serde_json::Map::new();
+        for (name, v) in vars {
+            let Some(b) = BLOCKS.iter().position(|&k| k == name) else {
+                return Err(StructureError::UnknownKey { file: file.into(), key: name });
+            };
+            if v.is_empty() && dims[b].0 * dims[b].1 == 0 {
+                continue;
+            }
+            let mut rows = Vec::with_capacity(v.rows);
+            for i in 0..v.rows {
+                let mut row = Vec::with_capacity(v.cols);
+                for j in 0..v.cols {
+                    let x = v.data[i + j * v.rows];
+                    row.push(match serde_json::Number::from_f64(x) {
+                        _ if x.is_nan() => Value::Null,
+                        Some(n) => Value::Number(n),
+                        None => {
+                            return Err(StructureError::NonFinite {
+                                file: file.into(),
+                                block: BLOCKS[b],
+                                row: i + 1,
+                                col: j + 1,
+                                value: x,
+                            })
+                        }
+                    });
+                }
+                rows.push(Value::Array(row));
+            }
+            map.insert(name, Value::Array(rows));
+        }
+        Self::from_value(Value::Object(map), file, shape)
+    }
+
+    /// The structure of a parsed JSON value (module docs).
+    fn from_value(v: Value, file: &str, shape: ControllerShape) -> Result<Self, StructureError> {
+        let syntax = |message: String| StructureError::Syntax { file: file.into(), message };
         let Value::Object(map) = v else {
             return Err(syntax("must be a JSON object with keys AK, BK, CK, DK".into()));
         };
@@ -348,6 +399,24 @@ mod tests {
         assert_eq!(Structure::locate(shape(2, 1, 1), 5), ("BK", 1, 0));
         assert_eq!(Structure::locate(shape(2, 1, 1), 7), ("CK", 0, 1));
         assert_eq!(Structure::locate(shape(0, 1, 1), 0), ("DK", 0, 0));
+    }
+
+    #[test]
+    fn a_mat_file_uses_nan_for_free() {
+        use crate::lti::write_mat;
+        let sh = shape(1, 1, 2);
+        let ak = faer::Mat::from_fn(1, 1, |_, _| -1.0);
+        let dk = faer::Mat::from_fn(1, 2, |_, j| if j == 0 { f64::NAN } else { 0.0 });
+        let bytes = write_mat(&[("AK", ak.as_ref()), ("DK", dk.as_ref())], "structure");
+        let s = Structure::from_mat_bytes(&bytes, "s.mat", sh).unwrap();
+        // x = [Ak | Bk11 Bk12 | Ck | Dk11 Dk12]
+        assert_eq!(s.entries(), &[Some(-1.0), None, None, None, None, Some(0.0)]);
+        let bad = write_mat(&[("EK", ak.as_ref())], "structure");
+        assert!(Structure::from_mat_bytes(&bad, "s.mat", sh).unwrap_err().to_string().contains("unknown key \"EK\""));
+        let inf = faer::Mat::from_fn(1, 1, |_, _| f64::INFINITY);
+        let bytes = write_mat(&[("AK", inf.as_ref())], "structure");
+        let msg = Structure::from_mat_bytes(&bytes, "s.mat", sh).unwrap_err().to_string();
+        assert!(msg.contains("block AK entry (1, 1)") && msg.contains("not finite"), "{msg}");
     }
 
     #[test]
