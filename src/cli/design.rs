@@ -2,7 +2,7 @@
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--stop-on-stall] [--max-starts N] [--hop-scales 0.01,0.1,1]
 //! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start] [--no-continue-at-maxit]
 //! [--continued-maxit 3000] [--keep-gs-reserve]
-//! [--variable-scaling off|alternate|always] [--init K.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
+//! [--variable-scaling off|alternate|always] [--init K.json] [--structure S.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
 //! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
 //!
@@ -18,12 +18,19 @@
 //! still written if it stabilises). `--out` is checked (not a directory, writable, with a
 //! probe file of a unique name, so that concurrent runs writing one file do not trip) before
 //! the design starts.
+//!
+//! `--structure S.json` designs a structured controller (docs/ALGORITHMS.md §1.1): a JSON object
+//! `{"AK": [[null, 0.0], …], "BK": …, "CK": …, "DK": …}` in which `null` is a free entry and a
+//! number an entry fixed at that value (bit for bit in the result); each block given has the
+//! shape of --order, a block left out is free, and a structure with no free entry is an error.
+//! A `.mat` file with variables AK, BK, CK, DK is read the same way, NaN = free.
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::design::{
-    run_with_control, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind, VariableScaling,
+    run_with_structure, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind,
+    Structure, VariableScaling,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
@@ -146,6 +153,12 @@ pub struct DesignArgs {
     /// Initial controller, JSON or .mat (order ≤ --order; a lower order is padded with stable modes).
     #[arg(long)]
     pub init: Option<PathBuf>,
+    /// Controller structure, JSON {"AK": [[null, 0.0], …], "BK": …, "CK": …, "DK": …}: null = free,
+    /// a number = fixed at that value; blocks of the shapes of --order, a block left out is free.
+    /// Or a .mat file with variables AK BK CK DK, NaN = free.
+    /// Initial, open-loop and central starts are projected onto it (fixed entries overwritten).
+    #[arg(long, value_name = "S.json")]
+    pub structure: Option<PathBuf>,
     /// Plain fixed-order H∞: do not require a stable controller.
     #[arg(long)]
     pub no_strong: bool,
@@ -204,10 +217,16 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         eprintln!("error: {} (order {}, strong objective): {e}", for_terminal(&plant.name), a.order);
         return Ok(ExitCode::from(EXIT_NOT_STABILISED));
     }
+    let structure = match &a.structure {
+        Some(path) => {
+            Some(Structure::load(path, ControllerShape::for_plant(&plant, opts.order)).context("--structure")?)
+        }
+        None => None,
+    };
     check_writable(&a.out).with_context(|| format!("--out {}", a.out.display()))?;
     let cancel = signals::install();
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
-    let outcome = run_with_control(&plant, &opts, init.as_ref(), &ctl, &mut NoDesignObserver)
+    let outcome = run_with_structure(&plant, &opts, init.as_ref(), structure.as_ref(), &ctl, &mut NoDesignObserver)
         .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
     let good = stabilising(&plant, &opts, &outcome);
     // A stabilising result has a finite γ; NaN or ∞ would be a failed computation called success.

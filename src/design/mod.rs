@@ -7,6 +7,7 @@
 //! * `objective`: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
 //!   observer adapter;
 //! * `phases`: the optimiser options of the two phases;
+//! * `structure`: structured controllers (entries of Ak, Bk, Ck, Dk fixed at values);
 //! * `scaling`: plant-scaled controller variables x = d ∘ x̃ for the search;
 //! * `search`: the multi-start search (local searches until a budget or the stall rule, basin
 //!   hopping, gradient sampling on the best point);
@@ -24,6 +25,7 @@ mod run;
 pub(crate) mod scaling;
 mod search;
 pub(crate) mod starts;
+mod structure;
 
 pub use central_start::{central_starts, reduce as reduce_controller, CENTRAL_MAX_STATES, CENTRAL_REGULARISATIONS};
 pub use float_serde::{f64_from_json, f64_text, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
@@ -42,6 +44,7 @@ pub use outcome::{
     NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary, StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
-pub use run::{run, run_with_control, strongly_stabilisable, validate};
+pub use run::{run, run_with_control, run_with_structure, strongly_stabilisable, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};
+pub use structure::{Structure, StructureError};

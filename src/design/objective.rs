@@ -48,6 +48,7 @@ use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind}
 
 use super::outcome::{DesignIterRecord, DesignObserver, Phase};
 use super::params::ControllerShape;
+use super::structure::Structure;
 
 /// Number of recently evaluated points whose components are kept for the observer.
 pub const COMPONENT_CACHE_LEN: usize = 32;
@@ -158,6 +159,9 @@ pub struct DesignObjective<'p> {
     /// Variable scaling d: the objective's x is x̃ with controller parameters d ∘ x̃
     /// (`design::scaling`); `None`: x are the parameters.
     scaling: Option<Rc<[f64]>>,
+    /// A controller structure (`design::structure`): the objective's x (after scaling) holds only
+    /// the free entries; `None`: x is the whole parameter vector.
+    structure: Option<Rc<Structure>>,
 }
 
 impl<'p> DesignObjective<'p> {
@@ -188,22 +192,34 @@ impl<'p> DesignObjective<'p> {
             reject_at: Cell::new(f64::INFINITY),
             on_eval_cpu: None,
             scaling: None,
+            structure: None,
         }
+    }
+
+    /// Takes x (after scaling) as the free entries of `structure` (`design::structure`): the
+    /// controller is the structure's template with them in place, the gradient ∇ₓ restricted to
+    /// them. `None`: x is the whole parameter vector. Set it before [`Self::with_scaling`].
+    pub fn with_structure(mut self, structure: Option<Rc<Structure>>) -> Self {
+        assert!(structure.as_ref().is_none_or(|s| s.fits(self.shape)), "structure does not fit the shape");
+        self.structure = structure;
+        self
     }
 
     /// Takes x as scaled variables x̃ with controller parameters d ∘ x̃ (`design::scaling`);
     /// gradients are then with respect to x̃ (d ∘ ∇ₓ). `None`: unscaled.
     pub fn with_scaling(mut self, d: Option<Rc<[f64]>>) -> Self {
-        assert!(d.as_ref().is_none_or(|d| d.len() == self.shape.nvar()), "scaling length must be nvar");
+        assert!(d.as_ref().is_none_or(|d| d.len() == Objective::nvar(&self)), "scaling length must be nvar");
         self.scaling = d;
         self
     }
 
     /// The controller at the objective's variables `x` (scaled if [`Self::with_scaling`]).
     fn controller(&self, x: &[f64]) -> Controller {
-        match &self.scaling {
-            Some(d) => self.shape.controller(&super::scaling::from_scaled(x, Some(d))),
-            None => self.shape.controller(x),
+        match (&self.scaling, &self.structure) {
+            (Some(d), None) => self.shape.controller(&super::scaling::from_scaled(x, Some(d))),
+            (None, None) => self.shape.controller(x),
+            (Some(d), Some(s)) => s.controller(self.shape, &super::scaling::from_scaled(x, Some(d))),
+            (None, Some(s)) => s.controller(self.shape, x),
         }
     }
 
@@ -228,6 +244,7 @@ impl<'p> DesignObjective<'p> {
         DesignObjective::new(o.plant, o.shape, o.phase, o.strong, o.eps, o.hinf_tol, o.cache())
             .with_interrupt(o.stop.clone())
             .with_eval_cpu_report(o.on_eval_cpu.clone())
+            .with_structure(o.structure.clone())
             .with_scaling(o.scaling.clone())
     }
 
@@ -359,7 +376,14 @@ impl DesignObjective<'_> {
         self.reject_at.set(f64::INFINITY);
         match grad {
             Some(gk) if c.f.is_finite() => {
-                self.shape.write_x(&gk, g);
+                match &self.structure {
+                    None => self.shape.write_x(&gk, g),
+                    Some(s) => {
+                        let mut full = vec![0.0; self.shape.nvar()];
+                        self.shape.write_x(&gk, &mut full);
+                        g.copy_from_slice(&s.restrict(&full));
+                    }
+                }
                 if let Some(d) = &self.scaling {
                     g.iter_mut().zip(d.iter()).for_each(|(v, s)| *v *= s);
                 }
@@ -419,7 +443,7 @@ fn scale(mut g: ControllerGradient, s: f64) -> ControllerGradient {
 
 impl Objective for DesignObjective<'_> {
     fn nvar(&self) -> usize {
-        self.shape.nvar()
+        self.structure.as_ref().map_or(self.shape.nvar(), |s| s.nfree())
     }
 
     fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {

@@ -25,6 +25,7 @@ use super::params::{controller_to_x, ControllerShape};
 use super::scaling::variable_scaling;
 use super::search::{ScaledObjectives, Search};
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
+use super::structure::Structure;
 
 /// Designs a controller of order `opts.order` for `plant` (HIFOO, strong stabilisation unless
 /// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds and
@@ -63,27 +64,72 @@ pub fn run_with_control(
     ctl: &RunControl,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
+    run_with_structure(plant, opts, init, None, ctl, obs)
+}
+
+/// As [`run_with_control`], for controllers of `structure` (`design::structure`,
+/// docs/ALGORITHMS.md §1.1): the optimiser's variables are the free entries, and every fixed
+/// entry of the returned controller is bit for bit its value. `None` is exactly
+/// [`run_with_control`].
+///
+/// Starting points with a structure: the first random starts draw `opts.nrand` standard-normal
+/// vectors of the free entries only; the initial controller (padded to the order if lower), the
+/// open-loop start and the central starts are *projected* onto the structure (their fixed
+/// entries overwritten by the structure's values); variable scaling applies to the free entries.
+/// A structure of other sizes than `opts.order` on this plant, or with no free entry, is an
+/// `Options` error (field `structure`).
+pub fn run_with_structure(
+    plant: &Plant,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    structure: Option<&Structure>,
+    ctl: &RunControl,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
     validate(plant, opts, init)?;
-    strongly_stabilisable(plant, opts)?;
     let shape = ControllerShape::for_plant(plant, opts.order);
+    if let Some(s) = structure {
+        if !s.fits(shape) {
+            let (nk, m, p) = s.sizes();
+            return Err(opt_err(
+                "structure",
+                format!(
+                    "made for order {nk} with {m} controls and {p} measurements, not order {} with {} and {}",
+                    shape.nk, shape.m, shape.p
+                ),
+            ));
+        }
+        if s.nfree() == 0 {
+            return Err(opt_err("structure", "every entry is fixed, there is nothing to design"));
+        }
+    }
+    strongly_stabilisable(plant, opts)?;
+    let structure: Option<Rc<Structure>> = structure.map(|s| Rc::new(s.clone()));
+    // The optimiser's variables of a controller (all of x, or its free entries: the fixed ones
+    // are overwritten, i.e. the controller is projected onto the structure).
+    let vars = |x: Vec<f64>| match &structure {
+        None => x,
+        Some(s) => s.restrict(&x),
+    };
+    let nvar = structure.as_ref().map_or(shape.nvar(), |s| s.nfree());
     let strong = opts.objective == ObjectiveKind::Strong;
     let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let mut first = starting_points(plant, opts, init, shape, &mut rng);
+    let mut first = starting_points(plant, opts, init, shape, nvar, &vars, &mut rng);
     let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
     if opts.open_loop_start {
-        first.push(controller_to_x(&open_loop_controller(plant, shape.nk)));
+        first.push(vars(controller_to_x(&open_loop_controller(plant, shape.nk))));
         kinds.push(StartKind::OpenLoop);
     }
     for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
-        first.push(controller_to_x(&k));
+        first.push(vars(controller_to_x(&k)));
         kinds.push(StartKind::Central);
     }
     // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
     // asks for them and the plant is scaled at all.
     let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
         VariableScaling::Off => None,
-        VariableScaling::Alternate | VariableScaling::Always => variable_scaling(plant, shape).map(Into::into),
+        VariableScaling::Alternate | VariableScaling::Always => variable_scaling(plant, shape).map(|d| vars(d).into()),
     };
     // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
     // sub-budget of the search is checked between evaluations.
@@ -101,9 +147,11 @@ pub fn run_with_control(
         let cache = Rc::new(RefCell::new(ComponentCache::default()));
         let new = |phase, cache| DesignObjective::new(plant, shape, phase, strong, opts.eps, opts.hinf_tol, cache);
         let stab = new(ObjectivePhase::Stabilisation, Rc::clone(&cache))
+            .with_structure(structure.clone())
             .with_interrupt(Some(Rc::clone(&stop)))
             .with_scaling(d.clone());
         let perf = new(ObjectivePhase::Performance, cache)
+            .with_structure(structure.clone())
             .with_interrupt(Some(Rc::clone(&stop)))
             .with_eval_cpu_report(Some(Rc::clone(&report)))
             .with_scaling(d);
@@ -124,7 +172,7 @@ pub fn run_with_control(
         ctl: &ctl,
         scaled,
     }
-    .run(opts, &first, &kinds, shape.nvar())?;
+    .run(opts, &first, &kinds, nvar)?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
 
     let (final_x, certificate) = match &res.perf {
@@ -145,7 +193,10 @@ pub fn run_with_control(
         DesignStatus::Stopped
     };
 
-    let k = shape.controller(&final_x);
+    let k = match &structure {
+        None => shape.controller(&final_x),
+        Some(s) => s.controller(shape, &final_x),
+    };
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
     let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
@@ -236,6 +287,8 @@ fn starting_points(
     opts: &DesignOptions,
     init: Option<&Controller>,
     shape: ControllerShape,
+    nvar: usize,
+    vars: &dyn Fn(Vec<f64>) -> Vec<f64>,
     rng: &mut ChaCha8Rng,
 ) -> Vec<Vec<f64>> {
     match init {
@@ -245,9 +298,9 @@ fn starting_points(
             } else {
                 k.clone()
             };
-            perturbed_starts(&controller_to_x(&padded), opts.nrand, rng)
+            perturbed_starts(&vars(controller_to_x(&padded)), opts.nrand, rng)
         }
-        None => random_starts(shape.nvar(), opts.nrand, rng),
+        None => random_starts(nvar, opts.nrand, rng),
     }
 }
 
