@@ -5,6 +5,8 @@
 //! continuous one as Ts shrinks. The plants are `examples/discrete/HE1_Ts*.json`
 //! (`make_plants.py` there: HE1 with a zero-order hold).
 
+mod common;
+
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -18,7 +20,6 @@ use hinfix::lti::{
     spectral_radius, Controller, ControllerErrorKind, HinfParams, LtiError, Plant, PlantErrorKind, PlantImage,
     TimeDomain,
 };
-use hinfix::optim::Objective;
 
 fn example(name: &str) -> Plant {
     Plant::load(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/discrete").join(name)).unwrap()
@@ -106,19 +107,7 @@ fn discrete_design_objectives_have_exact_gradients() {
     ] {
         let cache = Rc::new(RefCell::new(ComponentCache::default()));
         let mut obj = DesignObjective::new(&p, shape, phase, strong, eps, 1e-12, cache);
-        let mut g = vec![0.0; x0.len()];
-        let f0 = obj.eval(&x0, &mut g);
-        assert!(f0.is_finite() && g.iter().all(|v| v.is_finite()), "{phase:?}: f = {f0}");
-        let h = 1e-6;
-        let mut scratch = vec![0.0; x0.len()];
-        let mut worst = 0.0f64;
-        for i in 0..x0.len() {
-            let (mut xp, mut xm) = (x0.clone(), x0.clone());
-            xp[i] += h;
-            xm[i] -= h;
-            let fd = (obj.eval(&xp, &mut scratch) - obj.eval(&xm, &mut scratch)) / (2.0 * h);
-            worst = worst.max((fd - g[i]).abs() / g.iter().fold(1.0f64, |m, v| m.max(v.abs())));
-        }
+        let worst = common::worst_fd_error(&mut obj, &x0, &format!("{phase:?}"));
         assert!(worst < 1e-5, "{phase:?} strong={strong}: worst relative error {worst:.2e}");
     }
 }

@@ -3,6 +3,8 @@
 //! named errors, and a design without a structure (or with every entry free) is exactly the
 //! unstructured one.
 
+mod common;
+
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -151,19 +153,7 @@ fn the_structured_gradient_matches_finite_differences() {
         let mut obj =
             DesignObjective::new(&p, shape, phase, strong, eps, 1e-12, cache).with_structure(Some(Rc::clone(&s)));
         assert_eq!(obj.nvar(), s.nfree());
-        let mut g = vec![0.0; x0.len()];
-        let f0 = obj.eval(&x0, &mut g);
-        assert!(f0.is_finite() && g.iter().all(|v| v.is_finite()), "{phase:?}: f = {f0}");
-        let h = 1e-6;
-        let mut scratch = vec![0.0; x0.len()];
-        let mut worst = 0.0f64;
-        for i in 0..x0.len() {
-            let (mut xp, mut xm) = (x0.clone(), x0.clone());
-            xp[i] += h;
-            xm[i] -= h;
-            let fd = (obj.eval(&xp, &mut scratch) - obj.eval(&xm, &mut scratch)) / (2.0 * h);
-            worst = worst.max((fd - g[i]).abs() / g.iter().fold(1.0f64, |m, v| m.max(v.abs())));
-        }
+        let worst = common::worst_fd_error(&mut obj, &x0, &format!("{phase:?}"));
         assert!(worst < 1e-5, "{phase:?} strong={strong}: worst relative error {worst:.2e}");
     }
 }

@@ -261,3 +261,24 @@ pub fn json_system(case: &serde_json::Value) -> hinfix::lti::StateSpace {
     let mat = |k: &str, r, c| json_matrix(&case[k], r, c);
     hinfix::lti::StateSpace::new(mat("A", n, n), mat("B", n, m), mat("C", p, n), mat("D", p, m)).unwrap()
 }
+
+/// The largest error of central differences (step 1e-6) of `obj` at `x0` against its gradient
+/// there, each relative to max(1, ‖∇f‖∞); asserts first that f(x0) and its gradient are finite
+/// (`label` names the case in that message).
+pub fn worst_fd_error(obj: &mut impl hinfix::optim::Objective, x0: &[f64], label: &str) -> f64 {
+    let mut g = vec![0.0; x0.len()];
+    let f0 = obj.eval(x0, &mut g);
+    assert!(f0.is_finite() && g.iter().all(|v| v.is_finite()), "{label}: f = {f0}");
+    let scale = g.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let h = 1e-6;
+    let mut scratch = vec![0.0; x0.len()];
+    let mut worst = 0.0f64;
+    for i in 0..x0.len() {
+        let (mut xp, mut xm) = (x0.to_vec(), x0.to_vec());
+        xp[i] += h;
+        xm[i] -= h;
+        let fd = (obj.eval(&xp, &mut scratch) - obj.eval(&xm, &mut scratch)) / (2.0 * h);
+        worst = worst.max((fd - g[i]).abs() / scale);
+    }
+    worst
+}
