@@ -1,6 +1,7 @@
 //! LaTeX (booktabs) rendering of the campaign tables: `tables.tex` (the paper's layout: per
 //! plant, the full-order bound, then per n_K ours, the paper's and the ratio) and `compare.tex`.
 
+use crate::lti::TimeDomain;
 use std::fmt::Write as _;
 
 use super::compare::{
@@ -272,7 +273,10 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
             r.seed.map_or("--".into(), |x| x.to_string()),
             opt(r.k_hinf),
             // ρ(A_K) of a strongly stable controller is often within 1e-4 of 1: six decimals
-            r.alpha_k.map_or("--".to_string(), |a| if ts.is_some() { format!("{:.6}", a + 1.0) } else { sig4_inf(a) }),
+            r.alpha_k.map_or("--".to_string(), |a| match ts {
+                Some(ts) => format!("{:.6}", TimeDomain::Discrete { ts }.stability_quantity(a).1),
+                None => sig4_inf(a),
+            }),
             r.cpu_to_best_s.map_or("--".into(), |t| format!("{t:.1}"))
         );
     }

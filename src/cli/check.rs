@@ -150,8 +150,9 @@ fn to_json(r: &CheckReport) -> Value {
         }
         TimeDomain::Discrete { ts } => {
             o.insert("Ts".into(), num(ts));
-            o.insert("closed_loop_spectral_radius".into(), num(r.alpha_cl + 1.0));
-            o.insert("controller_spectral_radius".into(), r.alpha_k.map(|a| num(a + 1.0)).into());
+            let rho = |s: f64| num(r.domain.stability_quantity(s).1);
+            o.insert("closed_loop_spectral_radius".into(), rho(r.alpha_cl));
+            o.insert("controller_spectral_radius".into(), r.alpha_k.map(rho).into());
         }
     }
     v
@@ -167,16 +168,15 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         k.order()
     );
     // α, or ρ in discrete time (stable means ρ < 1 − margin)
-    let (name, shift, bound) = match r.domain {
-        TimeDomain::Continuous => ("α", 0.0, "α < −"),
-        TimeDomain::Discrete { .. } => ("ρ", 1.0, "ρ < 1 − "),
-    };
+    let quantity = |m: f64| r.domain.stability_quantity(m);
+    let (name, alpha_cl) = quantity(r.alpha_cl);
+    let bound = if r.domain.is_discrete() { "ρ < 1 − " } else { "α < −" };
     if r.domain.is_discrete() {
         s += &format!("{}, frequencies in rad/s up to the Nyquist frequency\n", r.domain);
     }
     s += &format!(
         "closed loop: {name}(A_cl) = {:+.6e}   {} (stable means {bound}{:.1e})\n",
-        r.alpha_cl + shift,
+        alpha_cl,
         yes_no(r.closed_loop_stable()),
         r.margin_cl
     );
@@ -185,7 +185,7 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         Some(a) => {
             s += &format!(
                 "controller:  {name}(Ak)    = {:+.6e}   {} (stable means {bound}{:.1e})\n",
-                a + shift,
+                quantity(a).1,
                 yes_no(r.controller_stable()),
                 r.margin_k
             )

@@ -380,10 +380,10 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         );
     }
     // α, or in discrete time ρ (the outcome holds ρ − 1, `lti::stability_measure`)
-    let (name, shift) = if plant.domain.is_discrete() { ("ρ", 1.0) } else { ("α", 0.0) };
-    s += &format!("{name}(A_cl) = {:+.4e}", o.alpha_cl + shift);
+    let (name, alpha_cl) = plant.domain.stability_quantity(o.alpha_cl);
+    s += &format!("{name}(A_cl) = {alpha_cl:+.4e}");
     match o.alpha_k {
-        Some(a) => s += &format!("   {name}(Ak) = {:+.4e}\n", a + shift),
+        Some(a) => s += &format!("   {name}(Ak) = {:+.4e}\n", plant.domain.stability_quantity(a).1),
         None => s += "   (static gain)\n",
     }
     let per_eval = if o.evaluations > 0 { o.design_cpu_s / o.evaluations as f64 } else { f64::NAN };

@@ -56,7 +56,8 @@ impl Summary {
             None => o.insert("open_loop_spectral_abscissa".into(), crate::design::f64_to_json(self.alpha)),
             Some(ts) => {
                 o.insert("Ts".into(), crate::design::f64_to_json(ts));
-                o.insert("open_loop_spectral_radius".into(), crate::design::f64_to_json(self.alpha + 1.0))
+                let rho = self.plant.domain.stability_quantity(self.alpha).1;
+                o.insert("open_loop_spectral_radius".into(), crate::design::f64_to_json(rho))
             }
         };
     }
@@ -147,7 +148,7 @@ pub fn show(a: PlantArgs) -> anyhow::Result<ExitCode> {
     println!("  sizes:       n = {}, w: m1 = {}, u: m2 = {}, z: p1 = {}, y: p2 = {}", d.n, d.m1, d.m2, d.p1, d.p2);
     let (what, value) = match p.domain {
         lti::TimeDomain::Continuous => ("spectral abscissa", s.alpha),
-        lti::TimeDomain::Discrete { .. } => ("spectral radius", s.alpha + 1.0),
+        lti::TimeDomain::Discrete { .. } => ("spectral radius", p.domain.stability_quantity(s.alpha).1),
     };
     if p.domain.is_discrete() {
         println!("  time:        {}", p.domain);

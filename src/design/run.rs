@@ -8,7 +8,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_in, hinf_norm_with_poles, is_stable,
+    closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_discrete, hinf_norm_with_poles, is_stable,
     stability_measure, stability_measure_of, Controller, HinfParams, Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
@@ -327,7 +327,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
                     let params = HinfParams::new(opts.hinf_tol).with_stop(stop);
                     let norm = match plant.domain {
                         TimeDomain::Continuous => hinf_norm_with_poles(&cl, &poles, &params),
-                        TimeDomain::Discrete { .. } => hinf_norm_in(plant.domain, &cl, &params),
+                        TimeDomain::Discrete { .. } => hinf_norm_discrete(&cl, &params),
                     };
                     norm.map_or(f64::NAN, |h| h.value)
                 } else {

@@ -101,6 +101,15 @@ impl TimeDomain {
         }
     }
 
+    /// What a stability measure s (`lti::stability_measure`) stands for, as printed: ("α", s) in
+    /// continuous time, ("ρ", s + 1) in discrete time (the spectral radius itself).
+    pub fn stability_quantity(self, measure: f64) -> (&'static str, f64) {
+        match self {
+            TimeDomain::Continuous => ("α", measure),
+            TimeDomain::Discrete { .. } => ("ρ", measure + 1.0),
+        }
+    }
+
     /// The Nyquist frequency π/Ts in rad/s (discrete time), the end of a discrete system's
     /// frequency axis; `None` in continuous time.
     pub fn nyquist(self) -> Option<f64> {
@@ -135,5 +144,9 @@ mod tests {
         assert_eq!(d.nyquist(), Some(2.0 * PI));
         assert_eq!(TimeDomain::Continuous.nyquist(), None);
         assert_eq!(d.to_string(), "discrete time (Ts = 0.5 s)");
+        assert_eq!(
+            (d.stability_quantity(-0.25), TimeDomain::Continuous.stability_quantity(-0.25)),
+            (("ρ", 0.75), ("α", -0.25))
+        );
     }
 }
