@@ -155,13 +155,20 @@ mod tests {
         }
     }
 
+    /// A system with a pole near z = −1 (the map is flipped for it) and one with a pole near
+    /// z = +1 (not flipped), each with whether the map is flipped.
+    fn one_on_each_side() -> [(StateSpace, bool); 2] {
+        [
+            (system([[-0.95, 0.2, 0.0], [0.0, 0.3, 0.1], [0.1, 0.0, 0.5]]), true),
+            (system([[0.95, 0.2, 0.0], [0.0, -0.3, 0.1], [0.1, 0.0, 0.5]]), false),
+        ]
+    }
+
     /// Gc(iω) = G(e^{iθ}) entry by entry (up to conjugation, which the flipped map introduces) at
     /// θ = 0, π and in between, for a system on each side of the choice; Ac is Hurwitz.
     #[test]
     fn the_image_has_the_same_response_on_the_boundary() {
-        let near_minus_one = system([[-0.95, 0.2, 0.0], [0.0, 0.3, 0.1], [0.1, 0.0, 0.5]]);
-        let near_plus_one = system([[0.95, 0.2, 0.0], [0.0, -0.3, 0.1], [0.1, 0.0, 0.5]]);
-        for (sys, flipped) in [(near_minus_one, true), (near_plus_one, false)] {
+        for (sys, flipped) in one_on_each_side() {
             let cay = Cayley::new(&sys).unwrap();
             assert_eq!(cay.flipped, flipped);
             assert!(crate::lti::kernels::spectral::spectral_abscissa(cay.sys.a.as_ref()) < 0.0);
@@ -188,9 +195,7 @@ mod tests {
     /// The inverse map takes the image back to the system, on both branches of the map.
     #[test]
     fn the_inverse_map_takes_the_image_back() {
-        let near_minus_one = system([[-0.95, 0.2, 0.0], [0.0, 0.3, 0.1], [0.1, 0.0, 0.5]]);
-        let near_plus_one = system([[0.95, 0.2, 0.0], [0.0, -0.3, 0.1], [0.1, 0.0, 0.5]]);
-        for (sys, flipped) in [(near_minus_one, true), (near_plus_one, false)] {
+        for (sys, flipped) in one_on_each_side() {
             let c = Cayley::new(&sys).unwrap();
             assert_eq!(c.flipped, flipped);
             let back = from_continuous(&c.sys, c.flipped).unwrap();
