@@ -82,6 +82,7 @@ fn record_line() -> &'static str {
                 evals_to_best: 12,
                 stop: hinfix::design::SearchStop::Stall,
             },
+            plants: Vec::new(),
         };
         let r = JobRecord::from_run("f", job, false, Ok(out), 1.0, 1.5).unwrap();
         serde_json::to_string(&r).unwrap()

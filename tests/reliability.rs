@@ -96,6 +96,7 @@ fn outcome(status: DesignStatus, x: f64) -> DesignOutcome {
             evals_to_best: 1,
             stop: hinfix::design::SearchStop::Stall,
         },
+        plants: Vec::new(),
     }
 }
 

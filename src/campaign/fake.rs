@@ -132,6 +132,7 @@ impl JobRunner for FakeRunner {
                 evals_to_best: iters,
                 stop: SearchStop::Starts,
             },
+            plants: Vec::new(),
         })
     }
 }

@@ -29,8 +29,8 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::design::{
-    run_with_structure, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind,
-    Structure, VariableScaling,
+    run_problem, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind,
+    PlantObjective, PlantTerm, PlantValue, Problem, Structure, VariableScaling,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
@@ -60,8 +60,25 @@ fn list_text(v: &[f64]) -> String {
 #[derive(clap::Args, Debug)]
 pub struct DesignArgs {
     /// Plant name (from plants/) or path to a plant file (JSON, or MATLAB .mat with A B1 B2 C1 C2 D11 D12 D21 D22).
-    #[arg(long)]
-    pub plant: String,
+    /// Repeat it to design one controller for several plants (docs/ALGORITHMS.md §14): every
+    /// plant is stabilised, and the largest weighted objective of the plants without a bound is
+    /// minimised subject to the bounds.
+    #[arg(long, required = true)]
+    pub plant: Vec<String>,
+    /// The objective of each plant: hinf (‖Tzw‖∞), h2 (‖Tzw‖₂; continuous time keeps
+    /// D11 + D12·DK·D21 = 0 and needs D22 = 0), abscissa (the closed loop's spectral abscissa,
+    /// ρ − 1 in discrete time) or radius (1/r_C, the reciprocal of the complex stability radius).
+    /// Given once (every plant) or once per --plant, in their order. Default hinf.
+    #[arg(long, value_name = "hinf|h2|abscissa|radius", value_parser = clap::value_parser!(PlantObjective))]
+    pub objective: Vec<PlantObjective>,
+    /// The weight w > 0 of each plant's objective: once (every plant) or once per --plant. Default 1.
+    #[arg(long, value_name = "W", allow_hyphen_values = true)]
+    pub weight: Vec<f64>,
+    /// A bound b on a plant's weighted objective (w·g ≤ b, an exact penalty; that plant is then
+    /// not in the minimised max): once (every plant) or once per --plant, "none" for no bound.
+    /// Default none.
+    #[arg(long, value_name = "B|none", allow_hyphen_values = true)]
+    pub bound: Vec<String>,
     /// Controller order nk ≥ 0.
     #[arg(long, allow_hyphen_values = true)]
     pub order: usize,
@@ -190,53 +207,99 @@ fn unverified_path(out: &Path) -> PathBuf {
 /// Whether `o`'s controller stabilises `plant` as the objective asks: the closed loop and (strong
 /// objective) the controller stable with the verification margin — the test `campaign report`
 /// applies to a journaled controller.
-fn stabilising(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> bool {
+fn stabilising(problem: &Problem, opts: &DesignOptions, o: &DesignOutcome) -> bool {
     if matches!(o.status, DesignStatus::NotStabilised { .. }) {
         return false;
     }
     let k = &o.controller;
-    let stable =
-        |a: faer::MatRef<'_, f64>| crate::lti::is_stable_with_margin(crate::lti::stability_measure(plant.domain, a), a);
-    let loop_stable = crate::lti::closed_loop(plant, k).is_ok_and(|cl| stable(cl.a.as_ref()));
+    let domain = problem.first().domain;
+    let stable = |a: faer::MatRef<'_, f64>| crate::lti::is_stable_with_margin(crate::lti::stability_measure(domain, a), a);
+    let loops_stable =
+        problem.terms.iter().all(|t| crate::lti::closed_loop(&t.plant, k).is_ok_and(|cl| stable(cl.a.as_ref())));
     let k_stable = k.order() == 0 || stable(k.ak.as_ref());
-    loop_stable && (k_stable || opts.objective == ObjectiveKind::Plain)
+    loops_stable && (k_stable || opts.objective == ObjectiveKind::Plain)
+}
+
+/// A per-plant list of `flag`'s values: none (every plant `default`), one (every plant), or one
+/// per plant.
+fn per_plant<T: Clone>(values: &[T], nplants: usize, default: T, flag: &str) -> anyhow::Result<Vec<T>> {
+    match values.len() {
+        0 => Ok(vec![default; nplants]),
+        1 => Ok(vec![values[0].clone(); nplants]),
+        n if n == nplants => Ok(values.to_vec()),
+        n => anyhow::bail!(
+            "{flag} is given {n} times for {nplants} --plant(s): give it once (for every plant) or once per --plant"
+        ),
+    }
+}
+
+/// `--bound`: a finite number, or "none".
+fn parse_bound(text: &str) -> anyhow::Result<Option<f64>> {
+    match text.trim() {
+        "none" => Ok(None),
+        t => match t.parse::<f64>() {
+            Ok(b) if b.is_finite() => Ok(Some(b)),
+            _ => anyhow::bail!("--bound: {t:?} is not a finite number or \"none\""),
+        },
+    }
+}
+
+/// The problem the `--plant`, `--objective`, `--weight` and `--bound` flags describe.
+pub fn problem(a: &DesignArgs) -> anyhow::Result<Problem> {
+    let n = a.plant.len();
+    let objectives = per_plant(&a.objective, n, PlantObjective::Hinf, "--objective")?;
+    let weights = per_plant(&a.weight, n, 1.0, "--weight")?;
+    let bounds = per_plant(&a.bound, n, "none".to_string(), "--bound")?;
+    let mut terms = Vec::with_capacity(n);
+    for (i, name) in a.plant.iter().enumerate() {
+        let plant = Plant::load(&resolve_plant(name)?)?;
+        let bound = parse_bound(&bounds[i])?;
+        terms.push(PlantTerm { plant, objective: objectives[i], weight: weights[i], bound });
+    }
+    let problem = Problem { terms };
+    problem.validate()?;
+    Ok(problem)
 }
 
 pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
-    let plant_file = resolve_plant(&a.plant)?;
-    let plant = Plant::load(&plant_file)?;
+    let problem = problem(&a)?;
+    let plant = problem.first();
     let init = match &a.init {
         Some(path) => Some(Controller::load(path)?),
         None => None,
     };
     let opts = options(&a)?;
     // Bad options and an unusable --out are errors before any work (and before any file is made).
-    crate::design::validate(&plant, &opts, init.as_ref())
-        .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
-    if let Err(e) = crate::design::strongly_stabilisable(&plant, &opts) {
-        eprintln!("error: {} (order {}, strong objective): {e}", for_terminal(&plant.name), a.order);
-        return Ok(ExitCode::from(EXIT_NOT_STABILISED));
+    for t in &problem.terms {
+        crate::design::validate(&t.plant, &opts, init.as_ref())
+            .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&t.plant.name)))?;
+    }
+    for t in &problem.terms {
+        if let Err(e) = crate::design::strongly_stabilisable(&t.plant, &opts) {
+            eprintln!("error: {} (order {}, strong objective): {e}", for_terminal(&t.plant.name), a.order);
+            return Ok(ExitCode::from(EXIT_NOT_STABILISED));
+        }
     }
     let structure = match &a.structure {
         Some(path) => {
-            Some(Structure::load(path, ControllerShape::for_plant(&plant, opts.order)).context("--structure")?)
+            Some(Structure::load(path, ControllerShape::for_plant(plant, opts.order)).context("--structure")?)
         }
         None => None,
     };
+    let names = problem.terms.iter().map(|t| for_terminal(&t.plant.name)).collect::<Vec<_>>().join(", ");
     check_writable(&a.out).with_context(|| format!("--out {}", a.out.display()))?;
     let cancel = signals::install();
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
-    let outcome = run_with_structure(&plant, &opts, init.as_ref(), structure.as_ref(), &ctl, &mut NoDesignObserver)
-        .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&plant.name)))?;
-    let good = stabilising(&plant, &opts, &outcome);
+    let outcome = run_problem(&problem, &opts, init.as_ref(), structure.as_ref(), &ctl, &mut NoDesignObserver)
+        .with_context(|| format!("designing an order-{} controller for {names}", a.order))?;
+    let good = stabilising(&problem, &opts, &outcome);
     // A stabilising result has a finite γ; NaN or ∞ would be a failed computation called success.
     let stabilising = !matches!(outcome.status, DesignStatus::NotStabilised { .. } | DesignStatus::Interrupted);
     if stabilising && !(outcome.gamma.is_finite() && outcome.objective.is_finite()) {
         anyhow::bail!(
-            "designing an order-{} controller for {}: the result's ‖Tzw‖∞ = {} (objective {}) is not finite for a \
+            "designing an order-{} controller for {names}: the result's ‖Tzw‖∞ = {} (objective {}) is not finite for a \
              stable closed loop; the numbers are out of the range the norm can be computed in, no controller written",
             a.order,
-            for_terminal(&plant.name),
             outcome.gamma,
             outcome.objective
         );
@@ -257,7 +320,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        print!("{}", summary(&plant, &opts, &outcome));
+        print!("{}", summary(plant, &opts, &outcome));
     }
     let what = match (&written, good) {
         (Some(p), true) => format!("controller written to {}", p.display()),
@@ -349,14 +412,46 @@ fn status_text(s: &DesignStatus) -> String {
     }
 }
 
+/// One line per plant of a several-plant (or non-H∞) design: its objective's value, weighted,
+/// its bound and whether it holds, its closed-loop stability measure. Empty for none.
+pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
+    let mut s = String::new();
+    for (i, v) in values.iter().enumerate() {
+        let bound = match v.bound {
+            None => String::new(),
+            Some(b) => format!(
+                "   bound {} {}",
+                fmt_num(b, 6),
+                if v.bound_met() { "met" } else { "VIOLATED" }
+            ),
+        };
+        s += &format!(
+            "plant {} {}: {} = {}   weight {} → {}{}   s(A_cl) = {:+.4e}\n",
+            i + 1,
+            for_terminal(&v.plant),
+            v.objective.symbol(),
+            fmt_num(v.value, 6),
+            fmt_num(v.weight, 6),
+            fmt_num(v.weighted(), 6),
+            bound,
+            v.alpha_cl
+        );
+    }
+    s
+}
+
 fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     let mode = match opts.objective {
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
         ObjectiveKind::Plain => "plain H∞".to_string(),
     };
+    let names = match o.plants.len() {
+        0 | 1 => for_terminal(&plant.name),
+        k => format!("{k} plants ({})", o.plants.iter().map(|v| for_terminal(&v.plant)).collect::<Vec<_>>().join(", ")),
+    };
     let mut s = format!(
         "{} (n = {}{}), order {}, {}, seed {}\n",
-        for_terminal(&plant.name),
+        names,
         plant.dims.n,
         plant.domain.ts().map_or(String::new(), |ts| format!(", discrete time Ts = {ts} s")),
         opts.order,
@@ -364,8 +459,11 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         opts.seed
     );
     s += &format!("status:   {}\n", status_text(&o.status));
+    s += &plant_lines(&o.plants);
+    // A problem's γ is its plants' largest weighted value (`design::run_problem`).
+    let gamma_name = if o.plants.is_empty() { "‖Tzw‖∞" } else { "max w·g" };
     s += &format!(
-        "‖Tzw‖∞ = {}   ‖K‖∞ = {}   objective = {}\n",
+        "{gamma_name} = {}   ‖K‖∞ = {}   objective = {}\n",
         fmt_num(o.gamma, 6),
         fmt_num(o.k_hinf, 6),
         fmt_num(o.objective, 6)

@@ -16,11 +16,13 @@
 //! The modules are crate-private; what is API is re-exported here.
 pub(crate) mod central_start;
 mod float_serde;
+mod multi_objective;
 pub(crate) mod objective;
 mod options;
 mod outcome;
 pub(crate) mod params;
 mod phases;
+mod problem;
 mod run;
 pub(crate) mod scaling;
 mod search;
@@ -44,7 +46,11 @@ pub use outcome::{
     NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary, StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
-pub use run::{run, run_with_control, run_with_structure, strongly_stabilisable, validate};
+pub use problem::{
+    plant_part, plant_value, plant_values, H2Feedthrough, PlantObjective, PlantTerm, PlantValue, Problem, ProblemError,
+    UnknownObjective, PENALTY_WEIGHT,
+};
+pub use run::{run, run_problem, run_with_control, run_with_structure, strongly_stabilisable, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};
 pub use structure::{Structure, StructureError};

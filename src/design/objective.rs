@@ -47,7 +47,9 @@ use crate::lti::{
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
 use super::outcome::{DesignIterRecord, DesignObserver, Phase};
+use super::multi_objective;
 use super::params::ControllerShape;
+use super::problem::{H2Feedthrough, Problem};
 use super::structure::Structure;
 
 /// Number of recently evaluated points whose components are kept for the observer.
@@ -93,7 +95,7 @@ pub struct Components {
 }
 
 impl Components {
-    const UNKNOWN: Components =
+    pub(crate) const UNKNOWN: Components =
         Components { f: f64::NAN, gamma: f64::NAN, k_hinf: f64::NAN, alpha_cl: f64::NAN, alpha_k: f64::NAN };
 }
 
@@ -162,6 +164,12 @@ pub struct DesignObjective<'p> {
     /// A controller structure (`design::structure`): the objective's x (after scaling) holds only
     /// the free entries; `None`: x is the whole parameter vector.
     structure: Option<Rc<Structure>>,
+    /// Several plants, or other objectives than one plant's H∞ norm (`design::problem`,
+    /// `design::multi_objective`); `None`: the single-plant H∞ objective of `plant`.
+    problem: Option<&'p Problem>,
+    /// The continuous H2 plants' set of controller feedthroughs, onto which every controller's
+    /// Dk is projected (`design::problem::H2Feedthrough`); `None`: Dk is free.
+    h2: Option<Rc<H2Feedthrough>>,
 }
 
 impl<'p> DesignObjective<'p> {
@@ -193,7 +201,20 @@ impl<'p> DesignObjective<'p> {
             on_eval_cpu: None,
             scaling: None,
             structure: None,
+            problem: None,
+            h2: None,
         }
+    }
+
+    /// Evaluates `problem` (several plants, or other objectives: `design::multi_objective`) in
+    /// place of the single-plant H∞ objective; `h2` projects every controller's Dk onto the
+    /// continuous H2 plants' set ([`Problem::validate`]). The objective's `plant` must be the
+    /// problem's first. `None`: the single-plant objective.
+    pub fn with_problem(mut self, problem: Option<&'p Problem>, h2: Option<Rc<H2Feedthrough>>) -> Self {
+        assert!(problem.is_none_or(|p| std::ptr::eq(p.first(), self.plant)), "the plant must be the problem's first");
+        self.problem = problem;
+        self.h2 = h2;
+        self
     }
 
     /// Takes x (after scaling) as the free entries of `structure` (`design::structure`): the
@@ -215,12 +236,22 @@ impl<'p> DesignObjective<'p> {
 
     /// The controller at the objective's variables `x` (scaled if [`Self::with_scaling`]).
     fn controller(&self, x: &[f64]) -> Controller {
-        match (&self.scaling, &self.structure) {
+        let k = match (&self.scaling, &self.structure) {
             (Some(d), None) => self.shape.controller(&super::scaling::from_scaled(x, Some(d))),
             (None, None) => self.shape.controller(x),
             (Some(d), Some(s)) => s.controller(self.shape, &super::scaling::from_scaled(x, Some(d))),
             (None, Some(s)) => s.controller(self.shape, x),
+        };
+        match &self.h2 {
+            None => k,
+            Some(h2) => Controller { dk: h2.project(&k.dk), ..k },
         }
+    }
+
+    /// The controller at the objective's variables `x`: the structure's template with the free
+    /// entries in place, Dk projected for the H2 objective (what the design returns).
+    pub fn controller_at(&self, x: &[f64]) -> Controller {
+        self.controller(x)
     }
 
     /// Polls `stop` inside evaluations of closed loops of at least [`MIN_ORDER_FOR_INTERRUPT`]
@@ -246,6 +277,7 @@ impl<'p> DesignObjective<'p> {
             .with_eval_cpu_report(o.on_eval_cpu.clone())
             .with_structure(o.structure.clone())
             .with_scaling(o.scaling.clone())
+            .with_problem(o.problem, o.h2.clone())
     }
 
     /// True if the stop hook applies to this plant and has fired.
@@ -260,6 +292,9 @@ impl<'p> DesignObjective<'p> {
 
     /// f and its components at controller `k`; the gradient (as controller matrices) if `grad`.
     pub fn components(&self, k: &Controller, grad: bool) -> (Components, Option<ControllerGradient>) {
+        if let Some(problem) = self.problem {
+            return self.problem_components(problem, k);
+        }
         match self.phase {
             ObjectivePhase::Stabilisation => self.stabilisation(k, grad),
             ObjectivePhase::Performance => self.performance(k, grad),
@@ -364,6 +399,35 @@ impl<'p> DesignObjective<'p> {
 }
 
 impl DesignObjective<'_> {
+    /// [`Self::components`] of a [`Problem`] (`design::multi_objective`).
+    fn problem_components(&self, problem: &Problem, k: &Controller) -> (Components, Option<ControllerGradient>) {
+        match self.phase {
+            ObjectivePhase::Stabilisation => multi_objective::stabilisation(problem, k, self.strong, self.eps),
+            ObjectivePhase::Performance => {
+                let hook = self.stop.as_deref().filter(|_| self.plant.dims.n + k.order() >= MIN_ORDER_FOR_INTERRUPT);
+                let params = HinfParams::new(self.hinf_tol).with_stop(hook.map_or(Interrupt::NEVER, Interrupt::new));
+                match multi_objective::performance(problem, k, self.strong, self.eps, self.hinf_tol, &params) {
+                    Ok(v) => v,
+                    Err(multi_objective::NoValue::Interrupted) => {
+                        self.abandoned.set(true);
+                        (Components::UNKNOWN, None)
+                    }
+                }
+            }
+        }
+    }
+
+    /// The closed loops' stability measure at `k`: the plant's, or the largest of a problem's.
+    fn closed_loop_measure(&self, k: &Controller) -> f64 {
+        let measure = |plant: &Plant| {
+            closed_loop(plant, k).map(|cl| stability_measure(plant.domain, cl.a.as_ref())).unwrap_or(f64::INFINITY)
+        };
+        match self.problem {
+            None => measure(self.plant),
+            Some(p) => p.terms.iter().map(|t| measure(&t.plant)).fold(f64::NEG_INFINITY, super::problem::nan_max),
+        }
+    }
+
     /// [`Objective::eval`], with the closed-loop norm stopping once it reaches `reject_at`
     /// (`lti::HinfParams::enough`): a value f ≥ `reject_at` may then be a lower bound,
     /// comes with a NaN gradient and is not cached (the line search only needs to know that f
@@ -375,7 +439,10 @@ impl DesignObjective<'_> {
         let (c, grad) = self.components(&k, true);
         self.reject_at.set(f64::INFINITY);
         match grad {
-            Some(gk) if c.f.is_finite() => {
+            Some(mut gk) if c.f.is_finite() => {
+                if let Some(h2) = &self.h2 {
+                    gk.dk = h2.project_gradient(&gk.dk);
+                }
                 match &self.structure {
                     None => self.shape.write_x(&gk, g),
                     Some(s) => {
@@ -459,6 +526,7 @@ impl Objective for DesignObjective<'_> {
     /// is evaluated by `eval_unless`, whose norm still stops once it reaches `threshold`.
     fn eval_below(&mut self, x: &[f64], g: &mut [f64], threshold: f64) -> f64 {
         if self.phase == ObjectivePhase::Performance
+            && self.problem.is_none()
             && self.plant.dims.n + self.shape.nk >= MIN_ORDER_FOR_REJECTION
             && !self.plant.domain.is_discrete()
         {
@@ -573,10 +641,7 @@ impl Observer for ObserverAdapter<'_, '_> {
             None => Components::UNKNOWN,
         };
         if wants && c.alpha_cl.is_nan() && obj.phase == ObjectivePhase::Performance && !obj.stop_fired() {
-            let k = obj.controller(rec.x);
-            c.alpha_cl = closed_loop(obj.plant, &k)
-                .map(|cl| stability_measure(obj.plant.domain, cl.a.as_ref()))
-                .unwrap_or(f64::INFINITY);
+            c.alpha_cl = obj.closed_loop_measure(&obj.controller(rec.x));
             obj.cache.borrow_mut().update(rec.x, c);
         }
         let phase = match (self.phase, rec.solver) {

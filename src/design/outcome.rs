@@ -268,6 +268,10 @@ pub struct DesignOutcome {
     /// ([`SearchSummary::not_recorded`] when read from a journal line that predates it).
     #[serde(default = "SearchSummary::not_recorded")]
     pub search: SearchSummary,
+    /// Each plant's recomputed value, of a design for several plants or another objective than
+    /// one plant's H∞ norm (`design::run_problem`); empty for the single-plant H∞ design.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plants: Vec<super::problem::PlantValue>,
 }
 
 /// One iteration as seen by a design observer (the campaign's trace writer).
@@ -351,6 +355,10 @@ pub enum DesignError {
     /// property fails, `lti::parity_interlacing`): refused before any search.
     #[error("{0}")]
     NotStronglyStabilisable(crate::lti::PipViolation),
+    /// Several plants that cannot share one controller, or a bad weight, bound or objective
+    /// (`design::problem`).
+    #[error("{0}")]
+    Problem(super::problem::ProblemError),
 }
 
 /// Why an initial controller (warm start, `--init`) cannot start a design run. Part of the

@@ -22,6 +22,7 @@ use super::outcome::{
     Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
+use super::problem::{nan_max, plant_part, plant_values, PlantValue, Problem, PENALTY_WEIGHT};
 use super::scaling::variable_scaling;
 use super::search::{ScaledObjectives, Search};
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
@@ -86,7 +87,43 @@ pub fn run_with_structure(
     ctl: &RunControl,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
-    validate(plant, opts, init)?;
+    run_problem(&Problem::single(plant.clone()), opts, init, structure, ctl, obs)
+}
+
+/// As [`run_with_structure`], for a [`Problem`]: several plants, each with its objective, weight
+/// and bound (`design::problem`, docs/ALGORITHMS.md §14). The single-plant H∞ problem
+/// ([`Problem::is_single_hinf`]) is exactly [`run_with_structure`]; any other is evaluated by
+/// `design::multi_objective`, every plant stabilised in the first phase. The first plant gives
+/// the starting points (random, `init`, open loop, its central starts) and the variable scaling;
+/// every plant is checked by [`validate`] and, strong objective, for strong stabilisability. The
+/// outcome's [`DesignOutcome::plants`] gives each plant's recomputed value; its `gamma` is then the
+/// largest weighted value w_j·g_j of the plants without a bound (of all plants if each has one),
+/// `alpha_cl` the largest closed-loop stability measure.
+pub fn run_problem(
+    problem: &Problem,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    structure: Option<&Structure>,
+    ctl: &RunControl,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
+    let h2 = problem.validate().map_err(DesignError::Problem)?;
+    let plant = problem.first();
+    for t in &problem.terms {
+        validate(&t.plant, opts, init)?;
+    }
+    let multi = (!problem.is_single_hinf()).then_some(problem);
+    if let (Some(s), Some(_)) = (structure, &h2) {
+        let shape = ControllerShape::for_plant(plant, opts.order);
+        let dk = &s.entries()[shape.nvar() - shape.m * shape.p..];
+        if dk.iter().any(Option::is_some) {
+            return Err(opt_err(
+                "structure",
+                "fixes entries of DK, which the h2 objective constrains to D11 + D12·DK·D21 = 0: leave DK free",
+            ));
+        }
+    }
+    let h2 = h2.map(Rc::new);
     let shape = ControllerShape::for_plant(plant, opts.order);
     if let Some(s) = structure {
         if !s.fits(shape) {
@@ -103,7 +140,9 @@ pub fn run_with_structure(
             return Err(opt_err("structure", "every entry is fixed, there is nothing to design"));
         }
     }
-    strongly_stabilisable(plant, opts)?;
+    for t in &problem.terms {
+        strongly_stabilisable(&t.plant, opts)?;
+    }
     let structure: Option<Rc<Structure>> = structure.map(|s| Rc::new(s.clone()));
     // The optimiser's variables of a controller (all of x, or its free entries: the fixed ones
     // are overwritten, i.e. the controller is projected onto the structure).
@@ -147,10 +186,12 @@ pub fn run_with_structure(
         let cache = Rc::new(RefCell::new(ComponentCache::default()));
         let new = |phase, cache| DesignObjective::new(plant, shape, phase, strong, opts.eps, opts.hinf_tol, cache);
         let stab = new(ObjectivePhase::Stabilisation, Rc::clone(&cache))
+            .with_problem(multi, h2.clone())
             .with_structure(structure.clone())
             .with_interrupt(Some(Rc::clone(&stop)))
             .with_scaling(d.clone());
         let perf = new(ObjectivePhase::Performance, cache)
+            .with_problem(multi, h2.clone())
             .with_structure(structure.clone())
             .with_interrupt(Some(Rc::clone(&stop)))
             .with_eval_cpu_report(Some(Rc::clone(&report)))
@@ -193,13 +234,18 @@ pub fn run_with_structure(
         DesignStatus::Stopped
     };
 
-    let k = match &structure {
-        None => shape.controller(&final_x),
-        Some(s) => s.controller(shape, &final_x),
-    };
+    let k = perf_obj.controller_at(&final_x);
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
-    let fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+    let mut fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+    let plants = match multi {
+        None => Vec::new(),
+        Some(p) => {
+            let values = plant_values(p, &k, opts.hinf_tol);
+            problem_figures(&mut fig, &values, opts);
+            values
+        }
+    };
     let iterations = res.phases.iter().map(|p| p.iters).sum();
     let evaluations = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {
@@ -217,7 +263,27 @@ pub fn run_with_structure(
         phases: res.phases,
         design_cpu_s: ctl.cpu_elapsed(),
         search: res.summary,
+        plants,
     })
+}
+
+/// A problem's figures in place of the first plant's (`run_problem`): γ the largest weighted value
+/// of the unbounded plants (of all if each has a bound), α(A_cl) the largest, the objective
+/// max(γ, ε‖K‖∞) plus the penalty of violated bounds.
+fn problem_figures(fig: &mut Figures, values: &[PlantValue], opts: &DesignOptions) {
+    let (free_max, violation) = plant_part(values);
+    fig.gamma = if free_max == f64::NEG_INFINITY {
+        values.iter().map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max)
+    } else {
+        free_max
+    };
+    fig.alpha_cl = values.iter().map(|v| v.alpha_cl).fold(f64::NEG_INFINITY, nan_max);
+    let k_term = match opts.objective {
+        ObjectiveKind::Strong => opts.eps * fig.k_hinf,
+        ObjectiveKind::Plain => f64::NEG_INFINITY,
+    };
+    let top = nan_max(free_max, k_term);
+    fig.objective = if top == f64::NEG_INFINITY { 0.0 } else { top } + PENALTY_WEIGHT * violation;
 }
 
 /// With the strong objective, refuses at once a plant that no stable controller stabilises:
