@@ -22,6 +22,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use crate::design::{plant_value, PlantObjective};
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm_in, stability_margin, stability_measure, Controller, HinfNorm,
     HinfParams, Plant, TimeDomain, DEFAULT_HINF_TOL, NORM_TIE_RTOL,
@@ -32,16 +33,18 @@ use serde_json::{json, Value};
 /// Arguments of `campaign check`.
 #[derive(clap::Args, Debug)]
 pub struct CheckArgs {
-    /// Plant name (from plants/) or path to a plant file (JSON or MATLAB .mat).
-    #[arg(long)]
-    pub plant: String,
+    /// Plant name (from plants/) or path to a plant file (JSON or MATLAB .mat). Repeat it to
+    /// check one controller on several plants (a multi-model design): each plant is reported.
+    #[arg(long, required = true)]
+    pub plant: Vec<String>,
     /// Controller file: JSON {AK, BK, CK, DK} or MATLAB .mat with the variables AK BK CK DK.
     #[arg(long)]
     pub controller: PathBuf,
     /// Print machine-readable JSON.
     #[arg(long)]
     pub json: bool,
-    /// Also draw the σ-plot (σmax of Tzw(iω) and K(iω) vs ω, peak marked) to this .png or .svg file.
+    /// Also draw the σ-plot (σmax of Tzw(iω) and K(iω) vs ω, peak marked) to this .png or .svg file
+    /// (one plant only).
     #[arg(long, value_name = "OUT.svg|OUT.png")]
     pub plot: Option<PathBuf>,
 }
@@ -59,6 +62,11 @@ struct CheckReport {
     /// the loop is unstable).
     peak_freqs: Vec<f64>,
     k_hinf: f64,
+    /// ‖Tzw‖₂ (+∞ for an unstable loop, or a continuous loop whose feedthrough is not zero).
+    h2: f64,
+    /// 1/r_C(A_cl), the reciprocal of the complex stability radius (continuous time; None in
+    /// discrete time).
+    inverse_radius: Option<f64>,
     /// Stability margins (`lti::stability_margin`) of A_cl and Ak: stable means α below minus it.
     margin_cl: f64,
     margin_k: f64,
@@ -74,22 +82,74 @@ impl CheckReport {
 }
 
 pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
-    let plant = Plant::load(crate::lti::resolve_plant(&a.plant)?)?;
+    let plants = a
+        .plant
+        .iter()
+        .map(|name| Ok(Plant::load(crate::lti::resolve_plant(name)?)?))
+        .collect::<anyhow::Result<Vec<Plant>>>()?;
+    if plants.len() > 1 && a.plot.is_some() {
+        anyhow::bail!("--plot draws one plant's σ-plot: give one --plant with it");
+    }
     let k = Controller::load(&a.controller)?;
-    k.check_fits(&plant).with_context(|| format!("controller {}", a.controller.display()))?;
-    let r = evaluate(&plant, &k)?;
+    for plant in &plants {
+        k.check_fits(plant)
+            .with_context(|| format!("controller {} on plant {}", a.controller.display(), plant.name))?;
+    }
+    let reports = plants.iter().map(|p| evaluate(p, &k)).collect::<anyhow::Result<Vec<_>>>()?;
+    let all_stable = reports.iter().all(CheckReport::closed_loop_stable);
+    let exit = if all_stable { ExitCode::SUCCESS } else { ExitCode::from(super::EXIT_NOT_STABILISED) };
+    if let [plant] = plants.as_slice() {
+        report_one(&a, plant, &k, &reports[0])?;
+        return Ok(exit);
+    }
+    if a.json {
+        let each: Vec<Value> = plants
+            .iter()
+            .zip(&reports)
+            .map(|(p, r)| {
+                let mut v = to_json(r);
+                v.as_object_mut().expect("an object").insert("plant".into(), json!(p.name));
+                v
+            })
+            .collect();
+        let v = json!({
+            "plants": each,
+            "closed_loop_stable": all_stable,
+            "controller_stable": reports[0].controller_stable(),
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        for (i, (p, r)) in plants.iter().zip(&reports).enumerate() {
+            print!("[{} of {}] {}", i + 1, plants.len(), human(p, &k, r));
+        }
+        let unstable: Vec<&str> = plants
+            .iter()
+            .zip(&reports)
+            .filter(|(_, r)| !r.closed_loop_stable())
+            .map(|(p, _)| p.name.as_str())
+            .collect();
+        match unstable.as_slice() {
+            [] => println!("every closed loop ({} plants) is stable", plants.len()),
+            u => println!("UNSTABLE closed loop with {}", crate::campaign::for_terminal(&u.join(", "))),
+        }
+    }
+    Ok(exit)
+}
+
+/// The report of one plant, as `check` has always printed it.
+fn report_one(a: &CheckArgs, plant: &Plant, k: &Controller, r: &CheckReport) -> anyhow::Result<()> {
     if let Some(out) = &a.plot {
         let title = format!("σ-plot: {}, controller {} (order {})", plant.name, a.controller.display(), k.order());
-        let fig = crate::campaign::plot::sigma_figure(&plant, &k, title)?;
+        let fig = crate::campaign::plot::sigma_figure(plant, k, title)?;
         crate::campaign::plot::write_by_extension(&fig, out)?;
         eprintln!("σ-plot written to {}", out.display());
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&r))?);
+        println!("{}", serde_json::to_string_pretty(&to_json(r))?);
     } else {
-        print!("{}", human(&plant, &k, &r));
+        print!("{}", human(plant, k, r));
     }
-    Ok(if r.closed_loop_stable() { ExitCode::SUCCESS } else { ExitCode::from(super::EXIT_NOT_STABILISED) })
+    Ok(())
 }
 
 fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
@@ -103,7 +163,13 @@ fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
     let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));
     let peak_freqs = crate::lti::near_peak_frequencies(domain, &cl, &h, NORM_TIE_RTOL);
+    let params = HinfParams::default();
+    let value = |o: PlantObjective| plant_value(plant, o, k, &params).map_or(f64::INFINITY, |(v, _)| v);
+    let h2 = value(PlantObjective::H2);
+    let inverse_radius = (!domain.is_discrete()).then(|| value(PlantObjective::Radius));
     let r = CheckReport {
+        h2,
+        inverse_radius,
         domain,
         alpha_cl,
         alpha_k,
@@ -137,6 +203,7 @@ fn to_json(r: &CheckReport) -> Value {
         "closed_loop_peak_freq": if r.peak_freq.is_nan() { Value::Null } else { num(r.peak_freq) },
         "closed_loop_peak_freqs": r.peak_freqs.iter().map(|&w| num(w)).collect::<Vec<_>>(),
         "k_hinf": num(r.k_hinf),
+        "h2": num(r.h2),
         "closed_loop_stable": r.closed_loop_stable(),
         "controller_stable": r.controller_stable(),
         "closed_loop_stability_margin": num(r.margin_cl),
@@ -147,6 +214,7 @@ fn to_json(r: &CheckReport) -> Value {
         TimeDomain::Continuous => {
             o.insert("closed_loop_spectral_abscissa".into(), num(r.alpha_cl));
             o.insert("controller_spectral_abscissa".into(), r.alpha_k.map(num).into());
+            o.insert("inverse_stability_radius".into(), r.inverse_radius.map(num).into());
         }
         TimeDomain::Discrete { ts } => {
             o.insert("Ts".into(), num(ts));
@@ -181,6 +249,14 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         r.margin_cl
     );
     s += &format!("             ‖Tzw‖∞  = {}   at {}\n", super::fmt_num(r.gamma, 10), freq);
+    s += &format!("             ‖Tzw‖₂  = {}\n", super::fmt_num(r.h2, 10));
+    if let Some(ir) = r.inverse_radius {
+        s += &format!(
+            "             1/r_C   = {}   (complex stability radius r_C = {})\n",
+            super::fmt_num(ir, 10),
+            super::fmt_num(1.0 / ir, 10)
+        );
+    }
     match r.alpha_k {
         Some(a) => {
             s += &format!(
@@ -236,6 +312,8 @@ mod tests {
             peak_freq: 0.0,
             peak_freqs: vec![0.0, 0.72, f64::INFINITY],
             k_hinf: 1.0,
+            h2: 1.0,
+            inverse_radius: Some(1.0),
             margin_cl: 1e-12,
             margin_k: 1e-12,
         };
@@ -256,6 +334,8 @@ mod tests {
             peak_freq: f64::NAN,
             peak_freqs: vec![],
             k_hinf: 1.5,
+            h2: f64::INFINITY,
+            inverse_radius: None,
             margin_cl: 1e-12,
             margin_k: 1e-12,
         };
@@ -275,6 +355,8 @@ mod tests {
             peak_freq: f64::INFINITY,
             peak_freqs: vec![f64::INFINITY],
             k_hinf: 1.5,
+            h2: f64::INFINITY,
+            inverse_radius: None,
             margin_cl: 1e-12,
             margin_k: 1e-12,
         };

@@ -65,7 +65,7 @@ enum Command {
     /// Check a controller on a plant: stability, ‖Tzw‖∞ and peak frequency, ‖K‖∞.
     Check(check::CheckArgs),
     /// Design one fixed-order controller (strong stabilisation by default).
-    Design(design::DesignArgs),
+    Design(Box<design::DesignArgs>),
 }
 
 /// Exit code of a run in which some jobs failed.
@@ -121,7 +121,7 @@ fn run_command_line(fake: Option<Box<dyn JobRunner>>) -> ExitCode {
         Command::Plants(a) => plants::list(a),
         Command::Plant(a) => plants::show(a),
         Command::Check(a) => check::run(a),
-        Command::Design(a) => design::run(a),
+        Command::Design(a) => design::run(*a),
     };
     match result {
         Ok(code) => code,

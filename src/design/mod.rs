@@ -15,6 +15,7 @@
 //!
 //! The modules are crate-private; what is API is re-exported here.
 pub(crate) mod central_start;
+mod components;
 mod float_serde;
 mod multi_objective;
 pub(crate) mod objective;
@@ -48,7 +49,7 @@ pub use outcome::{
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use problem::{
     plant_part, plant_value, plant_values, H2Feedthrough, PlantObjective, PlantTerm, PlantValue, Problem, ProblemError,
-    UnknownObjective, PENALTY_WEIGHT,
+    UnknownObjective, BOUND_RTOL, PENALTY_WEIGHT,
 };
 pub use run::{run, run_problem, run_with_control, run_with_structure, strongly_stabilisable, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};

@@ -19,7 +19,7 @@ use crate::lti::{
     ControllerGradient, HinfParams, LtiError,
 };
 
-use super::objective::Components;
+use super::components::Components;
 use super::problem::{plant_value, PlantObjective, Problem, PENALTY_WEIGHT};
 
 /// `acc += s·g`.
@@ -35,7 +35,8 @@ fn add_scaled(acc: &mut ControllerGradient, g: &ControllerGradient, s: f64) {
 
 /// `s·g`.
 pub(crate) fn scaled(g: &ControllerGradient, s: f64) -> ControllerGradient {
-    let mut out = Controller { ak: g.ak.clone(), bk: g.bk.clone(), ck: g.ck.clone(), dk: g.dk.clone(), domain: g.domain };
+    let mut out =
+        Controller { ak: g.ak.clone(), bk: g.bk.clone(), ck: g.ck.clone(), dk: g.dk.clone(), domain: g.domain };
     add_scaled(&mut out, g, s - 1.0);
     out
 }
@@ -108,7 +109,7 @@ pub(crate) fn performance(
     let mut penalty = 0.0;
     let mut penalty_grad: Option<ControllerGradient> = None;
     for t in &problem.terms {
-        let (g, grad) = match plant_value(t, k, params) {
+        let (g, grad) = match plant_value(&t.plant, t.objective, k, params) {
             Ok(v) => v,
             Err(LtiError::Interrupted(_)) => return Err(NoValue::Interrupted),
             Err(_) => (f64::INFINITY, k.clone()),

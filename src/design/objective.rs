@@ -46,8 +46,9 @@ use crate::lti::{
 };
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
-use super::outcome::{DesignIterRecord, DesignObserver, Phase};
+pub use super::components::Components;
 use super::multi_objective;
+use super::outcome::{DesignIterRecord, DesignObserver, Phase};
 use super::params::ControllerShape;
 use super::problem::{H2Feedthrough, Problem};
 use super::structure::Structure;
@@ -77,26 +78,6 @@ pub enum ObjectivePhase {
     Stabilisation,
     /// max(‖Tzw‖∞, ε·‖K‖∞).
     Performance,
-}
-
-/// The values behind one objective evaluation; NaN = not computed at this point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Components {
-    /// The objective value.
-    pub f: f64,
-    /// ‖Tzw‖∞.
-    pub gamma: f64,
-    /// ‖K‖∞.
-    pub k_hinf: f64,
-    /// α(Acl) (in discrete time ρ(Acl) − 1, `lti::stability_measure`).
-    pub alpha_cl: f64,
-    /// α(Ak) (ρ(Ak) − 1 in discrete time; NaN for order 0).
-    pub alpha_k: f64,
-}
-
-impl Components {
-    pub(crate) const UNKNOWN: Components =
-        Components { f: f64::NAN, gamma: f64::NAN, k_hinf: f64::NAN, alpha_cl: f64::NAN, alpha_k: f64::NAN };
 }
 
 /// Components at the most recently evaluated points (exact bitwise match on x).
