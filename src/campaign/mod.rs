@@ -36,7 +36,9 @@ mod trace_filter;
 pub use claims::unix_now;
 #[cfg(any(test, feature = "test-support"))]
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
-pub use jobs::{expand, job_id, Job, JobId, RunnerTag, JOB_ID_VERSION};
+pub use jobs::{
+    expand, job_id, problem_fingerprint, problem_job_id, Job, JobId, ProblemKey, RunnerTag, JOB_ID_VERSION,
+};
 pub use journal::{
     is_journal_name, journals_in, parse_journal, read_journal, CorruptLine, Follower, JournalError, JournalRead,
     JournalWriter, TornTail, JOURNAL_FILE,

@@ -315,7 +315,9 @@ pub fn plant_value(
         PlantObjective::H2 if plant.domain.is_discrete() => closed_loop_h2_grad_discrete(plant, k),
         PlantObjective::H2 => closed_loop_h2_grad(plant, k),
         PlantObjective::Abscissa => closed_loop_stability_grad(plant, k),
-        PlantObjective::Radius => closed_loop_inverse_stability_radius_grad(plant, k, params).map(|(n, g)| (n.value, g)),
+        PlantObjective::Radius => {
+            closed_loop_inverse_stability_radius_grad(plant, k, params).map(|(n, g)| (n.value, g))
+        }
     }
 }
 
@@ -381,6 +383,15 @@ pub fn plant_part(values: &[PlantValue]) -> (f64, f64) {
     let max = values.iter().filter(|v| v.bound.is_none()).map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max);
     let violation = values.iter().filter_map(|v| v.bound.map(|b| (v.weighted() - b).max(0.0))).sum();
     (max, violation)
+}
+
+/// The problem's γ from its plants' values: the largest weighted value w_j·g_j of the plants
+/// without a bound, of all plants if each has one (what [`super::DesignOutcome::gamma`] reports).
+pub fn problem_gamma(values: &[PlantValue]) -> f64 {
+    match plant_part(values).0 {
+        f64::NEG_INFINITY => values.iter().map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max),
+        free_max => free_max,
+    }
 }
 
 /// max that keeps a NaN.
