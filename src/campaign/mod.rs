@@ -48,13 +48,15 @@ pub use lookup::{find_record, Entry, LookupError};
 pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
 pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};
-pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
+pub use reduce::{
+    best_per_order, best_per_problem, verify, verify_problem, BestRow, PlantMap, ProblemMap, Verdict, NEAR_BEST_RTOL,
+};
 pub use reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use report::{
-    compare_rows, cost_rows, full_order_controller_stable, write_reports, CampaignAbout, CompareRow, CostRow,
+    compare_rows, cost_rows, full_order_controller_stable, write_problem_reports, write_reports, CampaignAbout, CompareRow, CostRow,
     FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
@@ -69,7 +71,7 @@ pub use spec::{
     MAX_SEEDS, MAX_THREADS,
 };
 pub use status::{
-    plant_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus, DuplicateJob,
+    plant_map, problem_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus, DuplicateJob,
     PlantStatus, RunningJob, ShardLoad,
 };
 pub use trace::{
