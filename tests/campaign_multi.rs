@@ -74,7 +74,7 @@ fn plants_parse_to_jobs_that_carry_the_problem() {
 #[test]
 fn bad_values_are_errors_at_their_key() {
     let cases: &[(&str, usize, &str)] = &[
-        ("plant = \"HE1_op1.json\"\nplants = [\"HE1_op2.json\"]\norders = [1]\n", 5, "not both"),
+        ("plant = \"HE1_op1.json\"\nplants = [\"HE1_op2.json\"]\norders = [1]\n", 6, "not both"),
         ("orders = [1]\n", 5, "needs plant"),
         ("plants = []\norders = [1]\n", 5, "at least one plant"),
         (&format!("{THREE}objectives = \"hinfinity\"\norders = [1]\n"), 6, "unknown objective"),
@@ -123,7 +123,7 @@ fn a_structure_loads_for_every_order_and_enters_the_ids() {
     assert!(e.to_string().contains("ak1.json") && e.to_string().contains("order 2"), "{e}");
 }
 
-/// The ids of the committed strong-stab campaign are the journal's (results/strong-stab), and
+/// The committed strong-stab journal's ids (results/strong-stab) are jobs of the campaign, and
 /// the smoke campaign's first job keeps the id it had before problems of several plants.
 #[test]
 fn single_plant_ids_are_unchanged() {
@@ -132,10 +132,12 @@ fn single_plant_ids_are_unchanged() {
     assert_eq!(jobs[0].id.0, "5a2a5e20881c547a3dd986b6c3fe174905f396e5be9718e4d6c9a72c6d245468", "{}", jobs[0].label());
     let c = Campaign::load(&Path::new(ROOT).join("campaigns/strong-stab.toml")).unwrap();
     let journal = read_journal(&Path::new(ROOT).join("results/strong-stab/runs.jsonl")).unwrap();
-    let journaled: BTreeSet<_> = journal.records.iter().map(|r| r.job_id.clone()).collect();
-    let jobs = expand(&c, RunnerTag::Design);
-    let missing = jobs.iter().filter(|j| !journaled.contains(&j.id)).count();
-    assert_eq!(missing, 0, "{missing} of {} strong-stab jobs have ids the journal does not know", jobs.len());
+    let ids: BTreeSet<_> = expand(&c, RunnerTag::Design).into_iter().map(|j| j.id).collect();
+    // the journal holds the campaign's first 1609 jobs (the rest not run yet): each one a job of
+    // today's expansion, so that a resume skips it
+    let unknown = journal.records.iter().filter(|r| !ids.contains(&r.job_id)).count();
+    assert!(journal.records.len() >= 1609, "{}", journal.records.len());
+    assert_eq!(unknown, 0, "{unknown} of {} journaled strong-stab jobs are not in the expansion", journal.records.len());
 }
 
 /// Each plant's journaled value, of a real two-plant run (HE1 and HE1 at another operating
