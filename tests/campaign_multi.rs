@@ -78,7 +78,11 @@ fn bad_values_are_errors_at_their_key() {
         ("orders = [1]\n", 5, "needs plant"),
         ("plants = []\norders = [1]\n", 5, "at least one plant"),
         (&format!("{THREE}objectives = \"hinfinity\"\norders = [1]\n"), 6, "unknown objective"),
-        (&format!("{THREE}objectives = [\"hinf\", \"h2\"]\norders = [1]\n"), 6, "objectives lists 2 values for 3 plants"),
+        (
+            &format!("{THREE}objectives = [\"hinf\", \"h2\"]\norders = [1]\n"),
+            6,
+            "objectives lists 2 values for 3 plants",
+        ),
         (&format!("{THREE}weights = [1.0, 1.0, 1.0, 1.0]\norders = [1]\n"), 6, "weights lists 4"),
         (&format!("{THREE}weights = [1.0, 0.0, 1.0]\norders = [1]\n"), 6, "weight 0 must be a finite number > 0"),
         (&format!("{THREE}weights = -1\norders = [1]\n"), 6, "weights: plant 1"),
@@ -137,7 +141,12 @@ fn single_plant_ids_are_unchanged() {
     // today's expansion, so that a resume skips it
     let unknown = journal.records.iter().filter(|r| !ids.contains(&r.job_id)).count();
     assert!(journal.records.len() >= 1609, "{}", journal.records.len());
-    assert_eq!(unknown, 0, "{unknown} of {} journaled strong-stab jobs are not in the expansion", journal.records.len());
+    assert_eq!(
+        unknown,
+        0,
+        "{unknown} of {} journaled strong-stab jobs are not in the expansion",
+        journal.records.len()
+    );
 }
 
 /// Each plant's journaled value, of a real two-plant run (HE1 and HE1 at another operating
@@ -187,7 +196,10 @@ fn a_two_plant_run_journals_each_plants_value() {
     let plants_csv = std::fs::read_to_string(dir.join("two/plants.csv")).unwrap();
     let lines: Vec<&str> = plants_csv.lines().collect();
     assert_eq!(lines.len(), 3, "{plants_csv}");
-    assert!(lines[0].starts_with("problem,order,objective,job_id,plant,plant_objective,weight,bound,value"), "{plants_csv}");
+    assert!(
+        lines[0].starts_with("problem,order,objective,job_id,plant,plant_objective,weight,bound,value"),
+        "{plants_csv}"
+    );
     assert!(lines[1].starts_with("HE1+HE1_op3,1,strong,") && lines[1].contains(",HE1,hinf,1,none,"), "{plants_csv}");
     let best = std::fs::read_to_string(dir.join("two/best.csv")).unwrap();
     assert!(best.lines().nth(1).is_some_and(|l| l.starts_with("HE1+HE1_op3,")), "{best}");

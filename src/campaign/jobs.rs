@@ -398,4 +398,50 @@ orders = [1]
         let warm = &jobs[4];
         assert_ne!(job_id(&warm.plant_fingerprint, &warm.options, None, RunnerTag::Design), warm.id);
     }
+
+    #[test]
+    fn problem_keys_enter_the_id_only_when_there_is_one() {
+        let c = campaign(TEXT);
+        let jobs = expand(&c, RunnerTag::Design);
+        let he1 = &jobs[0];
+        assert!(he1.multi.is_none() && he1.structure.is_none());
+        // the single-plant H∞ problem: no key, the id of the builds before
+        assert_eq!(ProblemKey::of(&he1.plant, None, None), None);
+        let id = |key: Option<&ProblemKey>| {
+            problem_job_id(&he1.plant_fingerprint, key, &he1.options, None, RunnerTag::Design)
+        };
+        assert_eq!(id(None), he1.id);
+        let p2 = &c.problems[1].plant;
+        let two = crate::design::Problem {
+            terms: vec![PlantTerm::hinf((*he1.plant).clone()), PlantTerm::hinf((**p2).clone())],
+        };
+        let base = ProblemKey::of(&he1.plant, Some(&two), None).unwrap();
+        assert_eq!(base.plants, [he1.plant.fingerprint(), p2.fingerprint()]);
+        let shape = crate::design::ControllerShape::for_plant(&he1.plant, 1);
+        let variants = [
+            ("objective", ProblemKey { objectives: vec![PlantObjective::Hinf, PlantObjective::H2], ..base.clone() }),
+            ("weight", ProblemKey { weights: vec![1.0, 2.0], ..base.clone() }),
+            ("bound", ProblemKey { bounds: vec![None, Some(3.0)], ..base.clone() }),
+            (
+                "structure",
+                ProblemKey { structure: Some(Structure::all_free(shape).entries().to_vec()), ..base.clone() },
+            ),
+            ("plants", ProblemKey { plants: vec![he1.plant.fingerprint()], ..base.clone() }),
+        ];
+        let mut ids = vec![he1.id.clone(), id(Some(&base))];
+        ids.extend(variants.iter().map(|(_, k)| id(Some(k))));
+        let distinct: std::collections::BTreeSet<_> = ids.iter().collect();
+        assert_eq!(distinct.len(), ids.len(), "{variants:?}");
+        // a structure alone makes a key
+        let s = Structure::all_free(shape);
+        let key = ProblemKey::of(&he1.plant, None, Some(&s)).unwrap();
+        assert_eq!((key.plants.len(), key.structure.as_deref()), (1, Some(s.entries())));
+        // the problem's fingerprint takes the structure file, not one order's entries
+        assert_eq!(
+            problem_fingerprint(&key, Some(b"x")),
+            problem_fingerprint(&ProblemKey { structure: None, ..key.clone() }, Some(b"x"))
+        );
+        assert_ne!(problem_fingerprint(&key, Some(b"x")), problem_fingerprint(&key, Some(b"y")));
+        assert_ne!(problem_fingerprint(&key, None), he1.plant.fingerprint());
+    }
 }

@@ -56,8 +56,8 @@ pub use reference::{
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use report::{
-    compare_rows, cost_rows, full_order_controller_stable, write_problem_reports, write_reports, CampaignAbout, CompareRow, CostRow,
-    FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+    compare_rows, cost_rows, full_order_controller_stable, write_problem_reports, write_reports, CampaignAbout,
+    CompareRow, CostRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
 pub use sanitise::for_terminal;
@@ -71,8 +71,8 @@ pub use spec::{
     MAX_SEEDS, MAX_THREADS,
 };
 pub use status::{
-    plant_map, problem_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus, DuplicateJob,
-    PlantStatus, RunningJob, ShardLoad,
+    plant_map, problem_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus,
+    DuplicateJob, PlantStatus, RunningJob, ShardLoad,
 };
 pub use trace::{
     iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,

@@ -382,6 +382,38 @@ mod tests {
         plants.iter().map(|p| (p.fingerprint(), Arc::clone(p))).collect()
     }
 
+    /// A problem of several plants is verified on each: K = 0 stabilises the stable plants, not
+    /// the unstable one, and γ is the largest weighted value.
+    #[test]
+    fn a_problem_is_verified_on_every_plant() {
+        use crate::design::PlantTerm;
+        let (p1, p2, unstable) = (plant("P1", 1.0), plant("P2", 2.0), plant_with_pole("U", 1.0, 1.0));
+        let problem = |plants: &[&Arc<Plant>], weights: &[f64]| Problem {
+            terms: plants
+                .iter()
+                .zip(weights)
+                .map(|(p, &weight)| PlantTerm { weight, ..PlantTerm::hinf((***p).clone()) })
+                .collect(),
+        };
+        let rec = record(&p1, "P1+P2", 0);
+        let Verdict::Verified { gamma, plants, .. } = verify_problem(&rec, &problem(&[&p1, &p2], &[3.0, 1.0])) else {
+            panic!("K = 0 stabilises both")
+        };
+        assert_eq!(plants.len(), 2);
+        assert!((plants[0].value - 1.0).abs() < 1e-9 && (plants[1].value - 2.0).abs() < 1e-9, "{plants:?}");
+        assert!((gamma - 3.0).abs() < 1e-9, "γ = max(3·1, 1·2) = {gamma}");
+        let Verdict::Rejected(why) = verify_problem(&rec, &problem(&[&p1, &unstable], &[1.0, 1.0])) else {
+            panic!("K = 0 does not stabilise U")
+        };
+        assert!(why.starts_with("plant U: closed loop not stable"), "{why}");
+        // best_per_problem takes the problem's γ and keeps each plant's value for plants.csv
+        let mut problems = ProblemMap::new();
+        problems.insert(rec.plant_fingerprint.clone(), Arc::new(problem(&[&p1, &p2], &[3.0, 1.0])));
+        let rows = best_per_problem(std::slice::from_ref(&rec), &PlantMap::new(), &problems);
+        assert_eq!((rows.len(), rows[0].plant.as_str(), rows[0].verified, rows[0].plants.len()), (1, "P1+P2", 1, 2));
+        assert!((rows[0].gamma - 3.0).abs() < 1e-9);
+    }
+
     #[test]
     fn two_plants_with_one_name_are_never_merged() {
         let (p1, p2) = (plant("P", 1.0), plant("P", 2.0));

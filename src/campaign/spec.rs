@@ -160,7 +160,7 @@ pub enum SpecProblem {
         /// The key the error is about (`plants`, `objectives`, `weights`, `bounds`).
         key: &'static str,
         /// Why.
-        source: ProblemError,
+        source: Box<ProblemError>,
     },
     /// `name` empty, or given to a single-plant H∞ problem without a structure (which is named by
     /// its plant).
@@ -168,7 +168,7 @@ pub enum SpecProblem {
     BadProblemName,
     /// The structure file does not load, or does not fit an order of the problem.
     #[error("{0}")]
-    Structure(StructureError),
+    Structure(Box<StructureError>),
     /// The problem's design options, as `design::validate` judges them.
     #[error("{0}")]
     Options(Box<crate::design::DesignError>),
@@ -684,7 +684,7 @@ fn resolve_terms(
             ProblemError::Bound { .. } => ("bounds", at(&bounds_span)),
             _ => ("objectives", at(&objectives_span)),
         };
-        return Err(src.error(span, SpecProblem::Problem { key, source }));
+        return Err(src.error(span, SpecProblem::Problem { key, source: Box::new(source) }));
     }
     Ok(problem)
 }
@@ -700,7 +700,7 @@ fn load_structure(
     src: &Source,
 ) -> Result<(ProblemStructure, Vec<u8>), SpecError> {
     let path = base_dir.join(arg.get_ref());
-    let fail = |e: StructureError| src.error(arg.span(), SpecProblem::Structure(e));
+    let fail = |e: StructureError| src.error(arg.span(), SpecProblem::Structure(Box::new(e)));
     let mut per_order = std::collections::BTreeMap::new();
     for &order in orders {
         let s = Structure::load(&path, ControllerShape::for_plant(plant, order)).map_err(fail)?;

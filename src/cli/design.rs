@@ -213,8 +213,7 @@ fn stabilising(problem: &Problem, opts: &DesignOptions, o: &DesignOutcome) -> bo
     }
     let k = &o.controller;
     let domain = problem.first().domain;
-    let stable =
-        |a: faer::MatRef<'_, f64>| crate::lti::is_stable_with_margin(crate::lti::stability_measure(domain, a), a);
+    let stable = |a: faer::MatRef<'_, f64>| crate::lti::is_stable_with_margin(crate::lti::stability_measure(domain, a), a);
     let loops_stable =
         problem.terms.iter().all(|t| crate::lti::closed_loop(&t.plant, k).is_ok_and(|cl| stable(cl.a.as_ref())));
     let k_stable = k.order() == 0 || stable(k.ak.as_ref());
@@ -272,9 +271,8 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     let opts = options(&a)?;
     // Bad options and an unusable --out are errors before any work (and before any file is made).
     for t in &problem.terms {
-        crate::design::validate(&t.plant, &opts, init.as_ref()).with_context(|| {
-            format!("designing an order-{} controller for {}", a.order, for_terminal(&t.plant.name))
-        })?;
+        crate::design::validate(&t.plant, &opts, init.as_ref())
+            .with_context(|| format!("designing an order-{} controller for {}", a.order, for_terminal(&t.plant.name)))?;
     }
     for t in &problem.terms {
         if let Err(e) = crate::design::strongly_stabilisable(&t.plant, &opts) {
@@ -421,7 +419,11 @@ pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
     for (i, v) in values.iter().enumerate() {
         let bound = match v.bound {
             None => String::new(),
-            Some(b) => format!("   bound {} {}", fmt_num(b, 6), if v.bound_met() { "met" } else { "VIOLATED" }),
+            Some(b) => format!(
+                "   bound {} {}",
+                fmt_num(b, 6),
+                if v.bound_met() { "met" } else { "VIOLATED" }
+            ),
         };
         s += &format!(
             "plant {} {}: {} = {}   weight {} → {}{}   s(A_cl) = {:+.4e}\n",

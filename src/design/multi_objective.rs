@@ -35,8 +35,7 @@ fn add_scaled(acc: &mut ControllerGradient, g: &ControllerGradient, s: f64) {
 
 /// `s·g`.
 pub(crate) fn scaled(g: &ControllerGradient, s: f64) -> ControllerGradient {
-    let mut out =
-        Controller { ak: g.ak.clone(), bk: g.bk.clone(), ck: g.ck.clone(), dk: g.dk.clone(), domain: g.domain };
+    let mut out = Controller { ak: g.ak.clone(), bk: g.bk.clone(), ck: g.ck.clone(), dk: g.dk.clone(), domain: g.domain };
     add_scaled(&mut out, g, s - 1.0);
     out
 }

@@ -46,8 +46,8 @@ use crate::lti::{
 };
 use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
 
-use super::multi_objective;
 use super::outcome::{DesignIterRecord, DesignObserver, Phase};
+use super::multi_objective;
 use super::params::ControllerShape;
 use super::problem::{H2Feedthrough, Problem};
 use super::structure::Structure;

@@ -315,9 +315,7 @@ pub fn plant_value(
         PlantObjective::H2 if plant.domain.is_discrete() => closed_loop_h2_grad_discrete(plant, k),
         PlantObjective::H2 => closed_loop_h2_grad(plant, k),
         PlantObjective::Abscissa => closed_loop_stability_grad(plant, k),
-        PlantObjective::Radius => {
-            closed_loop_inverse_stability_radius_grad(plant, k, params).map(|(n, g)| (n.value, g))
-        }
+        PlantObjective::Radius => closed_loop_inverse_stability_radius_grad(plant, k, params).map(|(n, g)| (n.value, g)),
     }
 }
 
@@ -388,9 +386,11 @@ pub fn plant_part(values: &[PlantValue]) -> (f64, f64) {
 /// The problem's γ from its plants' values: the largest weighted value w_j·g_j of the plants
 /// without a bound, of all plants if each has one (what [`super::DesignOutcome::gamma`] reports).
 pub fn problem_gamma(values: &[PlantValue]) -> f64 {
-    match plant_part(values).0 {
-        f64::NEG_INFINITY => values.iter().map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max),
-        free_max => free_max,
+    let free_max = plant_part(values).0;
+    if free_max == f64::NEG_INFINITY {
+        values.iter().map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max)
+    } else {
+        free_max
     }
 }
 
