@@ -2,7 +2,7 @@
 //! with a controller structure (`structure`), campaigns/FORMAT.md "Several plants": the file
 //! parses to jobs that carry the problem; each bad value is an error at its key; the ids of
 //! single-plant campaigns are those of the builds before; a real two-plant run journals each
-//! plant's value, which an independent recomputation confirms, and reports them in plants.csv.
+//! plant's value, which an independent recomputation confirms, and reports them in plants.csv and tables.tex.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -10,6 +10,8 @@ use std::process::Command;
 
 use hinfix::campaign::{expand, read_journal, Campaign, RunnerTag, SpecError};
 use hinfix::design::{plant_values, PlantObjective};
+
+mod common;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -201,6 +203,12 @@ fn a_two_plant_run_journals_each_plants_value() {
         "{plants_csv}"
     );
     assert!(lines[1].starts_with("HE1+HE1_op3,1,strong,") && lines[1].contains(",HE1,hinf,1,none,"), "{plants_csv}");
+    let tex = std::fs::read_to_string(dir.join("two/tables.tex")).unwrap();
+    assert!(
+        tex.contains("one controller for several plants") && tex.contains("1 & strong & HE1\\_op3 & hinf & 2.000 &"),
+        "{tex}"
+    );
+    common::latex_structure(&tex).unwrap();
     let best = std::fs::read_to_string(dir.join("two/best.csv")).unwrap();
     assert!(best.lines().nth(1).is_some_and(|l| l.starts_with("HE1+HE1_op3,")), "{best}");
 }
