@@ -10,6 +10,12 @@
 //! new jobs instead of mixing results. Cosmetic changes (plant name, file formatting, problem
 //! order in the file) keep the ids.
 //!
+//! A problem of several plants, or with another objective, weight or bound than H∞, 1, none, or
+//! with a controller structure, adds a [`ProblemKey`] to the document: every plant's
+//! fingerprint, objective, weight and bound, and the entries of the structure of the job's order.
+//! The single-plant H∞ problem without a structure leaves it out, so its ids are those of the
+//! builds before several plants.
+//!
 //! Warm start: with `warm_start = true`, order k of a (plant, ε, seed) chain starts from the
 //! controller of the next lower order of the same chain (the paper did this for AC10; the paper
 //! took the best controller over all runs, here the chain stays within one seed so that a job
@@ -22,7 +28,7 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use super::model::Campaign;
-use crate::design::DesignOptions;
+use crate::design::{DesignOptions, PlantObjective, PlantTerm, Structure};
 use crate::lti::Plant;
 
 /// Version of the id recipe; bump it if the hashed document changes meaning.
@@ -66,12 +72,17 @@ pub struct Job {
     pub index: usize,
     /// Index of its problem in the campaign.
     pub problem: usize,
-    /// Plant name (from the plant file).
+    /// Plant name (from the plant file), or the name of a problem of several plants.
     pub plant_name: String,
-    /// The plant.
+    /// The plant (the first plant of a problem of several).
     pub plant: Arc<Plant>,
-    /// Its fingerprint.
+    /// Its fingerprint (the problem's, [`super::model::Problem::fingerprint`]).
     pub plant_fingerprint: String,
+    /// The problem of several plants (or another objective, weight or bound); `None`: the
+    /// single-plant H∞ problem of `plant`.
+    pub multi: Option<Arc<crate::design::Problem>>,
+    /// The controller structure of the job's order, if the problem has one.
+    pub structure: Option<Arc<Structure>>,
     /// Full options of the run, including order, ε, seed and cpumax.
     pub options: DesignOptions,
     /// The job whose controller this one starts from (warm-start chains).
@@ -102,11 +113,68 @@ struct IdDoc<'a> {
     warm_from: Option<&'a str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     runner: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    problem: Option<&'a ProblemKey>,
 }
 
-/// The id of a job with these inputs.
+/// What a job id holds of a problem other than the single-plant H∞ one (module docs): per plant,
+/// in the order of the campaign file, its fingerprint, objective, weight and bound; and the
+/// entries of the structure (column-major Ak, Bk, Ck, Dk; `null` = free), if any.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProblemKey {
+    /// [`Plant::fingerprint`] of each plant.
+    pub plants: Vec<String>,
+    /// Each plant's objective.
+    pub objectives: Vec<PlantObjective>,
+    /// Each plant's weight.
+    pub weights: Vec<f64>,
+    /// Each plant's bound (`null`: none).
+    pub bounds: Vec<Option<f64>>,
+    /// The structure's entries for the job's order.
+    pub structure: Option<Vec<Option<f64>>>,
+}
+
+impl ProblemKey {
+    /// The key of `multi` (else the single-plant H∞ problem of `plant`) with `structure`; `None`
+    /// for the single-plant H∞ problem without a structure, whose ids have no key.
+    pub fn of(plant: &Plant, multi: Option<&crate::design::Problem>, structure: Option<&Structure>) -> Option<Self> {
+        if multi.is_none() && structure.is_none() {
+            return None;
+        }
+        let single = [PlantTerm::hinf(plant.clone())];
+        let terms = multi.map_or(&single[..], |p| &p.terms[..]);
+        Some(ProblemKey {
+            plants: terms.iter().map(|t| t.plant.fingerprint()).collect(),
+            objectives: terms.iter().map(|t| t.objective).collect(),
+            weights: terms.iter().map(|t| t.weight).collect(),
+            bounds: terms.iter().map(|t| t.bound).collect(),
+            structure: structure.map(|s| s.entries().to_vec()),
+        })
+    }
+}
+
+/// SHA-256 (hex) of a document's canonical JSON: serde_json writes struct fields in declaration
+/// order and floats in shortest round-trip form.
+fn digest_hex<T: Serialize>(doc: &T) -> String {
+    let bytes = serde_json::to_vec(doc).expect("id document serialises");
+    Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The id of a job of the single-plant H∞ problem with these inputs.
 pub fn job_id(plant_fingerprint: &str, options: &DesignOptions, warm_from: Option<&JobId>, runner: RunnerTag) -> JobId {
-    let doc = IdDoc {
+    problem_job_id(plant_fingerprint, None, options, warm_from, runner)
+}
+
+/// The id of a job with these inputs; `problem`: the [`ProblemKey`] of any other problem (None
+/// is [`job_id`]).
+pub fn problem_job_id(
+    plant_fingerprint: &str,
+    problem: Option<&ProblemKey>,
+    options: &DesignOptions,
+    warm_from: Option<&JobId>,
+    runner: RunnerTag,
+) -> JobId {
+    JobId(digest_hex(&IdDoc {
         recipe: "hinfix-job",
         version: JOB_ID_VERSION,
         plant: plant_fingerprint,
@@ -116,12 +184,24 @@ pub fn job_id(plant_fingerprint: &str, options: &DesignOptions, warm_from: Optio
             RunnerTag::Design => None,
             RunnerTag::Fake => Some("fake"),
         },
-    };
-    // serde_json writes struct fields in declaration order and floats in shortest round-trip
-    // form, so this document is canonical.
-    let bytes = serde_json::to_vec(&doc).expect("id document serialises");
-    let digest = Sha256::digest(&bytes);
-    JobId(digest.iter().map(|b| format!("{b:02x}")).collect())
+        problem,
+    }))
+}
+
+/// The identity of a problem other than the single-plant H∞ one without a structure
+/// ([`super::model::Problem::fingerprint`]): the SHA-256 of its plants' fingerprints,
+/// objectives, weights and bounds ([`ProblemKey`] without a structure) and the SHA-256 of the
+/// structure file's bytes, if any. Its journal records and report rows are grouped by it.
+pub fn problem_fingerprint(key: &ProblemKey, structure_file: Option<&[u8]>) -> String {
+    #[derive(Serialize)]
+    struct Doc<'a> {
+        recipe: &'static str,
+        key: &'a ProblemKey,
+        structure_file: Option<String>,
+    }
+    let key = ProblemKey { structure: None, ..key.clone() };
+    let structure_file = structure_file.map(|b| Sha256::digest(b).iter().map(|b| format!("{b:02x}")).collect());
+    digest_hex(&Doc { recipe: "hinfix-problem", key: &key, structure_file })
 }
 
 /// Expands a campaign into its jobs (see the module docs for the order and the chains).
@@ -131,6 +211,11 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
         let ns = p.seeds.len();
         // the job of the previous order at each (ε, seed), by position in p.eps × p.seeds
         let mut prev_order: Vec<Option<JobId>> = vec![None; p.eps.len() * ns];
+        let keys: std::collections::BTreeMap<usize, Option<ProblemKey>> = p
+            .orders
+            .iter()
+            .map(|&o| (o, ProblemKey::of(&p.plant, p.multi.as_deref(), structure_of(p, o).as_deref())))
+            .collect();
         for &order in &p.orders {
             // the jobs of this order so far, by the same position
             let mut this_order: Vec<Option<JobId>> = vec![None; p.eps.len() * ns];
@@ -150,15 +235,18 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
                     if continued {
                         continuation_options(&mut options, p.continued_cpumax);
                     }
-                    let id = job_id(&p.fingerprint, &options, warm_from.as_ref(), runner);
+                    let key = keys.get(&order).and_then(Option::as_ref);
+                    let id = problem_job_id(&p.fingerprint, key, &options, warm_from.as_ref(), runner);
                     this_order[chain] = Some(id.clone());
                     jobs.push(Job {
                         id,
                         index: jobs.len(),
                         problem: pi,
-                        plant_name: p.plant.name.clone(),
+                        plant_name: p.name.clone(),
                         plant: p.plant.clone(),
                         plant_fingerprint: p.fingerprint.clone(),
+                        multi: p.multi.clone(),
+                        structure: structure_of(p, order),
                         options,
                         warm_from,
                         runner,
@@ -169,6 +257,11 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
         }
     }
     jobs
+}
+
+/// The structure of `order` of problem `p`, if it has one.
+fn structure_of(p: &super::model::Problem, order: usize) -> Option<Arc<Structure>> {
+    p.structure.as_ref().and_then(|s| s.per_order.get(&order).cloned())
 }
 
 /// The options of an ε-continued job: its CPU budget `continued_cpumax` (if given), and as first
@@ -304,5 +397,51 @@ orders = [1]
         assert_ne!(job_id(&he1.plant_fingerprint, &he1.options, None, RunnerTag::Fake), he1.id);
         let warm = &jobs[4];
         assert_ne!(job_id(&warm.plant_fingerprint, &warm.options, None, RunnerTag::Design), warm.id);
+    }
+
+    #[test]
+    fn problem_keys_enter_the_id_only_when_there_is_one() {
+        let c = campaign(TEXT);
+        let jobs = expand(&c, RunnerTag::Design);
+        let he1 = &jobs[0];
+        assert!(he1.multi.is_none() && he1.structure.is_none());
+        // the single-plant H∞ problem: no key, the id of the builds before
+        assert_eq!(ProblemKey::of(&he1.plant, None, None), None);
+        let id = |key: Option<&ProblemKey>| {
+            problem_job_id(&he1.plant_fingerprint, key, &he1.options, None, RunnerTag::Design)
+        };
+        assert_eq!(id(None), he1.id);
+        let p2 = &c.problems[1].plant;
+        let two = crate::design::Problem {
+            terms: vec![PlantTerm::hinf((*he1.plant).clone()), PlantTerm::hinf((**p2).clone())],
+        };
+        let base = ProblemKey::of(&he1.plant, Some(&two), None).unwrap();
+        assert_eq!(base.plants, [he1.plant.fingerprint(), p2.fingerprint()]);
+        let shape = crate::design::ControllerShape::for_plant(&he1.plant, 1);
+        let variants = [
+            ("objective", ProblemKey { objectives: vec![PlantObjective::Hinf, PlantObjective::H2], ..base.clone() }),
+            ("weight", ProblemKey { weights: vec![1.0, 2.0], ..base.clone() }),
+            ("bound", ProblemKey { bounds: vec![None, Some(3.0)], ..base.clone() }),
+            (
+                "structure",
+                ProblemKey { structure: Some(Structure::all_free(shape).entries().to_vec()), ..base.clone() },
+            ),
+            ("plants", ProblemKey { plants: vec![he1.plant.fingerprint()], ..base.clone() }),
+        ];
+        let mut ids = vec![he1.id.clone(), id(Some(&base))];
+        ids.extend(variants.iter().map(|(_, k)| id(Some(k))));
+        let distinct: std::collections::BTreeSet<_> = ids.iter().collect();
+        assert_eq!(distinct.len(), ids.len(), "{variants:?}");
+        // a structure alone makes a key
+        let s = Structure::all_free(shape);
+        let key = ProblemKey::of(&he1.plant, None, Some(&s)).unwrap();
+        assert_eq!((key.plants.len(), key.structure.as_deref()), (1, Some(s.entries())));
+        // the problem's fingerprint takes the structure file, not one order's entries
+        assert_eq!(
+            problem_fingerprint(&key, Some(b"x")),
+            problem_fingerprint(&ProblemKey { structure: None, ..key.clone() }, Some(b"x"))
+        );
+        assert_ne!(problem_fingerprint(&key, Some(b"x")), problem_fingerprint(&key, Some(b"y")));
+        assert_ne!(problem_fingerprint(&key, None), he1.plant.fingerprint());
     }
 }

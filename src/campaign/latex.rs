@@ -98,7 +98,46 @@ pub fn tables_tex_about(
         if !cost.is_empty() {
             s.push_str(&cost_table(p, &cost));
         }
+        let several: Vec<&BestRow> = best.iter().filter(|r| r.plant == p && !r.plants.is_empty()).collect();
+        if !several.is_empty() {
+            s.push_str(&plants_table(p, &several));
+        }
     }
+    s
+}
+
+/// The plants of a problem of several plants (`rows`: its best rows with their plants' values):
+/// per n_K (highest first) and design objective, each plant's objective, weight, bound, value
+/// g_j and closed-loop stability measure for the row's best controller
+/// (`tab:hinfix-<problem>-plants`).
+pub fn plants_table(p: &str, rows: &[&BestRow]) -> String {
+    let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
+    let _ = writeln!(
+        s,
+        "\\caption{{{}: one controller for several plants. Per order $n_K$ and objective, each plant's objective $g_j$ (hinf: $\\|T_{{zw}}\\|_\\infty$, h2: $\\|T_{{zw}}\\|_2$, abscissa: $\\alpha(A_{{cl}})$, radius: $1/r_C$), weight $w_j$, bound $b_j$, value $g_j$ recomputed from the best re-verified controller, and its closed loop's stability measure; $\\gamma$ is the largest $w_j g_j$ of the plants without a bound.}}",
+        escape(p)
+    );
+    let _ = writeln!(s, "\\label{{tab:hinfix-{}-plants}}", label_key(p));
+    s.push_str("\\begin{tabular}{rllllrrr}\n\\toprule\n$n_K$ & objective & plant & $g_j$ & $w_j$ & $b_j$ & value & stability \\\\\n\\midrule\n");
+    let mut sorted = rows.to_vec();
+    sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
+    for r in sorted {
+        for v in &r.plants {
+            let bound = v.bound.map_or_else(|| "--".to_string(), sig4);
+            let _ = writeln!(
+                s,
+                "{} & {} & {} & {} & {} & {bound} & {} & {} \\\\",
+                r.order,
+                r.objective.name(),
+                escape(&v.plant),
+                v.objective.name(),
+                sig4(v.weight),
+                sig4(v.value),
+                sig4(v.alpha_cl)
+            );
+        }
+    }
+    s.push_str("\\bottomrule\n\\end{tabular}\n\\end{table}\n\n");
     s
 }
 

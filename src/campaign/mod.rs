@@ -36,7 +36,9 @@ mod trace_filter;
 pub use claims::unix_now;
 #[cfg(any(test, feature = "test-support"))]
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
-pub use jobs::{expand, job_id, Job, JobId, RunnerTag, JOB_ID_VERSION};
+pub use jobs::{
+    expand, job_id, problem_fingerprint, problem_job_id, Job, JobId, ProblemKey, RunnerTag, JOB_ID_VERSION,
+};
 pub use journal::{
     is_journal_name, journals_in, parse_journal, read_journal, CorruptLine, Follower, JournalError, JournalRead,
     JournalWriter, TornTail, JOURNAL_FILE,
@@ -46,14 +48,16 @@ pub use lookup::{find_record, Entry, LookupError};
 pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
 pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};
-pub use reduce::{best_per_order, verify, BestRow, PlantMap, Verdict, NEAR_BEST_RTOL};
+pub use reduce::{
+    best_per_order, best_per_problem, verify, verify_problem, BestRow, PlantMap, ProblemMap, Verdict, NEAR_BEST_RTOL,
+};
 pub use reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use report::{
-    compare_rows, cost_rows, full_order_controller_stable, write_reports, CampaignAbout, CompareRow, CostRow,
-    FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+    compare_rows, cost_rows, full_order_controller_stable, write_problem_reports, write_reports, CampaignAbout,
+    CompareRow, CostRow, FullOrderRow, ReportError, ReportSummary, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
 pub use sanitise::for_terminal;
@@ -67,8 +71,8 @@ pub use spec::{
     MAX_SEEDS, MAX_THREADS,
 };
 pub use status::{
-    plant_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus, DuplicateJob,
-    PlantStatus, RunningJob, ShardLoad,
+    plant_map, problem_map, report, shard_plan, status, CampaignReport, CampaignReportError, CampaignStatus,
+    DuplicateJob, PlantStatus, RunningJob, ShardLoad,
 };
 pub use trace::{
     iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,

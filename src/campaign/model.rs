@@ -1,11 +1,12 @@
 //! The validated campaign: what [`super::spec`] builds from a campaign file and
 //! [`super::jobs::expand`] turns into jobs. Below both, so neither imports the other's types.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::trace_filter::TraceLevel;
-use crate::design::DesignOptions;
+use crate::design::{DesignOptions, Structure};
 use crate::lti::Plant;
 
 /// Default number of worker threads (`--threads` and `defaults.threads` override it).
@@ -57,14 +58,27 @@ pub struct Campaign {
 /// One `[[problem]]` entry, resolved.
 #[derive(Debug, Clone)]
 pub struct Problem {
-    /// The `plant` value as written.
+    /// The `plant` value as written (the first of `plants`).
     pub plant_arg: String,
     /// The plant file it resolved to.
     pub plant_path: PathBuf,
-    /// The loaded plant.
+    /// The loaded plant (the first of `plants`: it gives the controller's sizes and the
+    /// starting points).
     pub plant: Arc<Plant>,
-    /// [`Plant::fingerprint`] (part of every job id).
+    /// The problem's identity in job ids and journal records: [`Plant::fingerprint`] of a
+    /// single-plant H∞ problem without a structure (as it always was), else
+    /// [`crate::campaign::problem_fingerprint`] of the plants, their objectives, weights and
+    /// bounds and the structure file.
     pub fingerprint: String,
+    /// The problem's name in tables, the journal's `plant` and job labels: the plant's name, or
+    /// for several plants the `name` key (default: their names joined with `+`).
+    pub name: String,
+    /// Several plants, or an objective, weight or bound other than H∞, 1, none: every plant with
+    /// its objective, weight and bound (`design::Problem`). `None`: the single-plant H∞ problem of
+    /// `plant`.
+    pub multi: Option<Arc<crate::design::Problem>>,
+    /// The controller structure (`structure` key), loaded for each order of the problem.
+    pub structure: Option<ProblemStructure>,
     /// Controller orders, ascending, distinct.
     pub orders: Vec<usize>,
     /// Weights ε, in file order, distinct.
@@ -86,6 +100,15 @@ pub struct Problem {
     pub trace: TraceLevel,
     /// Where the problem's `plant` key is (for messages about the problem).
     pub location: Location,
+}
+
+/// A problem's `structure` key: the file, and the structure it gives each order of the problem.
+#[derive(Debug, Clone)]
+pub struct ProblemStructure {
+    /// The file, resolved against the campaign file's folder.
+    pub path: PathBuf,
+    /// The structure for each order of the problem.
+    pub per_order: BTreeMap<usize, Arc<Structure>>,
 }
 
 impl Campaign {

@@ -13,6 +13,12 @@
 //! that share a name are never merged, and a renamed plant keeps its results (shown under its
 //! current name). Two plants of one name in one report are told apart as `name@<8 hex digits>`.
 //!
+//! A problem of several plants (a `plants` key, or another objective, weight or bound) is
+//! verified on every plant ([`verify_problem`]): each closed loop stable with the margin, the
+//! controller stable for a strong job, and each plant's value g_j recomputed
+//! (`design::plant_values`); its γ is then the problem's (`design::problem_gamma`: the largest
+//! weighted value of the plants without a bound).
+//!
 //! Several records of one job id (a job run twice, e.g. by two folders merged with
 //! `--journal`) count once: its best re-verified record.
 
@@ -20,7 +26,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::record::JobRecord;
-use crate::design::ObjectiveKind;
+use crate::design::{plant_values, problem_gamma, ObjectiveKind, PlantValue, Problem};
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm_in, is_stable_with_margin, stability_margin, stability_measure,
     HinfParams, Plant, DEFAULT_HINF_TOL,
@@ -29,6 +35,10 @@ use crate::lti::{
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
 /// them.
 pub type PlantMap = BTreeMap<String, Arc<Plant>>;
+
+/// Problems of several plants (or another objective, weight or bound) by their fingerprint (the
+/// journal's `plant_fingerprint` of their jobs).
+pub type ProblemMap = BTreeMap<String, Arc<Problem>>;
 
 /// Display names of plants given as (fingerprint, name) pairs: the name, or `name@<first 8 hex
 /// digits of the fingerprint>` when several fingerprints share it.
@@ -63,6 +73,8 @@ pub enum Verdict {
         k_hinf: f64,
         /// Whether the controller is stable with the margin (always for a strong job).
         controller_stable: bool,
+        /// Each plant's recomputed value, for a problem of several plants (empty for one).
+        plants: Vec<PlantValue>,
     },
     /// Not counted, with the reason.
     Rejected(String),
@@ -101,7 +113,42 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
         return Verdict::Rejected(format!("γ not finite ({gamma})"));
     }
     let k_hinf = controller_hinf_grad(k, DEFAULT_HINF_TOL).0.value;
-    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf, controller_stable }
+    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf, controller_stable, plants: Vec::new() }
+}
+
+/// Re-verifies one record's controller against every plant of `problem` ([`verify`] on each, a
+/// rejection naming the plant), with each plant's value recomputed: γ is the problem's
+/// (`design::problem_gamma`), α(A_cl) the largest.
+pub fn verify_problem(record: &JobRecord, problem: &Problem) -> Verdict {
+    let mut alpha_cl = f64::NEG_INFINITY;
+    let mut first = None;
+    for t in &problem.terms {
+        match verify(record, &t.plant) {
+            Verdict::Rejected(why) => return Verdict::Rejected(format!("plant {}: {why}", t.plant.name)),
+            Verdict::Verified { alpha_cl: a, alpha_k, k_hinf, controller_stable, .. } => {
+                alpha_cl = alpha_cl.max(a);
+                first.get_or_insert((alpha_k, k_hinf, controller_stable));
+            }
+        }
+    }
+    let (Some((alpha_k, k_hinf, controller_stable)), Some(k)) = (first, record.controller()) else {
+        return Verdict::Rejected("no plant".into());
+    };
+    let plants = plant_values(problem, k, DEFAULT_HINF_TOL);
+    let gamma = problem_gamma(&plants);
+    if !gamma.is_finite() {
+        return Verdict::Rejected(format!("γ not finite ({gamma})"));
+    }
+    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf, controller_stable, plants }
+}
+
+/// A record verified against its plant (`plants`) or its problem of several plants (`problems`);
+/// `None` when neither holds its fingerprint.
+fn verify_any(r: &JobRecord, plants: &PlantMap, problems: &ProblemMap) -> Option<Verdict> {
+    match problems.get(&r.plant_fingerprint) {
+        Some(p) => Some(verify_problem(r, p)),
+        None => plants.get(&r.plant_fingerprint).map(|p| verify(r, p)),
+    }
 }
 
 /// Relative distance to the best γ within which a replicate counts as reaching it
@@ -164,6 +211,10 @@ pub struct BestRow {
     /// `strong`, and what a `plain` row's γ cost; empty when no job verified.
     #[serde(default)]
     pub controller_stable: Option<bool>,
+    /// Each plant's recomputed value for the best controller of a problem of several plants
+    /// (empty for one plant). Not a column of best.csv: plants.csv holds them.
+    #[serde(skip)]
+    pub plants: Vec<PlantValue>,
 }
 
 /// Best γ per (plant, order, objective), sorted by plant label, order, then objective (strong
@@ -171,6 +222,12 @@ pub struct BestRow {
 /// from `plants` count as runs that failed verification; duplicate records of a job count once,
 /// by their best verified one.
 pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> {
+    best_per_problem(records, plants, &ProblemMap::new())
+}
+
+/// [`best_per_order`], with the problems of several plants of `problems` (their records are
+/// verified by [`verify_problem`], their rows named by the journal's `plant`).
+pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &ProblemMap) -> Vec<BestRow> {
     let labels = plant_labels(records.iter().map(|r| {
         let name = plants.get(&r.plant_fingerprint).map_or(r.plant.as_str(), |p| p.name.as_str());
         (r.plant_fingerprint.as_str(), name)
@@ -178,7 +235,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
     // job id → (record, verified figures) of its best record
     let mut per_job: BTreeMap<&str, (&JobRecord, Option<Verdict>)> = BTreeMap::new();
     for r in records {
-        let verdict = plants.get(&r.plant_fingerprint).map(|p| verify(r, p)).filter(|v| v.gamma().is_some());
+        let verdict = verify_any(r, plants, problems).filter(|v| v.gamma().is_some());
         let better = |old: &Option<Verdict>| match (verdict.as_ref().and_then(Verdict::gamma), old) {
             (Some(g), Some(o)) => o.gamma().is_some_and(|o| g < o),
             (Some(_), None) => true,
@@ -214,7 +271,8 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
         });
         row.runs += 1;
         match verdict {
-            &Some(Verdict::Verified { gamma, alpha_k, k_hinf, controller_stable, .. }) => {
+            Some(Verdict::Verified { gamma, alpha_k, k_hinf, controller_stable, plants, .. }) => {
+                let (gamma, alpha_k, k_hinf, controller_stable) = (*gamma, *alpha_k, *k_hinf, *controller_stable);
                 row.verified += 1;
                 gammas.push(gamma);
                 if !(gamma >= row.gamma) {
@@ -225,6 +283,7 @@ pub fn best_per_order(records: &[JobRecord], plants: &PlantMap) -> Vec<BestRow> 
                     row.k_hinf = Some(k_hinf);
                     row.alpha_k = alpha_k;
                     row.controller_stable = Some(controller_stable);
+                    row.plants = plants.clone();
                     row.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
                     row.chain_cpu_to_best_s = row.cpu_to_best_s.zip(chain_cpu_before(r)).map(|(t, before)| t + before);
                 }
@@ -263,6 +322,7 @@ impl BestRow {
             unverified: 0,
             objective: ObjectiveKind::Strong,
             controller_stable: None,
+            plants: Vec::new(),
         }
     }
 }
@@ -320,6 +380,38 @@ mod tests {
 
     fn map(plants: &[&Arc<Plant>]) -> PlantMap {
         plants.iter().map(|p| (p.fingerprint(), Arc::clone(p))).collect()
+    }
+
+    /// A problem of several plants is verified on each: K = 0 stabilises the stable plants, not
+    /// the unstable one, and γ is the largest weighted value.
+    #[test]
+    fn a_problem_is_verified_on_every_plant() {
+        use crate::design::PlantTerm;
+        let (p1, p2, unstable) = (plant("P1", 1.0), plant("P2", 2.0), plant_with_pole("U", 1.0, 1.0));
+        let problem = |plants: &[&Arc<Plant>], weights: &[f64]| Problem {
+            terms: plants
+                .iter()
+                .zip(weights)
+                .map(|(p, &weight)| PlantTerm { weight, ..PlantTerm::hinf((***p).clone()) })
+                .collect(),
+        };
+        let rec = record(&p1, "P1+P2", 0);
+        let Verdict::Verified { gamma, plants, .. } = verify_problem(&rec, &problem(&[&p1, &p2], &[3.0, 1.0])) else {
+            panic!("K = 0 stabilises both")
+        };
+        assert_eq!(plants.len(), 2);
+        assert!((plants[0].value - 1.0).abs() < 1e-9 && (plants[1].value - 2.0).abs() < 1e-9, "{plants:?}");
+        assert!((gamma - 3.0).abs() < 1e-9, "γ = max(3·1, 1·2) = {gamma}");
+        let Verdict::Rejected(why) = verify_problem(&rec, &problem(&[&p1, &unstable], &[1.0, 1.0])) else {
+            panic!("K = 0 does not stabilise U")
+        };
+        assert!(why.starts_with("plant U: closed loop not stable"), "{why}");
+        // best_per_problem takes the problem's γ and keeps each plant's value for plants.csv
+        let mut problems = ProblemMap::new();
+        problems.insert(rec.plant_fingerprint.clone(), Arc::new(problem(&[&p1, &p2], &[3.0, 1.0])));
+        let rows = best_per_problem(std::slice::from_ref(&rec), &PlantMap::new(), &problems);
+        assert_eq!((rows.len(), rows[0].plant.as_str(), rows[0].verified, rows[0].plants.len()), (1, "P1+P2", 1, 2));
+        assert!((rows[0].gamma - 3.0).abs() < 1e-9);
     }
 
     #[test]

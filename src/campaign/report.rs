@@ -1,6 +1,7 @@
 //! The campaign's report files, written atomically (tmp in the same directory, fsync, rename):
 //! `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`, and `strong_vs_plain.csv` when the
-//! campaign ran both objectives on a (plant, n_K). Pure functions of journal records,
+//! campaign ran both objectives on a (plant, n_K), and `plants.csv` when it ran a problem of
+//! several plants ([`PlantsCsv`]: one row per plant of each best controller). Pure functions of journal records,
 //! the plants and the paper's reference rows, so `campaign report` reruns without jobs.
 //!
 //! The rows themselves (ours against the paper's, the full-order bound) are computed by
@@ -13,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use super::latex;
 use super::record::JobRecord;
-use super::reduce::{best_per_order, BestRow};
+use super::reduce::{best_per_problem, BestRow, ProblemMap};
 use super::reference::ReferenceRow;
 use super::sanitise::{for_csv, for_terminal};
 
@@ -124,6 +125,54 @@ struct CompareCsv {
     objective: &'static str,
 }
 
+/// One row of `plants.csv`: a plant of a problem of several plants (or another objective,
+/// weight or bound), with its recomputed value for the best controller of the problem's
+/// (problem, order, objective) row of best.csv.
+#[derive(serde::Serialize)]
+struct PlantsCsv {
+    /// The problem's name (best.csv's `plant`).
+    problem: String,
+    order: usize,
+    /// The design objective (`strong` or `plain`), as best.csv's `objective`.
+    objective: &'static str,
+    job_id: String,
+    /// The plant's name.
+    plant: String,
+    /// Its objective: hinf, h2, abscissa or radius.
+    plant_objective: &'static str,
+    weight: String,
+    /// Its bound, or "none".
+    bound: String,
+    /// g_j, unweighted.
+    value: String,
+    /// w_j·g_j.
+    weighted: String,
+    /// Whether w_j·g_j ≤ b_j (true without a bound).
+    bound_met: bool,
+    /// The closed loop's stability measure (α, or ρ − 1 in discrete time).
+    alpha_cl: String,
+}
+
+/// The rows of `plants.csv` (none for a campaign of single-plant H∞ problems).
+fn plants_rows(best: &[BestRow]) -> Vec<PlantsCsv> {
+    let rows = best.iter().flat_map(|b| b.plants.iter().map(move |v| (b, v)));
+    rows.map(|(b, v)| PlantsCsv {
+        problem: for_csv(&b.plant),
+        order: b.order,
+        objective: b.objective.name(),
+        job_id: b.job_id.clone().unwrap_or_default(),
+        plant: for_csv(&v.plant),
+        plant_objective: v.objective.name(),
+        weight: csv_num(v.weight),
+        bound: v.bound.map_or_else(|| "none".to_string(), csv_num),
+        value: csv_num(v.value),
+        weighted: csv_num(v.weighted()),
+        bound_met: v.bound_met(),
+        alpha_cl: csv_num(v.alpha_cl),
+    })
+    .collect()
+}
+
 /// A number cell: non-finite values as "inf", "-inf", "nan", as in best.csv and every JSON file
 /// (builds before left the cell empty).
 fn csv_num(x: f64) -> String {
@@ -138,8 +187,21 @@ pub fn write_reports(
     plants: &BTreeMap<String, std::sync::Arc<crate::lti::Plant>>,
     reference: &[ReferenceRow],
 ) -> Result<ReportSummary, ReportError> {
+    write_problem_reports(out_dir, records, plants, &ProblemMap::new(), reference)
+}
+
+/// [`write_reports`] with the campaign's problems of several plants (`problems`, by
+/// fingerprint): their rows are verified on every plant, and `plants.csv` gives each plant's
+/// value.
+pub fn write_problem_reports(
+    out_dir: &Path,
+    records: &[JobRecord],
+    plants: &BTreeMap<String, std::sync::Arc<crate::lti::Plant>>,
+    problems: &ProblemMap,
+    reference: &[ReferenceRow],
+) -> Result<ReportSummary, ReportError> {
     std::fs::create_dir_all(out_dir).map_err(|source| ReportError::Io { path: out_dir.to_path_buf(), source })?;
-    let best = best_per_order(records, plants);
+    let best = best_per_problem(records, plants, problems);
     let full = full_order_rows(&best, plants, reference);
     let compare = compare_rows(&best, &full, reference);
     let mut files = Vec::new();
@@ -160,6 +222,13 @@ pub fn write_reports(
         let p = out_dir.join("strong_vs_plain.csv");
         let rows = costs.iter().map(|c| CostRow { plant: for_csv(&c.plant), ..c.clone() });
         write_atomic(&p, &csv_bytes(&p, rows)?)?;
+        files.push(p);
+    }
+
+    let per_plant = plants_rows(&best);
+    if !per_plant.is_empty() {
+        let p = out_dir.join("plants.csv");
+        write_atomic(&p, &csv_bytes(&p, per_plant)?)?;
         files.push(p);
     }
 

@@ -68,13 +68,30 @@ where
 }
 
 /// The production runner (a [`JobRunner`] as every such function is): [`crate::design::run`]
-/// with the job's plant and options.
+/// with the job's plant and options; a job of several plants (or another objective, or a
+/// structure) is [`crate::design::run_problem`] of its problem and structure, with the run
+/// control `design::run` makes (the job's `cpumax` and the observer's cancel flag).
 pub fn design_job(
     job: &Job,
     init: Option<&Controller>,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
-    crate::design::run(&job.plant, &job.options, init, obs)
+    if job.multi.is_none() && job.structure.is_none() {
+        return crate::design::run(&job.plant, &job.options, init, obs);
+    }
+    let single;
+    let problem = match &job.multi {
+        Some(p) => p.as_ref(),
+        None => {
+            single = crate::design::Problem::single((*job.plant).clone());
+            &single
+        }
+    };
+    let mut ctl = crate::optim::RunControl::new(job.options.cpumax);
+    if let Some(flag) = obs.cancel_flag() {
+        ctl = ctl.with_cancel(flag);
+    }
+    crate::design::run_problem(problem, &job.options, init, job.structure.as_deref(), &ctl, obs)
 }
 
 /// What [`Coordinator::claim`] found.

@@ -9,6 +9,12 @@
 //! ([`crate::lti::resolve_plant`]); a relative path (contains `/` or ends in `.json`) is relative
 //! to the campaign file's folder. Per-problem keys override `[defaults]`, which override
 //! [`DesignOptions::default`].
+//!
+//! A problem names one plant (`plant`) or several (`plants`, one controller for all), each with
+//! its objective, weight and bound (`objectives`, `weights`, `bounds`: one value for every plant
+//! or a list of one per plant), and optionally a controller structure (`structure`); these keys
+//! are per problem only. Their values are judged by `design::Problem::validate` and
+//! `design::Structure::load` before any job starts.
 
 use std::fmt;
 use std::ops::Range;
@@ -19,9 +25,13 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
-pub use super::model::{Campaign, Location, Problem, DEFAULT_THREADS};
+use super::jobs::{problem_fingerprint, ProblemKey};
+pub use super::model::{Campaign, Location, Problem, ProblemStructure, DEFAULT_THREADS};
 use super::trace_filter::TraceLevel;
-use crate::design::{DesignOptions, OptionValue};
+use crate::design::{
+    ControllerShape, DesignOptions, OptionValue, PlantObjective, PlantTerm, ProblemError, Structure, StructureError,
+    UnknownObjective,
+};
 use crate::lti::Plant;
 
 /// Largest controller order accepted in a campaign file (a typo guard, far above the paper's 8).
@@ -117,6 +127,48 @@ pub enum SpecProblem {
     /// The plant could not be found or loaded.
     #[error("{0}")]
     Plant(Box<crate::lti::PlantError>),
+    /// A `[[problem]]` with neither `plant` nor `plants`.
+    #[error("a [[problem]] needs plant = \"…\" (one plant) or plants = [\"…\", …] (several plants, one controller)")]
+    MissingPlant,
+    /// Both `plant` and `plants`.
+    #[error("give either plant (one plant) or plants (a list), not both")]
+    PlantAndPlants,
+    /// `plants = []`.
+    #[error("plants must list at least one plant")]
+    NoPlants,
+    /// A per-plant list (`objectives`, `weights`, `bounds`) of another length than `plants`.
+    #[error(
+        "{key} lists {found} values for {plants} plants: give one value for every plant, or a list of one per plant"
+    )]
+    PerPlantLength {
+        /// The key.
+        key: &'static str,
+        /// Its number of values.
+        found: usize,
+        /// The number of plants.
+        plants: usize,
+    },
+    /// An objective name that is not hinf, h2, abscissa or radius.
+    #[error("objectives: {0}")]
+    UnknownObjective(UnknownObjective),
+    /// A bound that is a string other than "none".
+    #[error("bounds: {0:?} is not a number or \"none\"")]
+    BadBound(String),
+    /// The plants, objectives, weights and bounds as `design::Problem::validate` judges them.
+    #[error("{key}: {source}")]
+    Problem {
+        /// The key the error is about (`plants`, `objectives`, `weights`, `bounds`).
+        key: &'static str,
+        /// Why.
+        source: Box<ProblemError>,
+    },
+    /// `name` empty, or given to a single-plant H∞ problem without a structure (which is named by
+    /// its plant).
+    #[error("name must be non-empty, and is for a problem of several plants, another objective, weight or bound, or a structure (a single plant is named by its plant file)")]
+    BadProblemName,
+    /// The structure file does not load, or does not fit an order of the problem.
+    #[error("{0}")]
+    Structure(Box<StructureError>),
     /// The problem's design options, as `design::validate` judges them.
     #[error("{0}")]
     Options(Box<crate::design::DesignError>),
@@ -178,11 +230,18 @@ macro_rules! campaign_settings {
             threads: Option<Spanned<usize>>,
         }
 
-        /// One `[[problem]]`: its plant and orders, then the settings.
+        /// One `[[problem]]`: its plant(s), their objectives, weights and bounds, its structure
+        /// and orders, then the settings.
         #[derive(Debug, Deserialize)]
         #[serde(deny_unknown_fields)]
         struct RawProblem {
-            plant: Spanned<String>,
+            plant: Option<Spanned<String>>,
+            plants: Option<Spanned<Vec<Spanned<String>>>>,
+            name: Option<Spanned<String>>,
+            objectives: Option<Spanned<PerPlant<String>>>,
+            weights: Option<Spanned<PerPlant<Number>>>,
+            bounds: Option<Spanned<PerPlant<BoundValue>>>,
+            structure: Option<Spanned<String>>,
             orders: Spanned<Orders>,
             #[serde(default)]
             warm_start: bool,
@@ -251,6 +310,39 @@ struct RawCampaign {
     defaults: RawDefaults,
     #[serde(default, rename = "problem")]
     problems: Vec<RawProblem>,
+}
+
+/// A per-plant key: one value for every plant, or a list of one per plant.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum PerPlant<T> {
+    One(T),
+    List(Vec<T>),
+}
+
+/// A number, integers accepted.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+enum Number {
+    F(f64),
+    I(i64),
+}
+
+impl Number {
+    fn value(self) -> f64 {
+        match self {
+            Number::F(x) => x,
+            Number::I(i) => i as f64,
+        }
+    }
+}
+
+/// A bound: a number, or "none".
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum BoundValue {
+    Number(Number),
+    Text(String),
 }
 
 /// `orders = 3`, `orders = [1, 2, 4]` or `orders = { from = 1, to = 8 }` (inclusive).
@@ -466,19 +558,43 @@ fn check_threads(threads: Option<&Spanned<usize>>, src: &Source) -> Result<Optio
 }
 
 /// Step 3: one `[[problem]]` — its settings layered over `[defaults]`, its lists checked, its
-/// plant loaded and its options judged.
+/// plants loaded and its options judged (for each plant), its plants' objectives, weights and
+/// bounds judged, its structure loaded for each order.
 fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Source) -> Result<Problem, SpecError> {
     let settings = Layered::new(p, d);
     let eps = check_eps(&settings.eps, src)?;
     let seeds = check_seeds(&settings.seeds, src)?;
     let orders = check_orders(&p.orders, src)?;
     let base = settings.options();
-    let (plant_path, plant) = load_plant(&p.plant, base_dir, src)?;
-    check_options(&plant, &base, &orders, &eps, &settings, p, src)?;
+    let args = plant_args(p, src)?;
+    let mut paths = Vec::with_capacity(args.len());
+    let mut plants = Vec::with_capacity(args.len());
+    for a in &args {
+        let (path, plant) = load_plant(a, base_dir, src)?;
+        paths.push(path);
+        plants.push(plant);
+    }
+    for plant in &plants {
+        check_options(plant, &base, &orders, &eps, &settings, p, src)?;
+    }
+    let problem = resolve_terms(p, &args, plants, src)?;
+    let plant = problem.first().clone();
+    let multi = (!problem.is_single_hinf()).then(|| Arc::new(problem));
+    let structure = p.structure.as_ref().map(|s| load_structure(s, &plant, &orders, base_dir, src)).transpose()?;
+    let name = problem_name(p, &plant, multi.as_deref(), structure.is_some(), src)?;
+    // any order's structure: the fingerprint takes the file, not one order's entries
+    let some_structure = structure.as_ref().and_then(|(s, _)| s.per_order.values().next().map(Arc::as_ref));
+    let fingerprint = match ProblemKey::of(&plant, multi.as_deref(), some_structure) {
+        None => plant.fingerprint(),
+        Some(key) => problem_fingerprint(&key, structure.as_ref().map(|(_, bytes)| bytes.as_slice())),
+    };
     Ok(Problem {
-        plant_arg: p.plant.get_ref().clone(),
-        plant_path,
-        fingerprint: plant.fingerprint(),
+        plant_arg: args[0].get_ref().clone(),
+        plant_path: paths.swap_remove(0),
+        fingerprint,
+        name,
+        multi,
+        structure: structure.map(|(s, _)| s),
         plant: Arc::new(plant),
         orders,
         eps,
@@ -488,8 +604,133 @@ fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Sourc
         continued_cpumax: settings.continued_cpumax.as_ref().map(|(x, _)| *x),
         base,
         trace: settings.trace.as_ref().map(|(t, _)| *t).unwrap_or_default(),
-        location: Location::of_offset(src.text, p.plant.span().start),
+        location: Location::of_offset(src.text, plant_span(p).start),
     })
+}
+
+/// Where a problem's plants are named (`plant` or `plants`; `orders` if neither is given).
+fn plant_span(p: &RawProblem) -> Range<usize> {
+    match (&p.plant, &p.plants) {
+        (Some(a), _) => a.span(),
+        (None, Some(list)) => list.span(),
+        (None, None) => p.orders.span(),
+    }
+}
+
+/// Step 3e: the plant arguments, from `plant` or `plants` (exactly one of them).
+fn plant_args(p: &RawProblem, src: &Source) -> Result<Vec<Spanned<String>>, SpecError> {
+    match (&p.plant, &p.plants) {
+        (Some(one), None) => Ok(vec![one.clone()]),
+        (None, Some(list)) if list.get_ref().is_empty() => Err(src.error(list.span(), SpecProblem::NoPlants)),
+        (None, Some(list)) => Ok(list.get_ref().clone()),
+        (Some(_), Some(list)) => Err(src.error(list.span(), SpecProblem::PlantAndPlants)),
+        (None, None) => Err(src.error(p.orders.span(), SpecProblem::MissingPlant)),
+    }
+}
+
+/// A per-plant key's values for `n` plants (`default` for each when it is not given) and its
+/// span.
+fn per_plant<T: Clone>(
+    value: &Option<Spanned<PerPlant<T>>>,
+    n: usize,
+    key: &'static str,
+    default: T,
+    src: &Source,
+) -> Result<(Vec<T>, Option<Range<usize>>), SpecError> {
+    let Some(v) = value else { return Ok((vec![default; n], None)) };
+    let values = match v.get_ref() {
+        PerPlant::One(x) => vec![x.clone(); n],
+        PerPlant::List(list) if list.len() == n => list.clone(),
+        PerPlant::List(list) => {
+            return Err(src.error(v.span(), SpecProblem::PerPlantLength { key, found: list.len(), plants: n }))
+        }
+    };
+    Ok((values, Some(v.span())))
+}
+
+/// Step 3h: the plants with their objectives, weights and bounds, judged by
+/// `design::Problem::validate`; an error points at the key it is about (a plant's channels or
+/// time domain: that plant).
+fn resolve_terms(
+    p: &RawProblem,
+    args: &[Spanned<String>],
+    plants: Vec<Plant>,
+    src: &Source,
+) -> Result<crate::design::Problem, SpecError> {
+    let n = plants.len();
+    let (objectives, objectives_span) = per_plant(&p.objectives, n, "objectives", "hinf".to_string(), src)?;
+    let (weights, weights_span) = per_plant(&p.weights, n, "weights", Number::F(1.0), src)?;
+    let (bounds, bounds_span) = per_plant(&p.bounds, n, "bounds", BoundValue::Text("none".into()), src)?;
+    let at = |span: &Option<Range<usize>>| span.clone().unwrap_or_else(|| plant_span(p));
+    let mut terms = Vec::with_capacity(n);
+    for (((plant, objective), weight), bound) in plants.into_iter().zip(&objectives).zip(&weights).zip(&bounds) {
+        let objective = objective
+            .parse::<PlantObjective>()
+            .map_err(|e| src.error(at(&objectives_span), SpecProblem::UnknownObjective(e)))?;
+        let bound = match bound {
+            BoundValue::Number(b) => Some(b.value()),
+            BoundValue::Text(t) if t == "none" => None,
+            BoundValue::Text(t) => return Err(src.error(at(&bounds_span), SpecProblem::BadBound(t.clone()))),
+        };
+        terms.push(PlantTerm { plant, objective, weight: weight.value(), bound });
+    }
+    let problem = crate::design::Problem { terms };
+    if let Err(source) = problem.validate() {
+        let (key, span) = match &source {
+            ProblemError::Channels { index, .. } | ProblemError::Domain { index, .. } => {
+                ("plants", args[index - 1].span())
+            }
+            ProblemError::Weight { .. } => ("weights", at(&weights_span)),
+            ProblemError::Bound { .. } => ("bounds", at(&bounds_span)),
+            _ => ("objectives", at(&objectives_span)),
+        };
+        return Err(src.error(span, SpecProblem::Problem { key, source: Box::new(source) }));
+    }
+    Ok(problem)
+}
+
+/// Step 3i: the structure file (a path, relative to the campaign file's folder), loaded for each
+/// order of the problem (`design::Structure::load`: it must fit each), and the file's bytes (for
+/// the problem's fingerprint).
+fn load_structure(
+    arg: &Spanned<String>,
+    plant: &Plant,
+    orders: &[usize],
+    base_dir: &Path,
+    src: &Source,
+) -> Result<(ProblemStructure, Vec<u8>), SpecError> {
+    let path = base_dir.join(arg.get_ref());
+    let fail = |e: StructureError| src.error(arg.span(), SpecProblem::Structure(Box::new(e)));
+    let mut per_order = std::collections::BTreeMap::new();
+    for &order in orders {
+        let s = Structure::load(&path, ControllerShape::for_plant(plant, order)).map_err(fail)?;
+        per_order.insert(order, Arc::new(s));
+    }
+    let bytes = std::fs::read(&path)
+        .map_err(|e| fail(StructureError::Io { file: path.display().to_string(), message: e.to_string() }))?;
+    Ok((ProblemStructure { path, per_order }, bytes))
+}
+
+/// Step 3j: the problem's name: `name`, else the plants' names joined with `+` (one plant: its
+/// name). `name` is refused on the single-plant H∞ problem without a structure, named by its
+/// plant in every report.
+fn problem_name(
+    p: &RawProblem,
+    plant: &Plant,
+    multi: Option<&crate::design::Problem>,
+    structured: bool,
+    src: &Source,
+) -> Result<String, SpecError> {
+    match &p.name {
+        Some(n) if n.get_ref().is_empty() || (multi.is_none() && !structured) => {
+            Err(src.error(n.span(), SpecProblem::BadProblemName))
+        }
+        Some(n) => Ok(n.get_ref().clone()),
+        None => Ok(multi.map_or_else(
+            || plant.name.clone(),
+            |m| m.terms.iter().map(|t| t.plant.name.as_str()).collect::<Vec<_>>().join("+"),
+        )),
+    }
 }
 
 /// A setting's value and the span it was read from.
@@ -546,14 +787,14 @@ fn check_orders(orders: &Spanned<Orders>, src: &Source) -> Result<Vec<usize>, Sp
     Ok(sorted)
 }
 
-/// Step 3e: the plant, resolved ([`resolve_plant_arg`]) and loaded; errors point at `plant`.
+/// Step 3f: the plant, resolved ([`resolve_plant_arg`]) and loaded; errors point at `plant`.
 fn load_plant(plant: &Spanned<String>, base_dir: &Path, src: &Source) -> Result<(PathBuf, Plant), SpecError> {
     let path = resolve_plant_arg(plant.get_ref(), base_dir).map_err(|m| src.error(plant.span(), m))?;
     let loaded = Plant::load(&path).map_err(|e| src.error(plant.span(), SpecProblem::Plant(Box::new(e))))?;
     Ok((path, loaded))
 }
 
-/// Step 3f: the very check `design` makes, for the largest order (the only option that depends
+/// Step 3g: the very check `design` makes, for the largest order (the only option that depends
 /// on the order is order ≤ n) and every ε, before any job starts; the error points at the value
 /// of the field it names, else at `plant`.
 fn check_options(
@@ -580,7 +821,7 @@ fn check_options(
                     crate::design::DesignError::Options { field, .. } => settings.span_of(field),
                     _ => None,
                 };
-                return Err(src.error(span.unwrap_or(p.plant.span()), SpecProblem::Options(Box::new(err))));
+                return Err(src.error(span.unwrap_or(plant_span(p)), SpecProblem::Options(Box::new(err))));
             }
         }
     }
@@ -594,7 +835,7 @@ fn check_job_count(problems: &[Problem], raw: &[RawProblem], src: &Source) -> Re
         let n = p.orders.len().saturating_mul(p.eps.len()).saturating_mul(p.seeds.len());
         total = total.saturating_add(n);
         if total > MAX_JOBS {
-            return Err(src.error(raw_p.plant.span(), SpecProblem::TooManyJobs));
+            return Err(src.error(plant_span(raw_p), SpecProblem::TooManyJobs));
         }
     }
     Ok(())
@@ -613,7 +854,7 @@ fn check_unique_jobs(campaign: &Campaign) -> Result<(), SpecError> {
                 location: p.location,
                 message: SpecProblem::RepeatedJob {
                     first_line: campaign.problems[first].location.line,
-                    plant: p.plant.name.clone(),
+                    plant: p.name.clone(),
                     order: j.options.order,
                     eps: j.options.eps,
                     seed: j.options.seed,

@@ -5,16 +5,18 @@
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use super::claims::{ClaimDir, ClaimError, ClaimOwner};
 use super::jobs::{Job, JobId};
 use super::model::Campaign;
 use super::record::JobRecord;
-use super::reduce::{plant_labels, PlantMap};
+use super::reduce::{plant_labels, PlantMap, ProblemMap};
 use super::reference::{load_default_reference, ReferenceError};
-use super::report::{write_reports, ReportError, ReportSummary};
+use super::report::{write_problem_reports, ReportError, ReportSummary};
 use super::run::duplicate_ids;
 use super::shard;
+use crate::lti::Plant;
 
 /// The jobs of one plant (or of the whole campaign, [`CampaignStatus::total`]).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -190,15 +192,30 @@ pub struct CampaignReport {
     pub duplicates: Vec<(JobId, usize)>,
 }
 
-/// The campaign's plants by content fingerprint (their identity in records).
+/// The campaign's plants by content fingerprint (their identity in records): each single-plant
+/// problem's plant (named as the problem, when a structure gives it a fingerprint of its own).
+/// Problems of several plants are in [`problem_map`].
 pub fn plant_map(c: &Campaign) -> PlantMap {
-    c.problems.iter().map(|p| (p.fingerprint.clone(), p.plant.clone())).collect()
+    let plant = |p: &super::model::Problem| {
+        if p.plant.name == p.name {
+            p.plant.clone()
+        } else {
+            Arc::new(Plant { name: p.name.clone(), ..(*p.plant).clone() })
+        }
+    };
+    c.problems.iter().filter(|p| p.multi.is_none()).map(|p| (p.fingerprint.clone(), plant(p))).collect()
+}
+
+/// The campaign's problems of several plants (or another objective, weight or bound) by their
+/// fingerprint.
+pub fn problem_map(c: &Campaign) -> ProblemMap {
+    c.problems.iter().filter_map(|p| Some((p.fingerprint.clone(), p.multi.clone()?))).collect()
 }
 
 /// Reduces `records` (the campaign's, duplicates included) to the report files in `dir`
 /// (best.csv, tables.tex, compare.csv/.tex).
 pub fn report(dir: &Path, c: &Campaign, records: &[JobRecord]) -> Result<CampaignReport, CampaignReportError> {
     let reference = load_default_reference().map_err(CampaignReportError::Reference)?;
-    let summary = write_reports(dir, records, &plant_map(c), &reference)?;
+    let summary = write_problem_reports(dir, records, &plant_map(c), &problem_map(c), &reference)?;
     Ok(CampaignReport { summary, duplicates: duplicate_ids(records) })
 }

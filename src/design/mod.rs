@@ -48,8 +48,8 @@ pub use outcome::{
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use problem::{
-    plant_part, plant_value, plant_values, H2Feedthrough, PlantObjective, PlantTerm, PlantValue, Problem, ProblemError,
-    UnknownObjective, BOUND_RTOL, PENALTY_WEIGHT,
+    plant_part, plant_value, plant_values, problem_gamma, H2Feedthrough, PlantObjective, PlantTerm, PlantValue,
+    Problem, ProblemError, UnknownObjective, BOUND_RTOL, PENALTY_WEIGHT,
 };
 pub use run::{run, run_problem, run_with_control, run_with_structure, strongly_stabilisable, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};

@@ -391,6 +391,17 @@ pub fn plant_part(values: &[PlantValue]) -> (f64, f64) {
     (max, violation)
 }
 
+/// The problem's γ from its plants' values: the largest weighted value w_j·g_j of the plants
+/// without a bound, of all plants if each has one (what [`super::DesignOutcome::gamma`] reports).
+pub fn problem_gamma(values: &[PlantValue]) -> f64 {
+    let free_max = plant_part(values).0;
+    if free_max == f64::NEG_INFINITY {
+        values.iter().map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max)
+    } else {
+        free_max
+    }
+}
+
 /// max that keeps a NaN.
 pub(crate) fn nan_max(a: f64, b: f64) -> f64 {
     if a.is_nan() || b.is_nan() {

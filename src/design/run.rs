@@ -22,7 +22,7 @@ use super::outcome::{
     Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
-use super::problem::{nan_max, plant_part, plant_values, PlantValue, Problem, PENALTY_WEIGHT};
+use super::problem::{nan_max, plant_part, plant_values, problem_gamma, PlantValue, Problem, PENALTY_WEIGHT};
 use super::scaling::variable_scaling;
 use super::search::{ScaledObjectives, Search};
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
@@ -272,11 +272,7 @@ pub fn run_problem(
 /// max(γ, ε‖K‖∞) plus the penalty of violated bounds.
 fn problem_figures(fig: &mut Figures, values: &[PlantValue], opts: &DesignOptions) {
     let (free_max, violation) = plant_part(values);
-    fig.gamma = if free_max == f64::NEG_INFINITY {
-        values.iter().map(PlantValue::weighted).fold(f64::NEG_INFINITY, nan_max)
-    } else {
-        free_max
-    };
+    fig.gamma = problem_gamma(values);
     fig.alpha_cl = values.iter().map(|v| v.alpha_cl).fold(f64::NEG_INFINITY, nan_max);
     let k_term = match opts.objective {
         ObjectiveKind::Strong => opts.eps * fig.k_hinf,
