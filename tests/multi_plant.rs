@@ -43,10 +43,12 @@ fn design(problem: &Problem, o: &DesignOptions, s: Option<&Structure>) -> Result
     run_problem(problem, o, None, s, &RunControl::new(o.cpumax), &mut NoDesignObserver)
 }
 
-/// HE1 with D11 = D12·X·D21 (X = [0.3; −0.2]): a continuous H2 objective then fixes Dk = −X
-/// (D12 is invertible and D21 has rank 1 = p2, so the set of feedthroughs is one point).
+/// HE1 with D21 = [0.5, 1] (HE1's is 0) and D11 = D12·X·D21 (X = [0.3; −0.2]): a continuous H2
+/// objective then fixes Dk = −X (D12 is invertible and D21 has rank 1 = p2, so the set of
+/// feedthroughs is one point).
 fn he1_with_feedthrough() -> Plant {
     let mut p = Plant::load(resolve_plant("HE1").unwrap()).unwrap();
+    p.d21 = faer::mat![[0.5, 1.0]];
     let x = faer::mat![[0.3], [-0.2]];
     p.d11 = &p.d12 * &x * &p.d21;
     p.name = "HE1-D11".into();
