@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
 """Compare the two sides of results/budget-comparison (same head jobs, stall rule vs spending
-the whole 300-s budget) as a Markdown table: per (plant, order, seed) γ and CPU seconds of each.
+the whole 300-s budget) as a Markdown table: per (plant, order, seed) γ and CPU seconds of each;
+then, if the quarter-budget run (budget-quarter/) is there, each protocol entry's best γ at a
+quarter of the per-run budget against the paper's value and the full protocol's best.
 
-    python3 scripts/budget_comparison.py results/budget-comparison
+    python3 scripts/budget_comparison.py results/budget-comparison [results/strong-stab]
 """
+import csv
 import json
 import os
 import sys
@@ -20,8 +23,37 @@ def jobs(path):
     return out
 
 
+def rows(path):
+    with open(path, encoding="utf-8") as f:
+        return {(r["plant"], int(r["order"])): r for r in csv.DictReader(f)}
+
+
+def quarter(root, full_root):
+    """The quarter-budget table: per entry, paper, full protocol, quarter budget, ratio."""
+    q_dir = os.path.join(root, "budget-quarter")
+    if not os.path.exists(os.path.join(q_dir, "compare.csv")):
+        return
+    q = rows(os.path.join(q_dir, "compare.csv"))
+    full = rows(os.path.join(full_root, "compare.csv"))
+    q_jobs = jobs(os.path.join(q_dir, "runs.jsonl"))
+    print("\n| plant | n_K | paper | full protocol | quarter budget | quarter/paper |")
+    print("|---|---:|---:|---:|---:|---:|")
+    at_or_below = 0
+    for key in sorted(q):
+        r = q[key]
+        paper = float(r["paper"])
+        ours = float(r["ours"])
+        ratio = ours / paper
+        at_or_below += ratio <= 1 + 1e-3
+        print(f"| {key[0]} | {key[1]} | {paper:.4g} | {float(full[key]['ours']):.4g} | {ours:.4g} | {ratio:.4f} |")
+    cpu = sum(r["cpu_s"] for r in q_jobs.values())
+    print(f"\nQuarter budget: {at_or_below} of {len(q)} entries at or below paper·(1 + 1e-3); "
+          f"{len(q_jobs)} jobs, {cpu / 3600:.2f} CPU h.")
+
+
 def main():
     root = sys.argv[1]
+    full_root = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(os.path.abspath(root)), "strong-stab")
     stall = jobs(os.path.join(root, "budget-stall", "runs.jsonl"))
     spend = jobs(os.path.join(root, "budget-spend", "runs.jsonl"))
     print("| plant | n_K | seed | γ stall rule | CPU s | γ whole budget | CPU s | spend/stall |")
@@ -37,6 +69,7 @@ def main():
     cpu_a = sum(r["cpu_s"] for r in stall.values())
     cpu_b = sum(r["cpu_s"] for r in spend.values())
     print(f"\nCPU: stall rule {cpu_a:.0f} s over {len(stall)} jobs; whole budget {cpu_b:.0f} s over {len(spend)} jobs.")
+    quarter(root, full_root)
 
 
 if __name__ == "__main__":

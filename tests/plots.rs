@@ -177,6 +177,16 @@ fn plant_names_never_share_or_overflow_figure_files() {
     assert!(files.contains(&"gamma-vs-order_X_1.png".to_string()), "{files:?}");
 }
 
+/// The trimmed texts of an SVG's `<text>` elements.
+fn svg_texts(svg: &str) -> Vec<String> {
+    let doc = roxmltree::Document::parse(svg).unwrap();
+    doc.descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .filter_map(|n| n.text())
+        .map(|t| t.trim().to_string())
+        .collect()
+}
+
 fn it(phase: &str, start: usize, iteration: usize, f: f64, t: f64) -> TraceIteration {
     TraceIteration { phase: phase.into(), start, iteration, f, elapsed_cpu_s: t }
 }
@@ -197,6 +207,21 @@ fn convergence_marks_phases_and_restarts_and_renders() {
     let p = Path::new("synthetic.png");
     check_png(&png_bytes(&fig, p).unwrap(), "convergence");
     check_svg(&svg_text(&fig, p).unwrap(), "convergence");
+
+    assert!(fig.shows_stabilisation());
+    let texts = svg_texts(&svg_text(&fig, p).unwrap());
+    assert!(texts.iter().any(|t| t == "stabilisation objective (first local search)"), "{texts:?}");
+
+    // A warm start that already stabilises: no stabilisation panel (it would be an empty sliver).
+    let mut warm = vec![it("stabilisation", 0, 0, -0.01, 0.001), it("stabilisation", 0, 1, -0.02, 0.002)];
+    warm.extend((0..20).map(|i| it("optimisation", 0, i, 2.0 / (1.0 + i as f64), 0.01 + 0.01 * i as f64)));
+    let warm = ConvergenceFigure { title: "warm".into(), iterations: warm };
+    assert!(!warm.shows_stabilisation());
+    let svg = svg_text(&warm, p).unwrap();
+    check_svg(&svg, "warm-started convergence");
+    let texts = svg_texts(&svg);
+    assert!(!texts.iter().any(|t| t.contains("stabilisation")), "{texts:?}");
+    assert!(texts.iter().any(|t| t == "local searches (thinned)"), "{texts:?}");
 
     // No CPU clock (the test runner's traces): drawn against the iteration count.
     let flat = ConvergenceFigure {
@@ -250,13 +275,7 @@ fn gamma_vs_order_labels_its_whole_range_and_the_bound() {
     assert!(fig.log_axis());
     let svg = svg_text(&fig, Path::new("g.svg")).unwrap();
     check_svg(&svg, "own");
-    let doc = roxmltree::Document::parse(&svg).unwrap();
-    let texts: Vec<String> = doc
-        .descendants()
-        .filter(|n| n.has_tag_name("text"))
-        .filter_map(|n| n.text())
-        .map(|t| t.trim().to_string())
-        .collect();
+    let texts = svg_texts(&svg);
     for label in
         ["3", "5", "20", "γ_opt = 2.5", "full-order bound γ_opt = 2.5", "ours, plain objective (K may be unstable)"]
     {

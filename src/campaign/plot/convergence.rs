@@ -8,7 +8,9 @@
 //! The stabilisation phase minimises max(α(A_cl), ε·α(A_K)), which ends below zero, while the
 //! later phases minimise max(‖T_zw‖∞, ε‖K‖∞) > 0: the first local search's stabilisation is drawn
 //! in a lower panel of its own (the upper one logarithmic when the objective spans more than a
-//! decade). A trace whose CPU clock never advanced (the test runner's) is drawn against the
+//! decade), when there is something to show: a search whose first start already stabilises (a
+//! warm start from a stabilising controller, as every continued job of a campaign has) has no
+//! lower panel. A trace whose CPU clock never advanced (the test runner's) is drawn against the
 //! iteration count.
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
@@ -118,6 +120,13 @@ impl ConvergenceFigure {
             }
         }
         runs
+    }
+
+    /// Whether the figure has the stabilisation panel: the first local search's stabilisation
+    /// starts at a point that does not stabilise (objective ≥ 0). From a stabilising start the
+    /// phase is a few messages below zero in a millisecond, an empty-looking panel.
+    pub fn shows_stabilisation(&self) -> bool {
+        self.panel_runs(true).first().and_then(|r| r.points.first()).is_some_and(|p| p.1 >= 0.0)
     }
 
     /// x range of a panel: the whole run for the objective; for the stabilisation panel only
@@ -364,7 +373,7 @@ impl Figure for ConvergenceFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let has_stab = self.iterations.iter().any(|it| it.phase == STABILISATION && it.f.is_finite());
         let has_opt = self.iterations.iter().any(|it| it.phase != STABILISATION && it.f.is_finite());
-        match (has_stab, has_opt) {
+        match (has_stab && (self.shows_stabilisation() || !has_opt), has_opt) {
             (true, true) => {
                 let (upper, lower) = root.split_vertically((root.dim_in_pixel().1 as f64 * 0.68) as u32);
                 self.panel_auto(&upper, false, Some(&self.title))?;
