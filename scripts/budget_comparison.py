@@ -35,7 +35,8 @@ def quarter(root, full_root):
         return
     q = rows(os.path.join(q_dir, "compare.csv"))
     full = rows(os.path.join(full_root, "compare.csv"))
-    q_jobs = jobs(os.path.join(q_dir, "runs.jsonl"))
+    with open(os.path.join(q_dir, "runs.jsonl"), encoding="utf-8") as f:
+        q_jobs = [json.loads(line) for line in f if line.strip()]
     print("\n| plant | n_K | paper | full protocol | quarter budget | quarter/paper |")
     print("|---|---:|---:|---:|---:|---:|")
     at_or_below = 0
@@ -46,7 +47,7 @@ def quarter(root, full_root):
         ratio = ours / paper
         at_or_below += ratio <= 1 + 1e-3
         print(f"| {key[0]} | {key[1]} | {paper:.4g} | {float(full[key]['ours']):.4g} | {ours:.4g} | {ratio:.4f} |")
-    cpu = sum(r["cpu_s"] for r in q_jobs.values())
+    cpu = sum(r["cpu_s"] for r in q_jobs)
     print(f"\nQuarter budget: {at_or_below} of {len(q)} entries at or below paper·(1 + 1e-3); "
           f"{len(q_jobs)} jobs, {cpu / 3600:.2f} CPU h.")
 
