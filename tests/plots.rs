@@ -206,10 +206,11 @@ fn convergence_marks_phases_and_restarts_and_renders() {
     assert_eq!(restarts, vec![(0.03 + 0.01 * 19.0, "start 2".to_string())]);
     let p = Path::new("synthetic.png");
     check_png(&png_bytes(&fig, p).unwrap(), "convergence");
-    check_svg(&svg_text(&fig, p).unwrap(), "convergence");
+    let svg = svg_text(&fig, p).unwrap();
+    check_svg(&svg, "convergence");
 
     assert!(fig.shows_stabilisation());
-    let texts = svg_texts(&svg_text(&fig, p).unwrap());
+    let texts = svg_texts(&svg);
     assert!(texts.iter().any(|t| t == "stabilisation objective (first local search)"), "{texts:?}");
 
     // A warm start that already stabilises: no stabilisation panel (it would be an empty sliver).

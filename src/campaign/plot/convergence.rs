@@ -373,7 +373,9 @@ impl Figure for ConvergenceFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let has_stab = self.iterations.iter().any(|it| it.phase == STABILISATION && it.f.is_finite());
         let has_opt = self.iterations.iter().any(|it| it.phase != STABILISATION && it.f.is_finite());
-        match (has_stab && (self.shows_stabilisation() || !has_opt), has_opt) {
+        // Beside the objective, the stabilisation panel only when it has something to show.
+        let stab_panel = if has_opt { self.shows_stabilisation() } else { has_stab };
+        match (stab_panel, has_opt) {
             (true, true) => {
                 let (upper, lower) = root.split_vertically((root.dim_in_pixel().1 as f64 * 0.68) as u32);
                 self.panel_auto(&upper, false, Some(&self.title))?;
