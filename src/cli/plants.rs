@@ -27,6 +27,8 @@ pub struct PlantArgs {
 /// One plant's summary line.
 struct Summary {
     name: String,
+    /// The library folder it comes from (`compleib`), `None` for the top folder or a path.
+    collection: Option<String>,
     plant: Plant,
     alpha: f64,
 }
@@ -35,7 +37,7 @@ impl Summary {
     fn new(plant: Plant) -> Self {
         // α, or ρ − 1 in discrete time
         let alpha = lti::stability_measure(plant.domain, plant.a.as_ref());
-        Summary { name: plant.name.clone(), plant, alpha }
+        Summary { name: plant.name.clone(), collection: None, plant, alpha }
     }
     fn stable(&self) -> bool {
         lti::is_stable_with_margin(self.alpha, self.plant.a.as_ref())
@@ -46,6 +48,8 @@ impl Summary {
             "name": self.name, "n": d.n, "m1": d.m1, "m2": d.m2, "p1": d.p1, "p2": d.p2,
             "open_loop_stable": self.stable(),
             "source": self.plant.citation,
+            "collection": self.collection,
+            "fingerprint": self.plant.fingerprint(),
         });
         self.insert_stability(v.as_object_mut().expect("an object"));
         v
@@ -66,22 +70,29 @@ impl Summary {
 /// `campaign plants`.
 pub fn list(a: PlantsArgs) -> anyhow::Result<ExitCode> {
     let dir = lti::plants_dir();
-    let names = lti::shipped_plants().with_context(|| format!("reading the plant library {}", dir.display()))?;
+    let entries = lti::library_plants().with_context(|| format!("reading the plant library {}", dir.display()))?;
     let mut rows = Vec::new();
-    for name in names {
-        let plant = Plant::load(dir.join(format!("{name}.json")))?;
-        rows.push(Summary::new(plant));
+    for entry in entries {
+        let mut summary = Summary::new(Plant::load(&entry.path)?);
+        // listed under the name it is asked for, which is the file's
+        summary.name = entry.name;
+        summary.collection = entry.collection;
+        rows.push(summary);
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&rows.iter().map(Summary::json).collect::<Vec<_>>())?);
         return Ok(ExitCode::SUCCESS);
     }
-    println!("{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} source", "plant", "n", "m1", "m2", "p1", "p2", "open loop");
+    let width = rows.iter().map(|r| r.name.chars().count()).max().unwrap_or(0).max(8);
+    println!(
+        "{:<width$} {:>4} {:>4} {:>3} {:>3} {:>3}  {:<10} {:<9} source",
+        "plant", "n", "m1", "m2", "p1", "p2", "open loop", "folder"
+    );
     for r in &rows {
         let d = r.plant.dims;
         let stab = if r.stable() { "stable" } else { "unstable" };
         println!(
-            "{:<8} {:>4} {:>3} {:>3} {:>3} {:>3}  {:<10} {}",
+            "{:<width$} {:>4} {:>4} {:>3} {:>3} {:>3}  {:<10} {:<9} {}",
             term(&r.name),
             d.n,
             d.m1,
@@ -89,15 +100,21 @@ pub fn list(a: PlantsArgs) -> anyhow::Result<ExitCode> {
             d.p1,
             d.p2,
             stab,
+            r.collection.as_deref().unwrap_or("."),
             term(&short(&r.plant.citation, 70))
         );
     }
-    println!(
-        "\n{} plants in {}; problems without public data: {}",
-        rows.len(),
-        dir.display(),
-        dir.join("MISSING.md").display()
-    );
+    println!("\n{} plants in {} and its folders", rows.len(), dir.display());
+    let missing: Vec<String> = std::iter::once(dir.join("MISSING.md"))
+        .chain(rows.iter().filter_map(|r| r.collection.as_ref()).map(|c| dir.join(c).join("MISSING.md")))
+        .filter(|p| p.is_file())
+        .map(|p| p.display().to_string())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    if !missing.is_empty() {
+        println!("plants listed as missing (no public data, or left out for size): {}", missing.join(", "));
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -90,6 +90,6 @@ pub use system::closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use system::controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};
 pub use system::export::{export_code, ExportTarget};
 pub use system::plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
-pub use system::plant_library::{plants_dir, resolve_plant, shipped_plants, PLANTS_ENV};
+pub use system::plant_library::{library_plants, plants_dir, resolve_plant, shipped_plants, LibraryPlant, PLANTS_ENV};
 pub use system::state_space::StateSpace;
 pub use system::time_domain::{BadSamplingTime, TimeDomain};

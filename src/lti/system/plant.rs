@@ -152,6 +152,17 @@ pub enum PlantErrorKind {
         /// The library's plant names, comma-separated.
         known: String,
     },
+    /// Several library collections hold a plant of that name.
+    #[error("the plant name `{name}` is in more than one library folder ({files}); give the path of the one you mean")]
+    AmbiguousName {
+        /// The name asked for.
+        name: String,
+        /// The files that have it, comma-separated.
+        files: String,
+    },
+    /// A gzip-compressed plant file (`.json.gz`) that does not decompress.
+    #[error("not a readable gzip file: {0}")]
+    Gzip(String),
     /// A matrix is missing, mis-shaped or holds a bad entry.
     #[error("matrix `{matrix}` {problem}{hint}")]
     Matrix {
@@ -223,8 +234,13 @@ impl Plant {
                 .map_err(|e| err(PlantErrorKind::Io(e)))?;
             return Self::from_mat_bytes(&bytes, path);
         }
+        let err = |kind| PlantError { file: path.to_path_buf(), kind };
+        if crate::lti::system::plant_library::is_gzip_json_path(path) {
+            let text = read_gzip_text(path).map_err(err)?;
+            return Self::from_json_str(&text, path);
+        }
         let text = crate::input::read_capped_string(path, crate::input::MAX_PLANT_BYTES, "plant file")
-            .map_err(|e| PlantError { file: path.to_path_buf(), kind: PlantErrorKind::Io(e) })?;
+            .map_err(|e| err(PlantErrorKind::Io(e)))?;
         Self::from_json_str(&text, path)
     }
 
@@ -245,6 +261,7 @@ impl Plant {
             .map_err(|e| err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() }))?;
         if let Value::Object(o) = &mut doc {
             let stem = file.as_ref().file_stem().map_or_else(|| "plant".into(), |s| s.to_string_lossy().into_owned());
+            let stem = stem.strip_suffix(".json").map(str::to_string).unwrap_or(stem);
             complete_document(o, &stem);
         }
         Self::from_json_value(&doc).map_err(err)
@@ -407,6 +424,27 @@ impl Plant {
         }
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
+}
+
+/// The text of a gzip-compressed plant file: at most `MAX_PLANT_BYTES` read, and at most as many
+/// after decompression (a small file that inflates without end is refused, not read until memory
+/// runs out); a leading UTF-8 byte-order mark is dropped as for a plain file.
+fn read_gzip_text(path: &Path) -> Result<String, PlantErrorKind> {
+    use std::io::Read;
+    let limit = crate::input::MAX_PLANT_BYTES;
+    let bytes = crate::input::read_capped(path, limit, "plant file").map_err(PlantErrorKind::Io)?;
+    let decoder = libflate::gzip::Decoder::new(bytes.as_slice()).map_err(|e| PlantErrorKind::Gzip(e.to_string()))?;
+    let mut text = Vec::new();
+    decoder.take(limit + 1).read_to_end(&mut text).map_err(|e| PlantErrorKind::Gzip(e.to_string()))?;
+    if text.len() as u64 > limit {
+        return Err(PlantErrorKind::Gzip(format!(
+            "it holds more than {} MiB of JSON, the limit for a plant file",
+            limit >> 20
+        )));
+    }
+    let text = text.strip_prefix(b"\xef\xbb\xbf").map(<[u8]>::to_vec).unwrap_or(text);
+    String::from_utf8(text)
+        .map_err(|e| PlantErrorKind::Gzip(format!("its content is not UTF-8 text ({})", e.utf8_error())))
 }
 
 fn bad(field: &str, problem: &str) -> PlantErrorKind {
