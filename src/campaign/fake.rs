@@ -7,8 +7,8 @@
 //!
 //! A fake job takes [`FAKE_ITERS`] "iterations", sleeping `pause` between them and reporting each
 //! to the observer (so cancellation works exactly as with the real runner), and returns figures
-//! that are a pure function of the job id and the initial controller: the same job gives the same
-//! record, and a warm-started job depends on its predecessor's controller.
+//! that are a pure function of the job id and the initial controllers: the same job gives the same
+//! record, and a warm-started (or chained) job depends on its predecessor's controller.
 
 use std::ops::ControlFlow;
 use std::time::Duration;
@@ -16,7 +16,7 @@ use std::time::Duration;
 use sha2::{Digest, Sha256};
 
 use super::jobs::{Job, RunnerTag};
-use super::scheduler::JobRunner;
+use super::scheduler::{JobRunner, JobStarts};
 use crate::design::{
     Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats,
     SearchStop, SearchSummary,
@@ -68,10 +68,14 @@ impl JobRunner for FakeRunner {
     fn run(
         &self,
         job: &Job,
-        init: Option<&Controller>,
+        starts: JobStarts<'_>,
         obs: &mut dyn DesignObserver,
     ) -> Result<DesignOutcome, DesignError> {
-        let init_text = init.map(|k| k.to_json().to_string()).unwrap_or_default();
+        let init = starts.warm.or(starts.chained);
+        let mut init_text = starts.warm.map(|k| k.to_json().to_string()).unwrap_or_default();
+        if let Some(k) = starts.chained {
+            init_text += &format!("chained {}", k.to_json());
+        }
         let seed = unit(&[job.id.0.as_bytes(), init_text.as_bytes()]);
         // warm starts improve on the predecessor, as a real chain tends to
         let base = init.map_or(10.0, |_| 5.0);

@@ -20,6 +20,16 @@
 //! controller of the next lower order of the same chain (the paper did this for AC10; the paper
 //! took the best controller over all runs, here the chain stays within one seed so that a job
 //! still needs nothing but its spec and its predecessor, and chains can be sharded).
+//!
+//! Order chaining: with `order_chaining = true`, every job of the i-th order of a problem (i > 0,
+//! orders ascending) also starts from the best controller of the (i−1)-th order at the same ε —
+//! at every ε, whatever `warm_start` and `eps_continuation` do. Its [`Job::chain_from`] lists
+//! every job of that order and ε (one per seed, in seed order); the scheduler starts the job only
+//! when all of them have finished and passes the controller of the best of them
+//! (`campaign::chain`: least re-verified γ, ties by job id), padded as `--init` pads. The list
+//! enters the job id (absent when empty, so the ids of campaigns without the key do not change):
+//! what a job starts from is decided by its id's inputs alone, the same in one sitting, resumed or
+//! sharded.
 
 use std::fmt;
 use std::sync::Arc;
@@ -87,11 +97,19 @@ pub struct Job {
     pub options: DesignOptions,
     /// The job whose controller this one starts from (warm-start chains).
     pub warm_from: Option<JobId>,
+    /// Order chaining (module docs): the jobs of the order below at the same ε, of which the best
+    /// verified controller is one more start; empty without `order_chaining`.
+    pub chain_from: Vec<JobId>,
     /// The runner the id was made for.
     pub runner: RunnerTag,
 }
 
 impl Job {
+    /// The jobs this one waits for: its `warm_from` predecessor, then its `chain_from` jobs.
+    pub fn predecessors(&self) -> impl Iterator<Item = &JobId> {
+        self.warm_from.iter().chain(&self.chain_from)
+    }
+
     /// `HE1 n_K=2 ε=1e-3 seed=4`.
     pub fn label(&self) -> String {
         format!(
@@ -115,6 +133,8 @@ struct IdDoc<'a> {
     runner: Option<&'static str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     problem: Option<&'a ProblemKey>,
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    chain_from: &'a [JobId],
 }
 
 /// What a job id holds of a problem other than the single-plant H∞ one (module docs): per plant,
@@ -174,6 +194,19 @@ pub fn problem_job_id(
     warm_from: Option<&JobId>,
     runner: RunnerTag,
 ) -> JobId {
+    chained_job_id(plant_fingerprint, problem, options, warm_from, &[], runner)
+}
+
+/// [`problem_job_id`] of a job with order chaining: `chain_from` the jobs of the order below
+/// ([`Job::chain_from`]; empty: [`problem_job_id`]).
+pub fn chained_job_id(
+    plant_fingerprint: &str,
+    problem: Option<&ProblemKey>,
+    options: &DesignOptions,
+    warm_from: Option<&JobId>,
+    chain_from: &[JobId],
+    runner: RunnerTag,
+) -> JobId {
     JobId(digest_hex(&IdDoc {
         recipe: "hinfix-job",
         version: JOB_ID_VERSION,
@@ -185,6 +218,7 @@ pub fn problem_job_id(
             RunnerTag::Fake => Some("fake"),
         },
         problem,
+        chain_from,
     }))
 }
 
@@ -211,6 +245,7 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
         let ns = p.seeds.len();
         // the job of the previous order at each (ε, seed), by position in p.eps × p.seeds
         let mut prev_order: Vec<Option<JobId>> = vec![None; p.eps.len() * ns];
+        let mut first_order = true;
         let keys: std::collections::BTreeMap<usize, Option<ProblemKey>> = p
             .orders
             .iter()
@@ -233,10 +268,16 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
                     };
                     let mut options = DesignOptions { order, eps, seed, ..p.base.clone() };
                     if continued {
-                        continuation_options(&mut options, p.continued_cpumax);
+                        continuation_options(&mut options, p.continued_cpumax, p.continued_stall_starts);
                     }
+                    // order chaining: every job of the order below at this ε
+                    let chain_from: Vec<JobId> = if p.order_chaining && !first_order {
+                        prev_order[ei * ns..(ei + 1) * ns].iter().flatten().cloned().collect()
+                    } else {
+                        Vec::new()
+                    };
                     let key = keys.get(&order).and_then(Option::as_ref);
-                    let id = problem_job_id(&p.fingerprint, key, &options, warm_from.as_ref(), runner);
+                    let id = chained_job_id(&p.fingerprint, key, &options, warm_from.as_ref(), &chain_from, runner);
                     this_order[chain] = Some(id.clone());
                     jobs.push(Job {
                         id,
@@ -249,11 +290,13 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
                         structure: structure_of(p, order),
                         options,
                         warm_from,
+                        chain_from,
                         runner,
                     });
                 }
             }
             prev_order = this_order;
+            first_order = false;
         }
     }
     jobs
@@ -264,15 +307,18 @@ fn structure_of(p: &super::model::Problem, order: usize) -> Option<Arc<Structure
     p.structure.as_ref().and_then(|s| s.per_order.get(&order).cloned())
 }
 
-/// The options of an ε-continued job: its CPU budget `continued_cpumax` (if given), and as first
-/// starts only its predecessor's controller and HIFOO's `nrand` perturbations of it — no
-/// open-loop and central-controller starts, which do not depend on ε and were made by the head
-/// of the chain.
-fn continuation_options(options: &mut DesignOptions, continued_cpumax: Option<f64>) {
+/// The options of an ε-continued job: its CPU budget `continued_cpumax` and its stall rule
+/// `continued_stall_starts` (each if given), and as first starts only its predecessor's
+/// controller and HIFOO's `nrand` perturbations of it — no open-loop and central-controller
+/// starts, which do not depend on ε and were made by the head of the chain.
+fn continuation_options(options: &mut DesignOptions, continued_cpumax: Option<f64>, stall_starts: Option<usize>) {
     options.open_loop_start = false;
     options.central_gammas.clear();
     if let Some(c) = continued_cpumax {
         options.cpumax = c;
+    }
+    if let Some(n) = stall_starts {
+        options.stall_starts = n;
     }
 }
 

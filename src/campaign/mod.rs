@@ -8,6 +8,7 @@
 //!
 //! The modules are crate-private; what is API is re-exported here, and the command line
 //! (`crate::cli`) uses only that: [`status`] and [`report`] give it typed results to print.
+mod chain;
 pub(crate) mod claims;
 mod compare;
 #[cfg(any(test, feature = "test-support"))]
@@ -37,7 +38,8 @@ pub use claims::unix_now;
 #[cfg(any(test, feature = "test-support"))]
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
 pub use jobs::{
-    expand, job_id, problem_fingerprint, problem_job_id, Job, JobId, ProblemKey, RunnerTag, JOB_ID_VERSION,
+    chained_job_id, expand, job_id, problem_fingerprint, problem_job_id, Job, JobId, ProblemKey, RunnerTag,
+    JOB_ID_VERSION,
 };
 pub use journal::{
     is_journal_name, journals_in, parse_journal, read_journal, CorruptLine, Follower, JournalError, JournalRead,
@@ -49,7 +51,8 @@ pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
 pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};
 pub use reduce::{
-    best_per_order, best_per_problem, verify, verify_problem, BestRow, PlantMap, ProblemMap, Verdict, NEAR_BEST_RTOL,
+    best_per_order, best_per_problem, verify, verify_controller, verify_problem, verify_problem_controller, BestRow,
+    PlantMap, ProblemMap, Verdict, NEAR_BEST_RTOL,
 };
 pub use reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
@@ -63,7 +66,7 @@ pub use run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, 
 pub use sanitise::for_terminal;
 pub use scheduler::{
     design_job, execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, ExecuteError, ExecuteOptions,
-    JobObserver, JobRunner, ObserverError, ObserverFactory, RunStats, Scheduler, Solo,
+    JobObserver, JobRunner, JobStarts, ObserverError, ObserverFactory, RunStats, Scheduler, Solo,
 };
 pub use shard::{select as shard_jobs, Shard};
 pub use spec::{

@@ -93,6 +93,11 @@ pub struct Problem {
     pub eps_continuation: bool,
     /// CPU budget of an ε-continued job (None: `base.cpumax`, as every other job).
     pub continued_cpumax: Option<f64>,
+    /// Stall rule of an ε-continued job (`stall_starts`; None: `base.stall_starts`).
+    pub continued_stall_starts: Option<usize>,
+    /// Order chaining: every job of an order also starts from the best verified controller of
+    /// the order below at the same ε (module docs of `campaign::jobs`).
+    pub order_chaining: bool,
     /// Options common to all this problem's jobs (`order`, `eps`, `seed` are set per job).
     pub base: DesignOptions,
     /// How much of its jobs' iterations their traces keep (`trace`). Not a design option: it is

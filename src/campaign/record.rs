@@ -201,6 +201,10 @@ pub struct JobRecord {
     pub warm_from: Option<JobId>,
     /// Whether the predecessor's controller was actually passed as the initial point.
     pub warm_started: bool,
+    /// Order chaining: the job of the order below whose controller was the chained start
+    /// (`campaign::chain`); absent without one (and in journals of builds before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chained_from: Option<JobId>,
     /// Set only by the fake runner of the test hook.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runner: Option<String>,
@@ -319,6 +323,7 @@ impl JobRecord {
             options: o.clone(),
             warm_from: job.warm_from.clone(),
             warm_started,
+            chained_from: None,
             runner: (job.runner == RunnerTag::Fake).then(|| "fake".to_string()),
             result,
             cpu_s,

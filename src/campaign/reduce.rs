@@ -29,7 +29,7 @@ use super::record::JobRecord;
 use crate::design::{plant_values, problem_gamma, ObjectiveKind, PlantValue, Problem};
 use crate::lti::{
     closed_loop, controller_hinf_grad, hinf_norm_in, is_stable_with_margin, stability_margin, stability_measure,
-    HinfParams, Plant, DEFAULT_HINF_TOL,
+    Controller, HinfParams, Plant, DEFAULT_HINF_TOL,
 };
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
@@ -82,14 +82,29 @@ pub enum Verdict {
 
 /// Re-verifies one record's controller against `plant`.
 pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
-    let Some(k) = record.controller() else { return Verdict::Rejected("job failed".into()) };
+    match recorded_controller(record) {
+        Ok(k) => verify_controller(k, record.order, record.options.objective, plant),
+        Err(why) => Verdict::Rejected(why),
+    }
+}
+
+/// The record's controller, or why there is none to verify (a failed job, or orders that
+/// disagree).
+fn recorded_controller(record: &JobRecord) -> Result<&Controller, String> {
+    let Some(k) = record.controller() else { return Err("job failed".into()) };
     if record.options.order != record.order {
-        return Verdict::Rejected(format!(
+        return Err(format!(
             "the record's order {} differs from its options' order {}",
             record.order, record.options.order
         ));
     }
-    if let Err(e) = k.check_fits_order(plant, record.order) {
+    Ok(k)
+}
+
+/// Re-verifies controller `k` of a job of `order` and `objective` against `plant` ([`verify`]
+/// without the record: the campaign's order chaining judges controllers this way too).
+pub fn verify_controller(k: &Controller, order: usize, objective: ObjectiveKind, plant: &Plant) -> Verdict {
+    if let Err(e) = k.check_fits_order(plant, order) {
         return Verdict::Rejected(format!("controller does not fit the job: {e}"));
     }
     let cl = match closed_loop(plant, k) {
@@ -104,7 +119,7 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
     }
     let alpha_k = (k.order() > 0).then(|| stability_measure(domain, k.ak.as_ref()));
     let controller_stable = alpha_k.is_none_or(|a| is_stable_with_margin(a, k.ak.as_ref()));
-    if !controller_stable && record.options.objective == ObjectiveKind::Strong {
+    if !controller_stable && objective == ObjectiveKind::Strong {
         let (a, margin) = (alpha_k.unwrap_or(f64::NAN), stability_margin(k.ak.as_ref()));
         return Verdict::Rejected(format!("controller not stable ({s} of A_K = {a}, must be below −{margin:.1e})"));
     }
@@ -120,10 +135,19 @@ pub fn verify(record: &JobRecord, plant: &Plant) -> Verdict {
 /// rejection naming the plant), with each plant's value recomputed: γ is the problem's
 /// (`design::problem_gamma`), α(A_cl) the largest.
 pub fn verify_problem(record: &JobRecord, problem: &Problem) -> Verdict {
+    match (recorded_controller(record), problem.terms.first()) {
+        (Ok(k), _) => verify_problem_controller(k, record.order, record.options.objective, problem),
+        (Err(why), Some(t)) => Verdict::Rejected(format!("plant {}: {why}", t.plant.name)),
+        (Err(_), None) => Verdict::Rejected("no plant".into()),
+    }
+}
+
+/// [`verify_problem`] of controller `k` of a job of `order` and `objective` (without the record).
+pub fn verify_problem_controller(k: &Controller, order: usize, objective: ObjectiveKind, problem: &Problem) -> Verdict {
     let mut alpha_cl = f64::NEG_INFINITY;
     let mut first = None;
     for t in &problem.terms {
-        match verify(record, &t.plant) {
+        match verify_controller(k, order, objective, &t.plant) {
             Verdict::Rejected(why) => return Verdict::Rejected(format!("plant {}: {why}", t.plant.name)),
             Verdict::Verified { alpha_cl: a, alpha_k, k_hinf, controller_stable, .. } => {
                 alpha_cl = alpha_cl.max(a);
@@ -131,7 +155,7 @@ pub fn verify_problem(record: &JobRecord, problem: &Problem) -> Verdict {
             }
         }
     }
-    let (Some((alpha_k, k_hinf, controller_stable)), Some(k)) = (first, record.controller()) else {
+    let Some((alpha_k, k_hinf, controller_stable)) = first else {
         return Verdict::Rejected("no plant".into());
     };
     let plants = plant_values(problem, k, DEFAULT_HINF_TOL);

@@ -8,6 +8,9 @@
 //!   worker that runs the job.
 //! * Warm-start chains: a job whose `warm_from` predecessor has not finished is not started; its
 //!   initial controller is the predecessor's (from this run or from the journal).
+//! * Order chaining: a job with `chain_from` jobs is not started before all of them have
+//!   finished (here, in the journals or elsewhere); its chained start is the controller of the
+//!   best of them (`campaign::chain`), re-verified once per job on the calling thread.
 //! * Cancellation: when `cancel` becomes true (first Ctrl-C, or a failing callback), nothing new
 //!   is scheduled and every in-flight job's observer returns `Break`, so `design::run` stops with
 //!   status `Interrupted`; such jobs produce [`CampaignEvent::JobInterrupted`] and no record, so a
@@ -42,41 +45,49 @@ use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome
 use crate::lti::Controller;
 use crate::optim::thread_cpu_time;
 
+/// The controllers a job starts from, besides its own random starts.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct JobStarts<'a> {
+    /// Its `warm_from` predecessor's controller (warm start, ε-continuation): the initial
+    /// controller, with its perturbations.
+    pub warm: Option<&'a Controller>,
+    /// The best controller of its `chain_from` jobs (order chaining): one more start, the first.
+    pub chained: Option<&'a Controller>,
+}
+
 /// Runs one job. Production: [`design_job`]; tests: closures.
 pub trait JobRunner: Sync {
-    /// Runs `job` from `init` (warm start) or from scratch, reporting iterations to `obs`.
-    fn run(
-        &self,
-        job: &Job,
-        init: Option<&Controller>,
-        obs: &mut dyn DesignObserver,
-    ) -> Result<DesignOutcome, DesignError>;
+    /// Runs `job` from `starts` (or from scratch), reporting iterations to `obs`.
+    fn run(&self, job: &Job, starts: JobStarts<'_>, obs: &mut dyn DesignObserver)
+        -> Result<DesignOutcome, DesignError>;
 }
 
 impl<F> JobRunner for F
 where
-    F: Fn(&Job, Option<&Controller>, &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> + Sync,
+    F: Fn(&Job, JobStarts<'_>, &mut dyn DesignObserver) -> Result<DesignOutcome, DesignError> + Sync,
 {
     fn run(
         &self,
         job: &Job,
-        init: Option<&Controller>,
+        starts: JobStarts<'_>,
         obs: &mut dyn DesignObserver,
     ) -> Result<DesignOutcome, DesignError> {
-        self(job, init, obs)
+        self(job, starts, obs)
     }
 }
 
 /// The production runner (a [`JobRunner`] as every such function is): [`crate::design::run`]
 /// with the job's plant and options; a job of several plants (or another objective, or a
-/// structure) is [`crate::design::run_problem`] of its problem and structure, with the run
-/// control `design::run` makes (the job's `cpumax` and the observer's cancel flag).
+/// structure), or with a chained start, is [`crate::design::run_problem_chained`] of its problem
+/// and structure, with the run control `design::run` makes (the job's `cpumax` and the
+/// observer's cancel flag).
 pub fn design_job(
     job: &Job,
-    init: Option<&Controller>,
+    starts: JobStarts<'_>,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
-    if job.multi.is_none() && job.structure.is_none() {
+    let init = starts.warm;
+    if job.multi.is_none() && job.structure.is_none() && starts.chained.is_none() {
         return crate::design::run(&job.plant, &job.options, init, obs);
     }
     let single;
@@ -91,7 +102,7 @@ pub fn design_job(
     if let Some(flag) = obs.cancel_flag() {
         ctl = ctl.with_cancel(flag);
     }
-    crate::design::run_problem(problem, &job.options, init, job.structure.as_deref(), &ctl, obs)
+    crate::design::run_problem_chained(problem, &job.options, init, starts.chained, job.structure.as_deref(), &ctl, obs)
 }
 
 /// What [`Coordinator::claim`] found.
@@ -389,6 +400,8 @@ pub struct Scheduler<'a, E, F> {
     index_of: HashMap<&'a JobId, usize>,
     /// Controllers of finished jobs (journals + this run), for warm starts.
     finished: HashMap<JobId, Option<Controller>>,
+    /// Re-verified γ of finished jobs that others chain from (order chaining), once computed.
+    chain_gamma: HashMap<JobId, Option<f64>>,
     /// Jobs still to run here, in campaign order.
     pending: VecDeque<usize>,
     /// Jobs found claimed elsewhere, with when to try them again.
@@ -432,6 +445,7 @@ where
             on_event,
             index_of: jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect(),
             finished: done.iter().map(|(id, r)| (id.clone(), r.controller().cloned())).collect(),
+            chain_gamma: HashMap::new(),
             stats: RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() },
             pending,
             busy_until: HashMap::new(),
@@ -551,11 +565,9 @@ where
         let mut skip = 0usize;
         while !self.free.is_empty() && self.stats.cancel.is_none() {
             let ready = self.pending.iter().skip(skip).position(|&i| {
+                let job = &self.jobs[i];
                 self.busy_until.get(&i).is_none_or(|t| *t <= now)
-                    && match &self.jobs[i].warm_from {
-                        None => true,
-                        Some(p) => self.finished.contains_key(p),
-                    }
+                    && job.predecessors().all(|p| self.finished.contains_key(p))
             });
             let Some(pos) = ready.map(|p| p + skip) else { break };
             match self.claim(self.pending[pos], now) {
@@ -599,6 +611,7 @@ where
         let worker = self.free.pop().expect("a free worker");
         let job: &'a Job = &self.jobs[index];
         let init = job.warm_from.as_ref().and_then(|p| self.finished.get(p)).cloned().flatten();
+        let chained = self.chained_start(job);
         self.running += 1;
         self.emit(Ok(CampaignEvent::JobStarted { index, worker, warm: init.is_some() }));
         let ctx = WorkerContext {
@@ -611,7 +624,25 @@ where
             worker,
             tx: tx.clone(),
         };
-        scope.spawn(move |_| run_one(ctx, StartedJob { index, job, init }));
+        scope.spawn(move |_| run_one(ctx, StartedJob { index, job, init, chained }));
+    }
+
+    /// The chained start of `job` (order chaining): the best of its finished `chain_from` jobs
+    /// (`campaign::chain`) and its controller; `None` without such jobs or if none verified.
+    fn chained_start(&mut self, job: &Job) -> Option<(JobId, Controller)> {
+        for id in &job.chain_from {
+            if self.chain_gamma.contains_key(id) {
+                continue;
+            }
+            let gamma = match (self.index_of.get(id), self.finished.get(id)) {
+                (Some(&i), Some(Some(k))) => super::chain::verified_gamma(&self.jobs[i], k),
+                _ => None,
+            };
+            self.chain_gamma.insert(id.clone(), gamma);
+        }
+        let best = super::chain::best(job.chain_from.iter().map(|id| (id, self.chain_gamma[id])))?;
+        let k = self.finished.get(best).cloned().flatten()?;
+        Some((best.clone(), k))
     }
 
     /// Handles one message of a worker.
@@ -677,6 +708,8 @@ struct StartedJob<'a> {
     job: &'a Job,
     /// Its predecessor's controller (warm start).
     init: Option<Controller>,
+    /// Its chained start (order chaining): the job it comes from and its controller.
+    chained: Option<(JobId, Controller)>,
 }
 
 /// The observer a job actually runs with: the user's (trace), progress events, cancellation.
@@ -764,7 +797,8 @@ impl WorkerContext<'_> {
             interval: self.progress_interval,
             last_sent: None,
         };
-        let result = match catch_unwind(AssertUnwindSafe(|| self.runner.run(job.job, job.init.as_ref(), &mut obs))) {
+        let starts = JobStarts { warm: job.init.as_ref(), chained: job.chained.as_ref().map(|(_, k)| k) };
+        let result = match catch_unwind(AssertUnwindSafe(|| self.runner.run(job.job, starts, &mut obs))) {
             Ok(Ok(out)) => Ok(out),
             Ok(Err(e)) => Err(JobFailure::RunnerError(e.to_string())),
             Err(panic) => Err(JobFailure::Panicked(panic_message(&panic))),
@@ -784,6 +818,7 @@ impl WorkerContext<'_> {
         let warm = job.init.is_some();
         JobRecord::from_run(self.campaign, job.job, warm, result, cpu, wall).map(|mut r| {
             r.provenance = Some(self.provenance.clone());
+            r.chained_from = job.chained.as_ref().map(|(id, _)| id.clone());
             r
         })
     }

@@ -1,8 +1,11 @@
 //! `--shard K/N`: a deterministic partition of a campaign's jobs into N parts, for running one
 //! campaign as N processes (e.g. a Slurm job array, one task per shard).
 //!
-//! * The unit is the warm-start chain (a job and every job warm-started from it, transitively),
-//!   so a chain never spans shards; a job without warm start is a chain of one.
+//! * The unit is the chain: jobs linked by waiting for one another (a job and every job
+//!   warm-started from it, transitively; with order chaining, every job of an order and ε with
+//!   those of the order below at that ε, so that a problem's chained jobs stay together), so a
+//!   chain never spans shards; a job that waits for none and that none waits for is a chain of
+//!   one.
 //! * Chains are dealt out by longest-processing-time first: in decreasing total budget (Σ
 //!   cpumax; ties by first job), each to the shard with the smallest total so far (ties to the
 //!   lower shard). This balances the shards' CPU budgets, which is what bounds an array's wall
@@ -84,15 +87,24 @@ impl fmt::Display for Shard {
 /// The shard (0-based) of every job, in job order (see the module docs).
 pub fn assign(jobs: &[Job], n: usize) -> Vec<usize> {
     let n = n.max(1);
-    // chain root of every job: its own index, or its predecessor's root
+    // chain root of every job: the smallest index of the jobs linked to it by waiting (union-find
+    // over the links to earlier jobs; a job with one predecessor gets its predecessor's root)
     let pos: HashMap<&JobId, usize> = jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
-    let mut root = vec![0usize; jobs.len()];
-    for (i, j) in jobs.iter().enumerate() {
-        root[i] = match j.warm_from.as_ref().and_then(|p| pos.get(p)) {
-            Some(&p) if p < i => root[p],
-            _ => i,
-        };
+    let mut parent: Vec<usize> = (0..jobs.len()).collect();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
     }
+    for (i, j) in jobs.iter().enumerate() {
+        for &p in j.predecessors().filter_map(|p| pos.get(p)).filter(|&&p| p < i) {
+            let (a, b) = (find(&mut parent, p), find(&mut parent, i));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    let root: Vec<usize> = (0..jobs.len()).map(|i| find(&mut parent, i)).collect();
     let mut cost: Vec<(usize, f64)> = Vec::new(); // (root, Σ cpumax), roots ascending
     let mut slot: HashMap<usize, usize> = HashMap::new();
     for (i, j) in jobs.iter().enumerate() {
@@ -171,7 +183,7 @@ orders = [1]
                 let ids: HashSet<&JobId> = part.iter().map(|j| &j.id).collect();
                 for j in part {
                     assert!(seen.insert(j.id.clone()), "n={n}: job {} in two shards", j.label());
-                    if let Some(p) = &j.warm_from {
+                    for p in j.predecessors() {
                         assert!(ids.contains(p), "n={n} shard {}: chain of {} split", k + 1, j.label());
                     }
                 }

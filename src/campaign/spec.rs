@@ -296,6 +296,8 @@ crate::design::design_option_table!(campaign_settings {
     seeds: Seeds,
     eps_continuation: bool,
     continued_cpumax: f64,
+    continued_stall_starts: usize,
+    order_chaining: bool,
     // Not a design setting (no `DesignOptions` field, not in the job id); layered alike.
     trace: TraceLevel,
 });
@@ -602,6 +604,8 @@ fn resolve_problem(p: &RawProblem, d: &RawDefaults, base_dir: &Path, src: &Sourc
         warm_start: p.warm_start,
         eps_continuation: settings.eps_continuation.as_ref().is_some_and(|(b, _)| *b),
         continued_cpumax: settings.continued_cpumax.as_ref().map(|(x, _)| *x),
+        continued_stall_starts: settings.continued_stall_starts.as_ref().map(|(x, _)| *x),
+        order_chaining: settings.order_chaining.as_ref().is_some_and(|(b, _)| *b),
         base,
         trace: settings.trace.as_ref().map(|(t, _)| *t).unwrap_or_default(),
         location: Location::of_offset(src.text, plant_span(p).start),

@@ -150,15 +150,15 @@ pub struct ShardLoad {
 }
 
 /// How `--shard K/N` splits the jobs: per shard, its jobs, CPU budget and a wall-time bound by
-/// list scheduling on `threads` workers: Σ cpumax / threads + its longest warm-start chain
-/// (Graham's bound; jobs stop at their CPU budget, and a worker thread gets a CPU to itself).
+/// list scheduling on `threads` workers: Σ cpumax / threads + its longest chain of jobs that
+/// wait for others (warm start, order chaining; Graham's bound; jobs stop at their CPU budget, and a worker thread gets a CPU to itself).
 pub fn shard_plan(jobs: &[Job], n: usize, threads: usize) -> Vec<ShardLoad> {
     let assign = shard::assign(jobs, n);
     let index: HashMap<_, _> = jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
     // budget of the chain up to and including each job
     let mut chain = vec![0.0f64; jobs.len()];
     for (i, j) in jobs.iter().enumerate() {
-        let before = j.warm_from.as_ref().and_then(|p| index.get(p)).map_or(0.0, |&p| chain[p]);
+        let before = j.predecessors().filter_map(|p| index.get(p)).map(|&p| chain[p]).fold(0.0, f64::max);
         chain[i] = before + j.options.cpumax;
     }
     (0..n)

@@ -108,6 +108,10 @@ pub struct DesignArgs {
     /// Relative improvement that resets the stall count.
     #[arg(long, value_name = "R", default_value_t = default().stall_rtol, allow_hyphen_values = true)]
     pub stall_rtol: f64,
+    /// Stall rule in CPU time: the stall rule also ends the run once this many CPU seconds
+    /// passed without an improvement by --stall-rtol (same conditions). 0: off.
+    #[arg(long, value_name = "S", default_value_t = default().stall_cpu, allow_hyphen_values = true)]
+    pub stall_cpu: f64,
     /// Let the stall rule end the run even when a budget (--cpumax, --maxevals, --max-starts)
     /// bounds it. By default a bounded run spends its budget: once a stabilising controller is
     /// found, the continued search goes on until a budget ends it, and the stall rule ends only
@@ -364,6 +368,7 @@ fn options(a: &DesignArgs) -> anyhow::Result<DesignOptions> {
         nrand: a.nrand,
         stall_starts: a.stall_starts,
         stall_rtol: a.stall_rtol,
+        stall_cpu: a.stall_cpu,
         spend_budget: if a.stop_on_stall { false } else { d.spend_budget },
         continue_at_maxit: if a.no_continue_at_maxit { false } else { d.continue_at_maxit },
         continued_maxit: a.continued_maxit,

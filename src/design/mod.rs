@@ -51,7 +51,9 @@ pub use problem::{
     plant_part, plant_value, plant_values, problem_gamma, H2Feedthrough, PlantObjective, PlantTerm, PlantValue,
     Problem, ProblemError, UnknownObjective, BOUND_RTOL, PENALTY_WEIGHT,
 };
-pub use run::{run, run_problem, run_with_control, run_with_structure, strongly_stabilisable, validate};
+pub use run::{
+    run, run_problem, run_problem_chained, run_with_control, run_with_structure, strongly_stabilisable, validate,
+};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};
 pub use structure::{Structure, StructureError};

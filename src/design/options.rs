@@ -345,6 +345,20 @@ macro_rules! design_option_table {
                     format!("must be finite and >= 0, got {v}")
                 }),
                 doc "relative improvement of the best objective that resets the stall count";
+            /// Stall rule in CPU time: the continued search also stops (under the same conditions as
+            /// the stall rule of `stall_starts`) once `stall_cpu` CPU seconds have passed since the
+            /// best objective last improved by `stall_rtol` (or since the run began), so that a slow
+            /// plant, whose local searches take many seconds each, stops as soon as a fast one. 0 (the
+            /// default): off. (Missing in a serialised record: 0, the behaviour before this option
+            /// existed; not written when 0, so job ids without it do not change.)
+            #[serde(default, with = "serde_f64_or_string", skip_serializing_if = "is_zero_f64")]
+            stall_cpu: f64 = 0.0,
+                key layered, flag "--stall-cpu",
+                accepts "finite, ≥ 0 (0: off)",
+                check |v: &f64| require(v.is_finite() && *v >= 0.0, || {
+                    format!("must be finite and >= 0 CPU seconds (0: off), got {v}")
+                }),
+                doc "stall rule in CPU time: stop after this many CPU seconds without improvement (0: off)";
             /// Spend the budget: when a budget bounds the run (`cpumax` finite, `maxevals` or
             /// `max_starts` set), the stall rule does not end it once a stable point is known; the
             /// continued search goes on until the budget ends it. The stall rule still ends runs without
@@ -679,6 +693,7 @@ mod tests {
             maxevals: Some(1),
             max_starts: Some(1),
             refine_rtol: 0.1,
+            stall_cpu: 1.0,
             ..Default::default()
         })
         .unwrap();

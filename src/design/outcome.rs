@@ -105,6 +105,10 @@ pub enum SearchStop {
     Starts,
     /// Cancelled or stopped by the observer.
     Interrupted,
+    /// Nothing to search: the design has no free variable (every entry fixed by a structure, or
+    /// Dk forced by the H2 feedthrough constraint at order 0); its one controller was evaluated
+    /// once.
+    NoFreeVariable,
     /// Not known: the record was journaled by a build before the search summary existed
     /// (06018b1); never returned by a design run. See [`SearchSummary::not_recorded`].
     NotRecorded,
@@ -119,6 +123,7 @@ impl SearchStop {
             SearchStop::Stall => "stall",
             SearchStop::Starts => "starts",
             SearchStop::Interrupted => "interrupted",
+            SearchStop::NoFreeVariable => "no_free_variable",
             SearchStop::NotRecorded => "not_recorded",
         }
     }
@@ -133,6 +138,9 @@ pub enum StartKind {
     Random,
     /// The initial controller or one of its perturbations.
     Init,
+    /// The padded controller of the order below (a campaign's order chaining,
+    /// [`crate::design::run_problem_chained`]).
+    Chained,
     /// A reduced-order full-order-central-controller start (`central_gammas`).
     Central,
     /// The open-loop start K = 0 (`open_loop_start`).
@@ -149,6 +157,7 @@ impl StartKind {
         match self {
             StartKind::Random => "random",
             StartKind::Init => "init",
+            StartKind::Chained => "chained",
             StartKind::Central => "central",
             StartKind::OpenLoop => "open_loop",
             StartKind::Hop => "hop",

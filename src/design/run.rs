@@ -19,10 +19,13 @@ use super::objective::{
 };
 use super::options::{DesignOptions, ObjectiveKind, VariableScaling};
 use super::outcome::{
-    Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, SearchStop, StartKind,
+    Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop,
+    SearchSummary, StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
-use super::problem::{nan_max, plant_part, plant_values, problem_gamma, PlantValue, Problem, PENALTY_WEIGHT};
+use super::problem::{
+    nan_max, plant_part, plant_values, problem_gamma, H2Feedthrough, PlantValue, Problem, PENALTY_WEIGHT,
+};
 use super::scaling::variable_scaling;
 use super::search::{ScaledObjectives, Search};
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
@@ -77,8 +80,9 @@ pub fn run_with_control(
 /// vectors of the free entries only; the initial controller (padded to the order if lower), the
 /// open-loop start and the central starts are *projected* onto the structure (their fixed
 /// entries overwritten by the structure's values); variable scaling applies to the free entries.
-/// A structure of other sizes than `opts.order` on this plant, or with no free entry, is an
-/// `Options` error (field `structure`).
+/// A structure of other sizes than `opts.order` on this plant is an `Options` error (field
+/// `structure`); one with no free entry (and no free Dk entry left by the H2 objective) is
+/// evaluated once and answered at once (search stop `no_free_variable`).
 pub fn run_with_structure(
     plant: &Plant,
     opts: &DesignOptions,
@@ -107,10 +111,33 @@ pub fn run_problem(
     ctl: &RunControl,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
+    run_problem_chained(problem, opts, init, None, structure, ctl, obs)
+}
+
+/// As [`run_problem`], with `chained`: one more initial controller of order ≤ `opts.order` (a
+/// campaign's order chaining passes the best controller of the order below, `campaign::jobs`),
+/// padded exactly as `init` is (docs/ALGORITHMS.md §8.2) and projected onto the structure. It is
+/// the **first** local search of the run (kind [`StartKind::Chained`], no perturbations of it),
+/// so that no budget can end the run before it: the search then never returns a controller whose
+/// objective is above the padded controller's, which (same ε) is the objective of `chained`
+/// itself. The other starts (from `init` or random, open loop, central) follow as in
+/// [`run_problem`]; `chained = None` is exactly [`run_problem`].
+pub fn run_problem_chained(
+    problem: &Problem,
+    opts: &DesignOptions,
+    init: Option<&Controller>,
+    chained: Option<&Controller>,
+    structure: Option<&Structure>,
+    ctl: &RunControl,
+    obs: &mut dyn DesignObserver,
+) -> Result<DesignOutcome, DesignError> {
     let h2 = problem.validate().map_err(DesignError::Problem)?;
     let plant = problem.first();
     for t in &problem.terms {
         validate(&t.plant, opts, init)?;
+        if chained.is_some() {
+            validate(&t.plant, opts, chained)?;
+        }
     }
     let multi = (!problem.is_single_hinf()).then_some(problem);
     if let (Some(s), Some(_)) = (structure, &h2) {
@@ -136,12 +163,12 @@ pub fn run_problem(
                 ),
             ));
         }
-        if s.nfree() == 0 {
-            return Err(opt_err("structure", "every entry is fixed, there is nothing to design"));
-        }
     }
     for t in &problem.terms {
         strongly_stabilisable(&t.plant, opts)?;
+    }
+    if free_variables(shape, structure, h2.as_deref()) == 0 {
+        return Ok(fixed_design(problem, opts, shape, structure, h2.as_deref()));
     }
     let structure: Option<Rc<Structure>> = structure.map(|s| Rc::new(s.clone()));
     // The optimiser's variables of a controller (all of x, or its free entries: the fixed ones
@@ -156,6 +183,10 @@ pub fn run_problem(
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let mut first = starting_points(plant, opts, init, shape, nvar, &vars, &mut rng);
     let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
+    if let Some(k) = chained {
+        first.insert(0, vars(controller_to_x(&padded_to(plant, k, shape.nk))));
+        kinds.insert(0, StartKind::Chained);
+    }
     if opts.open_loop_start {
         first.push(vars(controller_to_x(&open_loop_controller(plant, shape.nk))));
         kinds.push(StartKind::OpenLoop);
@@ -267,6 +298,93 @@ pub fn run_problem(
     })
 }
 
+/// The design's free variables: the structure's free entries (every entry without one), Dk's
+/// counted as the dimension of the H2 feedthrough set when the h2 objective constrains Dk (a
+/// structure then leaves Dk free, checked by [`run_problem_chained`]).
+fn free_variables(shape: ControllerShape, structure: Option<&Structure>, h2: Option<&H2Feedthrough>) -> usize {
+    let ndk = shape.m * shape.p;
+    let split = shape.nvar() - ndk;
+    let (others, dk) = match structure {
+        None => (split, ndk),
+        Some(s) => {
+            let free = |e: &[Option<f64>]| e.iter().filter(|v| v.is_none()).count();
+            (free(&s.entries()[..split]), free(&s.entries()[split..]))
+        }
+    };
+    others + h2.map_or(dk, |h| h.0.dim())
+}
+
+/// The outcome of a design with no free variable ([`free_variables`] = 0): its one controller
+/// (the structure's fixed entries, Dk projected onto the H2 feedthrough set), evaluated once.
+/// Stable and stabilising (K stable too for the strong objective): [`DesignStatus::Converged`],
+/// with the certificate dnorm = 0 of a point that is the whole feasible set; else
+/// [`DesignStatus::NotStabilised`]. Either way the search's stop is
+/// [`SearchStop::NoFreeVariable`].
+fn fixed_design(
+    problem: &Problem,
+    opts: &DesignOptions,
+    shape: ControllerShape,
+    structure: Option<&Structure>,
+    h2: Option<&H2Feedthrough>,
+) -> DesignOutcome {
+    let cpu0 = crate::optim::thread_cpu_time();
+    let plant = problem.first();
+    let k = match structure {
+        Some(s) => s.controller(shape, &[]),
+        None => shape.controller(&vec![0.0; shape.nvar()]),
+    };
+    let k = match h2 {
+        Some(h) => Controller { dk: h.project(&k.dk), ..k },
+        None => k,
+    };
+    let mut fig = figures(plant, opts, &k, Interrupt::NEVER);
+    let multi = (!problem.is_single_hinf()).then_some(problem);
+    let plants = match multi {
+        None => Vec::new(),
+        Some(p) => {
+            let values = plant_values(p, &k, opts.hinf_tol);
+            problem_figures(&mut fig, &values, opts);
+            values
+        }
+    };
+    let strong = opts.objective == ObjectiveKind::Strong;
+    let alpha = match fig.alpha_k {
+        Some(a) if strong => nan_max(fig.alpha_cl, opts.eps * a),
+        _ => fig.alpha_cl,
+    };
+    let (status, certificate) = if is_stable(alpha) {
+        (DesignStatus::Converged, Some(Certificate { dnorm: 0.0, evaldist: 0.0 }))
+    } else {
+        (DesignStatus::NotStabilised { best_alpha: alpha }, None)
+    };
+    let cpu = crate::optim::thread_cpu_time() - cpu0;
+    DesignOutcome {
+        status,
+        controller: k,
+        gamma: fig.gamma,
+        k_hinf: fig.k_hinf,
+        alpha_cl: fig.alpha_cl,
+        alpha_k: fig.alpha_k,
+        objective: fig.objective,
+        controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
+        certificate,
+        iterations: 0,
+        evaluations: 1,
+        phases: vec![PhaseStats { phase: Phase::Stabilisation, iters: 0, evals: 1, cpu_s: cpu }],
+        design_cpu_s: cpu,
+        search: SearchSummary {
+            starts: 0,
+            best_start: 0,
+            best_start_kind: None,
+            best_start_scaled: false,
+            cpu_to_best_s: cpu,
+            evals_to_best: 1,
+            stop: SearchStop::NoFreeVariable,
+        },
+        plants,
+    }
+}
+
 /// A problem's figures in place of the first plant's (`run_problem`): γ the largest weighted value
 /// of the unbounded plants (of all if each has a bound), α(A_cl) the largest, the objective
 /// max(γ, ε‖K‖∞) plus the penalty of violated bounds.
@@ -354,15 +472,18 @@ fn starting_points(
     rng: &mut ChaCha8Rng,
 ) -> Vec<Vec<f64>> {
     match init {
-        Some(k) => {
-            let padded = if k.order() < shape.nk {
-                pad_controller(k, shape.nk, padding_diagonal(plant, k)).expect("order checked by validate")
-            } else {
-                k.clone()
-            };
-            perturbed_starts(&vars(controller_to_x(&padded)), opts.nrand, rng)
-        }
+        Some(k) => perturbed_starts(&vars(controller_to_x(&padded_to(plant, k, shape.nk))), opts.nrand, rng),
         None => random_starts(nvar, opts.nrand, rng),
+    }
+}
+
+/// `k` (of order ≤ `nk`, checked by [`validate`]) padded to order `nk` with decoupled stable
+/// modes at [`padding_diagonal`] (`--init`'s padding, docs/ALGORITHMS.md §8.2).
+fn padded_to(plant: &Plant, k: &Controller, nk: usize) -> Controller {
+    if k.order() < nk {
+        pad_controller(k, nk, padding_diagonal(plant, k)).expect("order checked by validate")
+    } else {
+        k.clone()
     }
 }
 

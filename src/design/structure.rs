@@ -114,12 +114,6 @@ pub enum StructureError {
         /// The value.
         value: f64,
     },
-    /// Every entry is fixed: there is nothing to optimise.
-    #[error("structure file {file}: every entry is fixed, there is nothing to design")]
-    NothingFree {
-        /// The file.
-        file: String,
-    },
 }
 
 /// Rows and columns of the four blocks for `shape`.
@@ -181,9 +175,6 @@ impl Structure {
         } else {
             Self::from_json(&std::fs::read_to_string(path).map_err(io)?, &file, shape)?
         };
-        if s.nfree() == 0 {
-            return Err(StructureError::NothingFree { file });
-        }
         Ok(s)
     }
 

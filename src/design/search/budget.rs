@@ -7,6 +7,8 @@
 //! `stall_starts` consecutive local searches have not lowered the best objective by at least
 //! `stall_rtol`·|best| (f_h once a stable point exists; before that, f_s, whose improvements count
 //! at least `stall_rtol` in absolute terms near 0, and only if no budget is finite).
+//! The stall rule in CPU time (`stall_cpu` > 0) ends the run the same way once `stall_cpu` CPU
+//! seconds have passed since the last such improvement (or since the run began).
 //! `stall_starts = 0` is HIFOO's search. With `spend_budget` (the default) the stall rule ends
 //! only runs that no budget bounds: a run with a finite `cpumax`, `maxevals` or `max_starts`
 //! goes on until that budget ends it, since more local searches can only lower the best
@@ -81,7 +83,8 @@ pub(super) fn continued_stop(st: &State<'_>, search_ctl: &RunControl) -> Option<
     // and with `spend_budget` only when nothing else would end the run.
     let bounded = search_ctl.cpumax().is_finite() || opts.maxevals.is_some() || opts.max_starts.is_some();
     let stall_ends = !bounded || (st.stabilised && !opts.spend_budget);
-    (st.stall >= opts.stall_starts && stall_ends).then_some(SearchStop::Stall)
+    let cpu_stalled = opts.stall_cpu > 0.0 && search_ctl.cpu_elapsed() - st.improved_cpu >= opts.stall_cpu;
+    ((st.stall >= opts.stall_starts || cpu_stalled) && stall_ends).then_some(SearchStop::Stall)
 }
 
 /// What `return_gs_reserve` has done so far (module docs).

@@ -111,6 +111,9 @@ struct State<'s> {
     stab: Option<Best>,
     stabilised: bool,
     stall: usize,
+    /// CPU seconds of the run (its control's clock) at the last improvement in the stall rule's
+    /// sense (0: none yet), for `stall_cpu`.
+    improved_cpu: f64,
     /// The f_h local search that produced `perf` ended on `maxit` or a budget (not at a
     /// minimiser): the next continued start resumes it (`continue_at_maxit`).
     perf_cut: bool,
@@ -252,6 +255,7 @@ impl Search<'_, '_, '_> {
             stab: None,
             stabilised: false,
             stall: 0,
+            improved_cpu: 0.0,
             perf_cut: false,
             continued: false,
             refinements: 0,
@@ -312,6 +316,9 @@ impl Search<'_, '_, '_> {
                 }
             };
             st.stall = if better { 0 } else { st.stall + 1 };
+            if better {
+                st.improved_cpu = self.ctl.cpu_elapsed();
+            }
             // The search's share of a budget is spent but the budget is not: the next turn may
             // give the search back what gradient sampling does not need (`return_gs_reserve`).
             let share_only =
@@ -389,6 +396,7 @@ mod tests {
             stab: None,
             stabilised: true,
             stall: 0,
+            improved_cpu: 0.0,
             perf_cut: false,
             continued: true,
             refinements: 0,
