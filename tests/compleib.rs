@@ -107,3 +107,30 @@ fn a_damaged_or_endless_gzip_plant_is_a_clear_error() {
     let e = Plant::load(&text).unwrap_err().to_string();
     assert!(e.contains("text.json.gz") && e.contains("dims"), "{e}");
 }
+
+#[test]
+fn a_stabilising_controller_of_a_badly_scaled_plant_verifies() {
+    // EB6: ‖A‖_F = 1.3e8 while |λ| ≤ 6 400 and the modes are damped to 1e-7. Its order-1
+    // controller (tests/fixtures/compleib/EB6_order1.json, from `campaign design --plant EB6
+    // --order 1`) gives α(A_cl) ≈ −4.0e-5: a margin of 1e-12·‖A_cl‖_F (above 1e-4) threw it
+    // away; the margin of the balanced closed loop keeps it, and the abscissa computed on the
+    // balanced matrix is the same as on A_cl to far better than that.
+    use hinfix::campaign::{verify_controller, Verdict};
+    use hinfix::design::ObjectiveKind;
+    let plant = Plant::load(lti::resolve_plant("EB6").unwrap()).unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/compleib/EB6_order1.json");
+    let k = lti::Controller::load(fixture).unwrap();
+    let cl = lti::closed_loop(&plant, &k).unwrap();
+    assert!(1e-12 * cl.a.norm_l2() > 4.0e-5, "the unbalanced margin would refuse it");
+    let margin = lti::stability_margin(cl.a.as_ref());
+    assert!(margin < 1e-6, "{margin}");
+    let alpha = lti::verified_stability_measure(plant.domain, cl.a.as_ref());
+    assert!((alpha + 4.007e-5).abs() < 1e-8, "{alpha}");
+    match verify_controller(&k, 1, ObjectiveKind::Strong, &plant) {
+        Verdict::Verified { gamma, .. } => assert!((gamma - 1.905236).abs() < 1e-5, "{gamma}"),
+        other => panic!("{other:?}"),
+    }
+    // the open loop, damped to 1e-7, is stable with the balanced margin
+    let a = plant.a.as_ref();
+    assert!(lti::is_stable_with_margin(lti::verified_stability_measure(plant.domain, a), a));
+}

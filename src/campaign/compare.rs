@@ -13,7 +13,9 @@ use std::collections::BTreeMap;
 use super::reduce::{BestRow, PlantMap};
 use super::reference::{RefMethod, ReferenceRow};
 use crate::design::ObjectiveKind;
-use crate::lti::{full_order_gamma, is_stable_with_margin, spectral_abscissa, CentralProblem, Plant, PlantImage};
+use crate::lti::{
+    full_order_gamma, is_stable_with_margin, verified_spectral_abscissa, CentralProblem, Plant, PlantImage,
+};
 
 /// Largest plant order for which the full-order bound is computed here.
 pub const FULL_ORDER_MAX_N: usize = 60;
@@ -47,7 +49,7 @@ pub fn full_order_controller_stable(plant: &Plant) -> Option<bool> {
     let continuous = image.as_ref().map_or(plant, |i| &i.plant);
     let c = CentralProblem::new(continuous).ok()?;
     let k = c.controller(FULL_ORDER_CENTRAL_LEVEL * c.gamma_opt).ok()?;
-    Some(k.order() == 0 || is_stable_with_margin(spectral_abscissa(k.ak.as_ref()), k.ak.as_ref()))
+    Some(k.order() == 0 || is_stable_with_margin(verified_spectral_abscissa(k.ak.as_ref()), k.ak.as_ref()))
 }
 
 /// What a table's caption says of the campaign behind it: its name(s), ε values, number of

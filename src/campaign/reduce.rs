@@ -2,7 +2,7 @@
 //! are re-verified by recomputation: the controller's shape is checked against the job's order
 //! and the plant's channels (the journal's `order` and `options.order` must agree too), the
 //! closed loop is formed again (`lti::closed_loop`), both α(A_cl) and α(Ak) (in discrete time
-//! ρ − 1, `lti::stability_measure`) are checked to be below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F)), and
+//! ρ − 1, `lti::verified_stability_measure`, on the balanced matrix where that pays) are checked to be below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F) — ‖·‖_F of the balanced A where balancing lowers it more than 100-fold, docs/ALGORITHMS.md §5), and
 //! γ = ‖Tzw‖∞ is recomputed. The reported γ is always the recomputed one, never the journal's.
 //! A job of the plain objective (no stability asked of K) counts with an unstable controller
 //! too: its row says whether the controller is stable (`controller_stable`), which is what the
@@ -28,8 +28,8 @@ use std::sync::Arc;
 use super::record::JobRecord;
 use crate::design::{plant_values, problem_gamma, ObjectiveKind, PlantValue, Problem};
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm_in, is_stable_with_margin, stability_margin, stability_measure,
-    Controller, HinfParams, Plant, DEFAULT_HINF_TOL,
+    closed_loop, controller_hinf_grad, hinf_norm_in, is_stable_with_margin, stability_margin,
+    verified_stability_measure, Controller, HinfParams, Plant, DEFAULT_HINF_TOL,
 };
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
@@ -112,12 +112,12 @@ pub fn verify_controller(k: &Controller, order: usize, objective: ObjectiveKind,
         Err(e) => return Verdict::Rejected(format!("closed loop: {e}")),
     };
     let (domain, s) = (plant.domain, plant.domain.stability_symbol());
-    let alpha_cl = stability_measure(domain, cl.a.as_ref());
+    let alpha_cl = verified_stability_measure(domain, cl.a.as_ref());
     if !is_stable_with_margin(alpha_cl, cl.a.as_ref()) {
         let margin = stability_margin(cl.a.as_ref());
         return Verdict::Rejected(format!("closed loop not stable ({s} = {alpha_cl}, must be below −{margin:.1e})"));
     }
-    let alpha_k = (k.order() > 0).then(|| stability_measure(domain, k.ak.as_ref()));
+    let alpha_k = (k.order() > 0).then(|| verified_stability_measure(domain, k.ak.as_ref()));
     let controller_stable = alpha_k.is_none_or(|a| is_stable_with_margin(a, k.ak.as_ref()));
     if !controller_stable && objective == ObjectiveKind::Strong {
         let (a, margin) = (alpha_k.unwrap_or(f64::NAN), stability_margin(k.ak.as_ref()));

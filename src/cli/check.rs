@@ -24,8 +24,8 @@ use std::process::ExitCode;
 
 use crate::design::{plant_value, PlantObjective};
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm_in, stability_margin, stability_measure, Controller, HinfNorm,
-    HinfParams, Plant, TimeDomain, DEFAULT_HINF_TOL, NORM_TIE_RTOL,
+    closed_loop, controller_hinf_grad, hinf_norm_in, stability_margin, verified_stability_measure, Controller,
+    HinfNorm, HinfParams, Plant, TimeDomain, DEFAULT_HINF_TOL, NORM_TIE_RTOL,
 };
 use anyhow::Context;
 use serde_json::{json, Value};
@@ -155,11 +155,11 @@ fn report_one(a: &CheckArgs, plant: &Plant, k: &Controller, r: &CheckReport) -> 
 fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
     let cl = closed_loop(plant, k).context("forming the closed loop")?;
     let domain = plant.domain;
-    let alpha_cl = stability_measure(domain, cl.a.as_ref());
+    let alpha_cl = verified_stability_measure(domain, cl.a.as_ref());
     let h = hinf_norm_in(domain, &cl, &HinfParams::default()).expect("no stop hook is set");
     // in rad/s (a discrete norm's θ is in rad/sample)
     let h = HinfNorm { value: h.value, peak_freq: domain.to_rad_per_s(h.peak_freq) };
-    let alpha_k = (k.order() > 0).then(|| stability_measure(domain, k.ak.as_ref()));
+    let alpha_k = (k.order() > 0).then(|| verified_stability_measure(domain, k.ak.as_ref()));
     let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
     let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));
     let peak_freqs = crate::lti::near_peak_frequencies(domain, &cl, &h, NORM_TIE_RTOL);

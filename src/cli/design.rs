@@ -217,8 +217,9 @@ fn stabilising(problem: &Problem, opts: &DesignOptions, o: &DesignOutcome) -> bo
     }
     let k = &o.controller;
     let domain = problem.first().domain;
-    let stable =
-        |a: faer::MatRef<'_, f64>| crate::lti::is_stable_with_margin(crate::lti::stability_measure(domain, a), a);
+    let stable = |a: faer::MatRef<'_, f64>| {
+        crate::lti::is_stable_with_margin(crate::lti::verified_stability_measure(domain, a), a)
+    };
     let loops_stable =
         problem.terms.iter().all(|t| crate::lti::closed_loop(&t.plant, k).is_ok_and(|cl| stable(cl.a.as_ref())));
     let k_stable = k.order() == 0 || stable(k.ak.as_ref());

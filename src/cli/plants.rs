@@ -36,7 +36,7 @@ struct Summary {
 impl Summary {
     fn new(plant: Plant) -> Self {
         // α, or ρ − 1 in discrete time
-        let alpha = lti::stability_measure(plant.domain, plant.a.as_ref());
+        let alpha = lti::verified_stability_measure(plant.domain, plant.a.as_ref());
         Summary { name: plant.name.clone(), collection: None, plant, alpha }
     }
     fn stable(&self) -> bool {

@@ -46,8 +46,8 @@ pub use kernels::riccati::{care_residual, solve_care, CareSolution, RiccatiError
 pub(crate) use kernels::spectral::eigenvalues as eigenvalues_of;
 pub use kernels::spectral::{
     is_schur_stable, is_schur_stable_with_margin, is_stable, is_stable_with_margin, spectral_abscissa,
-    spectral_abscissa_grad, spectral_radius, spectral_radius_grad, stability_margin, MIN_EIGVEC_COSINE,
-    STABILITY_MARGIN_RTOL,
+    spectral_abscissa_grad, spectral_radius, spectral_radius_grad, stability_margin, verified_spectral_abscissa,
+    verified_spectral_radius, MIN_EIGVEC_COSINE, STABILITY_MARGIN_RTOL,
 };
 pub use norms::discrete::{
     closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete, hinf_norm_grad_discrete,
@@ -55,7 +55,7 @@ pub use norms::discrete::{
 pub(crate) use norms::domain::stability_measure_of;
 pub use norms::domain::{
     closed_loop_hinf_grad, closed_loop_stability_grad, controller_hinf_grad, controller_stability_grad, hinf_norm_in,
-    stability_measure,
+    stability_measure, verified_stability_measure,
 };
 pub use norms::gradient::{
     closed_loop_abscissa_grad, closed_loop_radius_grad, controller_abscissa_grad, controller_radius_grad,

@@ -17,6 +17,7 @@
 //! Imports `system` (for [`StateSpace`](crate::lti::StateSpace)) and the shared `error`,
 //! `interrupt`; never `norms` or `synthesis`.
 
+pub(crate) mod balance;
 pub(crate) mod bilinear;
 pub(crate) mod freq_response;
 pub(crate) mod hessenberg_qr;

@@ -22,7 +22,9 @@ use super::gradient::{
 use super::hinf::{hinf_norm, HinfNorm, HinfParams};
 use crate::lti::error::LtiError;
 use crate::lti::interrupt::Interrupted;
-use crate::lti::kernels::spectral::{abscissa_of, radius_of, spectral_abscissa, spectral_radius};
+use crate::lti::kernels::spectral::{
+    abscissa_of, radius_of, spectral_abscissa, spectral_radius, verified_spectral_abscissa, verified_spectral_radius,
+};
 use crate::lti::system::controller::Controller;
 use crate::lti::system::plant::Plant;
 use crate::lti::system::state_space::StateSpace;
@@ -35,6 +37,17 @@ pub fn stability_measure(domain: TimeDomain, a: MatRef<'_, f64>) -> f64 {
     match domain {
         TimeDomain::Continuous => spectral_abscissa(a),
         TimeDomain::Discrete { .. } => spectral_radius(a) - 1.0,
+    }
+}
+
+/// The stability measure as verification and reports compute it (on the balanced matrix:
+/// [`verified_spectral_abscissa`], [`verified_spectral_radius`]), to be judged against
+/// [`stability_margin`](crate::lti::kernels::spectral::stability_margin). The optimiser's
+/// objective uses [`stability_measure`].
+pub fn verified_stability_measure(domain: TimeDomain, a: MatRef<'_, f64>) -> f64 {
+    match domain {
+        TimeDomain::Continuous => verified_spectral_abscissa(a),
+        TimeDomain::Discrete { .. } => verified_spectral_radius(a) - 1.0,
     }
 }
 
