@@ -168,8 +168,8 @@ pub fn shard_plan(jobs: &[Job], n: usize, threads: usize, done: &HashSet<&JobId>
     (0..n)
         .map(|k| {
             let mine: Vec<usize> = (0..jobs.len()).filter(|&i| assign[i] == k && left(i)).collect();
-            // a fold from +0 (an empty `sum` of f64 is −0, printed "-0 s")
-            let cpu_s = mine.iter().map(|&i| budget(i)).fold(0.0, |a, b| a + b);
+            // + 0.0: an empty `sum` of f64 is −0 (printed "-0 s"), and −0 + 0 is +0
+            let cpu_s = mine.iter().map(|&i| budget(i)).sum::<f64>() + 0.0;
             let longest = mine.iter().map(|&i| chain[i]).fold(0.0, f64::max);
             ShardLoad { jobs: mine.len(), cpu_s, wall_bound_s: cpu_s / threads as f64 + longest }
         })
