@@ -162,10 +162,17 @@ fn a_plant_of_ones_own_gets_the_campaign_layout_and_the_two_objectives_side_by_s
         ),
         "{tex}"
     );
+    // the full-order row is a plain row; what it is, a note under the table (no multicolumn text
+    // that widens the table past the page)
+    assert!(tex.contains("full$^*$ & -- & 2.400 & -- & -- & -- & -- & -- \\\\\n\\midrule"), "{tex}");
     assert!(
-        tex.contains("the unconstrained bound (any order, $K$ may be unstable); central $K$ at $1.01\\gamma$ unstable"),
+        tex.contains(
+            "\\end{tabular}\n\\par\\footnotesize $^*$ full order: the unconstrained bound $\\gamma = 2.400$ (any order, \
+             $K$ may be unstable); its central $K$ at $1.01\\gamma$ is unstable."
+        ),
         "{tex}"
     );
+    assert!(!tex.contains("multicolumn"), "{tex}");
     assert!(tex.contains("1 & strong & 3.000 & $10^{-3}$ & 0 & 40.00 & -0.5000 & 12.3 \\\\"), "{tex}");
     assert!(tex.contains("1 & plain, $K$ unstable & 2.500 & $10^{-3}$ & 0 & $\\infty$ & 0.3000 & 12.3 \\\\"), "{tex}");
     // the side-by-side table: orders with both objectives only, ratio strong/plain

@@ -1,5 +1,6 @@
 """Builds the walk-through's plant of one's own with python-control and saves it as
-two_mass.mat (the nine blocks hinfix reads): two masses joined by a spring and a damper, the
+scratch/two_mass.mat (the nine blocks hinfix reads; scratch/ is ignored by git) — the committed
+examples/own-plant/two_mass.mat is this file, which the script checks: two masses joined by a spring and a damper, the
 first also held by a spring of *negative* stiffness (an unstable real mode), the force u on the
 first mass, a disturbance force on the second, the second's position measured (non-collocated).
 
@@ -9,12 +10,15 @@ first mass, a disturbance force on the second, the second's position measured (n
 Development-time only (hinfix and its tests never run Python):
 
     python3 -m venv venv && venv/bin/pip install control slycot numpy scipy
-    venv/bin/python examples/own-plant/make_plant.py
+    venv/bin/python examples/own-plant/make_plant.py [OUT.mat]
+
+(`venv/` and `scratch/` are in .gitignore: the walk-through leaves no untracked file.)
 
 It also prints slycot's full-order optimal level (control.hinfsyn), to compare with
 `campaign plant examples/own-plant/two_mass.mat`.
 """
 import os
+import sys
 
 import control
 import numpy as np
@@ -46,6 +50,12 @@ print("open-loop poles:", np.sort_complex(np.linalg.eigvals(A)))
 K, CL, gamma, rcond = control.hinfsyn(P, 1, 1)
 print(f"slycot hinfsyn: full-order gamma = {gamma:.7f}")
 
-out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "two_mass.mat")
-scipy.io.savemat(out, dict(A=A, B1=B1, B2=B2, C1=C1, C2=C2, D11=D11, D12=D12, D21=D21, D22=D22))
-print("wrote", out)
+here = os.path.dirname(os.path.abspath(__file__))
+blocks = dict(A=A, B1=B1, B2=B2, C1=C1, C2=C2, D11=D11, D12=D12, D21=D21, D22=D22)
+out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "..", "scratch", "two_mass.mat")
+os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+scipy.io.savemat(out, blocks)
+print("wrote", os.path.normpath(out))
+committed = scipy.io.loadmat(os.path.join(here, "two_mass.mat"))
+same = all(np.array_equal(np.atleast_2d(committed[k]), v) for k, v in blocks.items())
+print("the same blocks as the committed examples/own-plant/two_mass.mat:", "yes" if same else "NO")

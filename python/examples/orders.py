@@ -2,7 +2,9 @@
 stabilising controllers of orders 0–3 designed by hinfix, each checked by python-control, and γ
 plotted against the order (with the full-order bound γ_opt).
 
-    python python/examples/orders.py [--out gamma_vs_order.png] [--maxevals 3000]
+    python python/examples/orders.py [--out scratch/gamma_vs_order.png] [--maxevals 3000]
+
+(scratch/ is ignored by git.)
 
 The plant: two masses joined by a lightly damped spring, the first one tied to the ground by a
 soft spring; the force u acts on the first mass, a disturbance force w1 on the second, whose
@@ -10,6 +12,7 @@ position is measured with noise w2. The performance outputs are the second mass'
 weighted control effort. u = K y (positive feedback), as control.hinfsyn: P.lft(K) is the loop.
 """
 import argparse
+import os
 
 import numpy as np
 import control
@@ -30,7 +33,8 @@ def two_mass_plant(k=1.0, k0=0.2, c=0.02, noise=0.1, effort=0.1):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="gamma_vs_order.png", help="figure file (needs matplotlib)")
+    ap.add_argument("--out", default=os.path.join("scratch", "gamma_vs_order.png"),
+                    help="figure file (needs matplotlib)")
     ap.add_argument("--maxevals", type=int, default=3000, help="evaluation budget per design")
     args = ap.parse_args()
 
@@ -72,6 +76,7 @@ def main():
     ax.set_xticks(range(4))
     ax.legend()
     fig.tight_layout()
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     fig.savefig(args.out, dpi=120)
     print(f"figure written to {args.out}")
 

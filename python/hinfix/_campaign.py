@@ -1,15 +1,19 @@
 """Campaigns from Python: run a campaign file, read a results folder into lists and numpy arrays
-(no pandas) for plotting."""
+for plotting (pandas optional: ``Results.to_pandas()``)."""
+from __future__ import annotations
+
 import csv
 import math
 import os
+import warnings
 
 import numpy as np
 
 from . import _hinfix
 from ._json import loads
 
-def run_campaign(path, results=None, *, threads=None, progress=False):
+def run_campaign(path: str | os.PathLike, results: str | os.PathLike | None = None, *, threads: int | None = None,
+                 progress: bool = False) -> dict:
     """Runs the campaign file ``path`` as ``campaign run PATH --results RESULTS`` does, into
     ``RESULTS/<campaign name>/`` (default results root: ``results``), resuming the jobs already
     journaled there, and writes the report files (best.csv, tables.tex, compare.csv/.tex).
@@ -31,7 +35,7 @@ class Results:
     ``best`` is the report's ``best.csv`` as a list of dicts (empty if the folder has no report).
     """
 
-    def __init__(self, folder, records, best):
+    def __init__(self, folder: str, records: list[dict], best: list[dict]):
         self.folder = folder
         self.records = records
         self.best = best
@@ -39,7 +43,7 @@ class Results:
     def __len__(self):
         return len(self.records)
 
-    def columns(self, *keys):
+    def columns(self, *keys: str) -> dict[str, np.ndarray]:
         """Columns of the records as numpy arrays (float for numbers, NaN where a record has
         none, e.g. a failed job's γ; object arrays for text). Default keys: plant, order, eps,
         seed, status, gamma, k_hinf, alpha_cl, alpha_k, cpu_s."""
@@ -50,31 +54,54 @@ class Results:
             vals = [r.get(k) for r in self.records]
             if k == "status":
                 vals = [v["kind"] if isinstance(v, dict) else v for v in vals]
-            if all(isinstance(v, (int, float)) or v is None for v in vals):
+            numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) or v is None for v in vals)
+            if numbers and vals and all(isinstance(v, int) for v in vals):
+                out[k] = np.array(vals, dtype=np.int64)  # order, seed: integers stay integers
+            elif numbers:
                 out[k] = np.array([math.nan if v is None else v for v in vals], dtype=float)
+            elif all(isinstance(v, bool) for v in vals):
+                out[k] = np.array(vals, dtype=bool)
             else:
                 out[k] = np.array(vals, dtype=object)
         return out
+
+    def to_pandas(self, *keys: str) -> "pandas.DataFrame":  # noqa: F821
+        """``columns(*keys)`` as a ``pandas.DataFrame`` (pandas must be installed; it is not a
+        dependency of hinfix)."""
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("Results.to_pandas() needs pandas (pip install pandas); "
+                              "Results.columns() gives the same columns as numpy arrays") from None
+        return pandas.DataFrame(self.columns(*keys))
 
     def __repr__(self):
         return f"Results({self.folder!r}: {len(self.records)} records, {len(self.best)} best rows)"
 
 
-def read_results(folder):
-    """Reads the results folder ``folder`` (``results/<campaign>``): every journal's records and,
-    if the report was written, ``best.csv``. Returns a ``Results``."""
+def read_results(folder: str | os.PathLike) -> Results:
+    """Reads the results folder ``folder`` of one campaign (``results/<campaign>``, not the
+    results root ``results/``: that is a ValueError naming the campaign folders in it): every
+    journal's records and, if the report was written, ``best.csv``. A torn last journal line
+    (a run killed while writing) is left out with a ``UserWarning``, as ``campaign report``
+    warns. Returns a ``Results``."""
     folder = os.fspath(folder)
-    records = loads(_hinfix.read_results(folder))
+    read = loads(_hinfix.read_results(folder))
+    for w in read["warnings"]:
+        warnings.warn(w, UserWarning, stacklevel=2)
     best = []
     best_csv = os.path.join(folder, "best.csv")
     if os.path.isfile(best_csv):
         with open(best_csv, newline="") as f:
             best = [{k: _cell(v) for k, v in row.items()} for row in csv.DictReader(f)]
-    return Results(folder, records, best)
+    return Results(folder, read["records"], best)
 
 
 def _cell(text):
-    """A CSV cell: an int, a float, or the text."""
+    """A CSV cell: a bool (``true``, ``false``, as ``run_campaign()["best"]`` gives them), an
+    int, a float, or the text."""
+    if text in ("true", "false"):
+        return text == "true"
     for kind in (int, float):
         try:
             return kind(text)

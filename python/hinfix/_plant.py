@@ -6,7 +6,8 @@
     z  = C1 x + D11 w + D12 u         D = [D11 D12; D21 D22]
     y  = C2 x + D21 w + D22 u
 
-with the last ``ncon`` inputs the controls u and the last ``nmeas`` outputs the measurements y.
+with the last ``ncon`` inputs the controls u and the last ``nmeas`` outputs the measurements y
+(x' is x(t+1) for a discrete-time ``P``, whose ``dt`` is its sampling time in seconds).
 hinfix's plant is the same system as the nine blocks (A, B1, B2, C1, C2, D11, D12, D21, D22).
 """
 import numpy as np
@@ -28,30 +29,46 @@ def as_matrix(x, name):
     return a
 
 
-def continuous(sys, what):
-    """``sys`` as a continuous-time ``control.StateSpace`` (a ValueError otherwise)."""
+def system(sys, what):
+    """``sys`` as a ``control.StateSpace`` (a ValueError otherwise), continuous or discrete time."""
     if not isinstance(sys, control.StateSpace):
         try:
             sys = control.ss(sys)
         except Exception as e:  # python-control raises several types for what it cannot convert
             raise ValueError(f"{what} must be a control.StateSpace (or convertible to one): {e}") from None
-    if sys.dt not in (0, None):
-        raise ValueError(f"{what} must be continuous-time, got a discrete-time system (dt = {sys.dt})")
+    sampling_time(sys, what)
     return sys
 
 
-def _count(value, name, upper):
+def sampling_time(sys, what):
+    """The sampling time of ``sys`` in seconds, 0 for continuous time. python-control's
+    ``dt=True`` (discrete time, sampling time unspecified) is refused: the design's frequencies
+    and the Nyquist frequency need it."""
+    dt = sys.dt
+    if dt is None or dt is False or dt == 0:
+        return 0.0
+    if dt is True:
+        raise ValueError(f"{what} is discrete-time with an unspecified sampling time (dt=True): "
+                         "give its sampling time in seconds (control.ss(..., dt=0.1))")
+    dt = float(dt)
+    if not (np.isfinite(dt) and dt > 0):
+        raise ValueError(f"{what} has the sampling time dt = {dt}: it must be a finite number of seconds > 0")
+    return dt
+
+
+def _count(value, name, upper, what):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer, got {value!r}")
+        raise TypeError(f"{name} must be a whole number, got {value!r}")
     if not 1 <= value <= upper:
-        raise ValueError(f"{name} must be in 1..={upper}, got {value}")
+        raise ValueError(f"{name} must be in 1..={upper} ({what}), got {value}")
     return int(value)
 
 
 def blocks(P, nmeas=None, ncon=None):
-    """The nine matrices of ``P``: a ``control.StateSpace`` with ``nmeas`` measurements (its last
-    outputs) and ``ncon`` controls (its last inputs), or a sequence of the nine matrices
-    themselves (then ``nmeas``, ``ncon`` may be omitted, and must agree if given)."""
+    """The nine matrices of ``P`` and its sampling time (0: continuous time): a
+    ``control.StateSpace`` with ``nmeas`` measurements (its last outputs) and ``ncon`` controls
+    (its last inputs), or a sequence of the nine matrices themselves (continuous time; then
+    ``nmeas``, ``ncon`` may be omitted, and must agree if given)."""
     if isinstance(P, (tuple, list)):
         if len(P) != 9:
             raise ValueError(f"a plant given as matrices needs the nine {', '.join(NAMES)}, got {len(P)}")
@@ -59,28 +76,43 @@ def blocks(P, nmeas=None, ncon=None):
         for given, actual, name in ((nmeas, mats[4].shape[0], "nmeas"), (ncon, mats[2].shape[1], "ncon")):
             if given is not None and given != actual:
                 raise ValueError(f"{name} = {given} does not match the matrices ({actual})")
-        return mats
-    P = continuous(P, "P")
+        return mats, 0.0
+    P = system(P, "P")
     if nmeas is None or ncon is None:
         raise TypeError("nmeas and ncon are required with a StateSpace plant (as for control.hinfsyn)")
-    nmeas = _count(nmeas, "nmeas", P.noutputs)
-    ncon = _count(ncon, "ncon", P.ninputs)
+    # at least one disturbance input w and one performance output z must remain
+    nmeas = _count(nmeas, "nmeas", P.noutputs - 1, f"P has {P.noutputs} outputs and one at least is z")
+    ncon = _count(ncon, "ncon", P.ninputs - 1, f"P has {P.ninputs} inputs and one at least is w")
     A, B, C, D = (as_matrix(m, n) for m, n in zip((P.A, P.B, P.C, P.D), "ABCD"))
     m1, p1 = P.ninputs - ncon, P.noutputs - nmeas
     return (A, B[:, :m1], B[:, m1:], C[:p1, :], C[p1:, :],
-            D[:p1, :m1], D[:p1, m1:], D[p1:, :m1], D[p1:, m1:])
+            D[:p1, :m1], D[:p1, m1:], D[p1:, :m1], D[p1:, m1:]), sampling_time(P, "P")
 
 
-def statespace(mats, name=None):
-    """The ``control.StateSpace`` of nine plant matrices, with (nmeas, ncon)."""
+def statespace(mats, name=None, dt=0.0):
+    """The ``control.StateSpace`` of nine plant matrices (sampling time ``dt``, 0: continuous
+    time), with (nmeas, ncon). Its signals are named w[i], u[i] (inputs) and z[i], y[i]
+    (outputs), as the partition reads them."""
     A, B1, B2, C1, C2, D11, D12, D21, D22 = mats
     B = np.hstack([B1, B2])
     C = np.vstack([C1, C2])
     D = np.block([[D11, D12], [D21, D22]])
-    kw = {"name": name} if name else {}
-    return control.ss(A, B, C, D, **kw), C2.shape[0], B2.shape[1]
+    names = {"inputs": [f"w[{i}]" for i in range(B1.shape[1])] + [f"u[{i}]" for i in range(B2.shape[1])],
+             "outputs": [f"z[{i}]" for i in range(C1.shape[0])] + [f"y[{i}]" for i in range(C2.shape[0])]}
+    kw = {"name": name.replace(".", "_")} if name else {}  # python-control refuses '.' in a name
+    return control.ss(A, B, C, D, dt=dt, **names, **kw), C2.shape[0], B2.shape[1]
 
 
-def controller(ak, bk, ck, dk):
-    """The controller u = K y as a ``control.StateSpace`` (a static gain for order 0)."""
-    return control.ss(ak, bk, ck, dk)
+def controller(ak, bk, ck, dk, P=None, nmeas=None, ncon=None, dt=0.0):
+    """The controller u = K y as a ``control.StateSpace`` (a static gain for order 0) with
+    sampling time ``dt``. Its inputs are named after the plant's measurements (the last
+    ``nmeas`` outputs of ``P``) and its outputs after the plant's controls (the last ``ncon``
+    inputs), when ``P`` is a ``StateSpace``."""
+    names = {}
+    if isinstance(P, control.StateSpace):
+        names = {"inputs": list(P.output_labels[P.noutputs - nmeas:]),
+                 "outputs": list(P.input_labels[P.ninputs - ncon:])}
+    else:
+        names = {"inputs": [f"y[{i}]" for i in range(bk.shape[1])],
+                 "outputs": [f"u[{i}]" for i in range(ck.shape[0])]}
+    return control.ss(ak, bk, ck, dk, dt=dt, **names)

@@ -31,6 +31,20 @@ pub fn run_interruptible<T: Send>(
     cancel: Arc<AtomicBool>,
     work: impl FnOnce(&AtomicBool) -> T + Send,
 ) -> PyResult<T> {
+    run_interruptible_with(py, cancel, work, |_, _| Ok(()))
+}
+
+/// As [`run_interruptible`], calling `on_poll(py, done)` in the calling thread with the GIL at
+/// each poll (`done` false) and once after `work` has returned (`done` true): where a progress
+/// callback runs, so that what it prints goes where the caller's output goes (a Jupyter cell).
+/// An exception of `on_poll` is handled as a signal handler's: the run is cancelled and the
+/// exception raised once `work` has returned.
+pub fn run_interruptible_with<T: Send>(
+    py: Python<'_>,
+    cancel: Arc<AtomicBool>,
+    work: impl FnOnce(&AtomicBool) -> T + Send,
+    mut on_poll: impl FnMut(Python<'_>, bool) -> PyResult<()>,
+) -> PyResult<T> {
     let (tx, rx) = channel();
     let flag = Arc::clone(&cancel);
     std::thread::scope(|s| {
@@ -57,12 +71,15 @@ pub fn run_interruptible<T: Send>(
                 Err(RecvTimeoutError::Timeout) => {}
             }
             if raised.is_none() {
-                if let Err(e) = py.check_signals() {
+                if let Err(e) = py.check_signals().and_then(|()| on_poll(py, false)) {
                     cancel.store(true, Ordering::SeqCst);
                     raised = Some(e);
                 }
             }
         };
+        if raised.is_none() && done.is_ok() {
+            raised = on_poll(py, true).err();
+        }
         match (raised, done) {
             (Some(e), _) => Err(e),
             (None, Ok(value)) => Ok(value),

@@ -26,6 +26,8 @@ fn _hinfix(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("HinfixError", m.py().get_type::<errors::HinfixError>())?;
     m.add_function(wrap_pyfunction!(design::design, m)?)?;
     m.add_function(wrap_pyfunction!(design::option_names, m)?)?;
+    m.add_function(wrap_pyfunction!(design::default_options, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(norms::hinfnorm, m)?)?;
     m.add_function(wrap_pyfunction!(norms::full_order_gamma, m)?)?;
     m.add_function(wrap_pyfunction!(plant::load_plant, m)?)?;

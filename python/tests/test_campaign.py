@@ -34,7 +34,13 @@ def test_run_then_read_a_campaign(tmp_path):
     res = hinfix.read_results(summary["dir"])
     assert len(res) == 2
     cols = res.columns()
-    assert cols["order"].dtype == float and sorted(cols["order"]) == [0.0, 1.0]
+    assert cols["order"].dtype == np.int64 and sorted(cols["order"]) == [0, 1]
+    assert cols["seed"].dtype == np.int64
+    best = {r["order"]: r for r in res.best}
+    assert all(type(r["controller_stable"]) is bool for r in res.best), res.best
+    assert [type(r["controller_stable"]) for r in summary["best"]] == [bool, bool]
+    assert [best[r["order"]]["controller_stable"] for r in summary["best"]] == \
+        [r["controller_stable"] for r in summary["best"]]
     assert list(cols["plant"]) == ["HE1", "HE1"]
     assert np.all(np.isfinite(cols["gamma"]))
     assert {r["order"] for r in res.best} == {0, 1}
@@ -58,3 +64,46 @@ def test_a_bad_campaign_file_is_a_value_error(tmp_path):
     path.write_text('name = "bad"\n[[problem]]\nplant = "HE1"\norders = [1]\nnrandd = 3\n')
     with pytest.raises(ValueError, match="nrandd"):
         hinfix.run_campaign(path, tmp_path)
+
+
+def test_progress_lines_go_to_sys_stderr(tmp_path, monkeypatch):
+    import io
+    import sys
+    path = tmp_path / "small.toml"
+    path.write_text(CAMPAIGN.replace("orders = [0, 1]", "orders = [0]"))
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)  # a Jupyter cell's stream, not file descriptor 2
+    hinfix.run_campaign(path, tmp_path / "results", progress=True)
+    assert "1 jobs: 0 already in the journal, 1 to run" in err.getvalue()
+    assert "start  HE1" in err.getvalue()
+
+
+def test_a_results_root_points_at_its_campaign_folders(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(CAMPAIGN.replace("orders = [0, 1]", "orders = [0]"))
+    hinfix.run_campaign(path, tmp_path / "results")
+    with pytest.raises(ValueError, match=r"is a results root, not a campaign's folder: it holds py-small"):
+        hinfix.read_results(tmp_path / "results")
+
+
+def test_a_torn_last_line_is_left_out_with_a_warning(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(CAMPAIGN.replace("orders = [0, 1]", "orders = [0]"))
+    folder = hinfix.run_campaign(path, tmp_path / "results")["dir"]
+    with open(f"{folder}/runs.jsonl", "a") as f:
+        f.write('{"plant": "HE1", "ord')  # a run killed while writing
+    with pytest.warns(UserWarning, match=r"runs.jsonl: line 2 is torn"):
+        res = hinfix.read_results(folder)
+    assert len(res) == 1
+
+
+def test_to_pandas_gives_the_columns_or_says_what_is_missing(tmp_path, monkeypatch):
+    import sys
+    res = hinfix.read_results(tmp_path)
+    monkeypatch.setitem(sys.modules, "pandas", None)  # as if pandas were not installed
+    with pytest.raises(ImportError, match=r"needs pandas .*Results.columns\(\)"):
+        res.to_pandas()
+    monkeypatch.undo()
+    pandas = pytest.importorskip("pandas")
+    df = res.to_pandas("plant", "gamma")
+    assert isinstance(df, pandas.DataFrame) and list(df.columns) == ["plant", "gamma"]

@@ -17,32 +17,23 @@ def test_hinfix_error_is_a_runtime_error():
 
 def test_partition_errors(he1):
     P, nmeas, ncon = he1
-    with pytest.raises(ValueError, match=r"nmeas must be in 1..=3, got 0"):
+    with pytest.raises(ValueError, match=r"nmeas must be in 1..=2 \(P has 3 outputs and one at least is z\), got 0"):
         hinfix.design(P, 0, ncon, 1)
-    with pytest.raises(ValueError, match=r"ncon must be in 1..=4, got 7"):
+    with pytest.raises(ValueError, match=r"ncon must be in 1..=3 \(P has 4 inputs and one at least is w\), got 7"):
         hinfix.design(P, nmeas, 7, 1)
-    with pytest.raises(TypeError, match="nmeas must be an integer"):
+    with pytest.raises(TypeError, match="nmeas must be a whole number"):
         hinfix.design(P, 1.5, ncon, 1)
-    with pytest.raises(ValueError, match="discrete-time"):
-        hinfix.design(control.c2d(P, 0.1), nmeas, ncon, 1)
-
-
-def test_a_discrete_time_plant_file_is_refused_by_name():
-    import os
-    path = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "discrete", "HE1_Ts0.1.json")
-    with pytest.raises(ValueError, match=r"HE1_Ts0\.1\.json: a discrete-time plant \(Ts = 0\.1 s\)"):
-        hinfix.load_plant(path)
 
 
 def test_option_errors_carry_the_crates_message(he1):
     P, nmeas, ncon = he1
     with pytest.raises(ValueError, match="ε must be finite and positive"):
         hinfix.design(P, nmeas, ncon, 1, eps=-1.0)
-    with pytest.raises(ValueError, match="option `nrand`: invalid type: string"):
+    with pytest.raises(TypeError, match="nrand must be a whole number, got '3'"):
         hinfix.design(P, nmeas, ncon, 1, nrand="3")
     with pytest.raises(ValueError, match="exceeds the plant order n = 4"):
         hinfix.design(P, nmeas, ncon, 5)
-    with pytest.raises(ValueError, match="option `order`: invalid value: integer `-1`"):
+    with pytest.raises(ValueError, match="order must be ≥ 0, got -1"):
         hinfix.design(P, nmeas, ncon, -1)
     with pytest.raises(ValueError, match="must be at least 1"):
         hinfix.design(P, nmeas, ncon, 1, maxevals=0)

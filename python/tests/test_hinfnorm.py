@@ -32,9 +32,19 @@ def test_static_gain_transfer_function_and_unstable():
 
 
 def test_bad_systems_raise():
-    with pytest.raises(ValueError, match="discrete-time"):
-        hinfix.hinfnorm(control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], 0.1))
+    with pytest.raises(ValueError, match="unspecified sampling time"):
+        hinfix.hinfnorm(control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], True))
     with pytest.raises(ValueError, match="NaN or infinite"):
         hinfix.hinfnorm(control.ss([[-1.0]], [[np.nan]], [[1.0]], [[0.0]]))
     with pytest.raises(ValueError, match="tol"):
         hinfix.hinfnorm(control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), tol=0.0)
+
+
+def test_a_discrete_time_system_on_the_unit_circle():
+    # G(z) = 1/(z - 0.5): the peak is at z = -1 (θ = π), |G| = 1/1.5; at z = 1 it is 2
+    value, peak = hinfix.hinfnorm(control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], 0.1))
+    assert value == pytest.approx(2.0, rel=1e-12) and peak == pytest.approx(0.0, abs=1e-9)
+    value, peak = hinfix.hinfnorm(control.ss([[-0.5]], [[1.0]], [[1.0]], [[0.0]], 0.1))
+    assert value == pytest.approx(2.0, rel=1e-12) and peak == pytest.approx(math.pi / 0.1, rel=1e-9)
+    value, peak = hinfix.hinfnorm(control.ss([[1.5]], [[1.0]], [[1.0]], [[0.0]], 0.1))
+    assert value == math.inf and math.isnan(peak)

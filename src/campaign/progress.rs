@@ -5,7 +5,9 @@
 //! * [`Display::Bars`] (stderr is a terminal): an indicatif bar over all jobs with ETA, and one
 //!   line per worker showing its job (plant, n_K, ε, seed) and the current γ;
 //! * [`Display::Plain`] (stderr is not a terminal, or `--no-progress`): one log line per started,
-//!   finished or interrupted job and per warning, so CI logs and `nohup` files stay readable.
+//!   finished or interrupted job and per warning, so CI logs and `nohup` files stay readable;
+//! * [`Display::Collect`]: the plain lines, kept for the caller ([`Reporter::take_lines`]), who
+//!   shows them where its user looks (the Python package: `sys.stderr`, a Jupyter cell).
 
 use std::io::IsTerminal;
 use std::time::Duration;
@@ -22,6 +24,8 @@ pub enum Display {
     Bars,
     /// One line per event on stderr.
     Plain,
+    /// The plain lines, kept until [`Reporter::take_lines`].
+    Collect,
 }
 
 impl Display {
@@ -42,6 +46,8 @@ pub struct Reporter<'a> {
     multi: MultiProgress,
     overall: Option<ProgressBar>,
     workers: Vec<ProgressBar>,
+    /// The lines kept by [`Display::Collect`].
+    pending: Vec<String>,
 }
 
 impl<'a> Reporter<'a> {
@@ -49,9 +55,9 @@ impl<'a> Reporter<'a> {
     pub fn new(jobs: &'a [Job], display: Display) -> Self {
         let multi = MultiProgress::with_draw_target(match display {
             Display::Bars => ProgressDrawTarget::stderr(),
-            Display::Plain => ProgressDrawTarget::hidden(),
+            Display::Plain | Display::Collect => ProgressDrawTarget::hidden(),
         });
-        Reporter { jobs, display, multi, overall: None, workers: Vec::new() }
+        Reporter { jobs, display, multi, overall: None, workers: Vec::new(), pending: Vec::new() }
     }
 
     fn label(&self, index: usize) -> String {
@@ -59,13 +65,19 @@ impl<'a> Reporter<'a> {
     }
 
     /// Prints a line above the bars (or plainly).
-    fn line(&self, msg: String) {
+    fn line(&mut self, msg: String) {
         match self.display {
             Display::Bars => {
                 let _ = self.multi.println(msg);
             }
             Display::Plain => eprintln!("{msg}"),
+            Display::Collect => self.pending.push(msg),
         }
+    }
+
+    /// The lines kept since the last call ([`Display::Collect`]; none for the other displays).
+    pub fn take_lines(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.pending)
     }
 
     /// Consumes one event.

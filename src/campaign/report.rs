@@ -64,9 +64,11 @@ impl fmt::Display for ReportSummary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // the objective is named only when the campaign ran both
         let mixed = self.compare.iter().any(|r| r.objective != self.compare[0].objective);
+        // the plant column as wide as its longest name (at least 8, the width it always had)
+        let w = self.compare.iter().map(|r| for_terminal(&r.plant).chars().count()).fold(8, usize::max);
         writeln!(
             f,
-            "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}{}",
+            "{:<w$} {:>3} {:>11} {:>11} {:>8} {:>9}{}",
             "plant",
             "nK",
             "ours",
@@ -85,7 +87,7 @@ impl fmt::Display for ReportSummary {
             };
             writeln!(
                 f,
-                "{:<8} {:>3} {:>11} {:>11} {:>8} {:>9}{objective}",
+                "{:<w$} {:>3} {:>11} {:>11} {:>8} {:>9}{objective}",
                 for_terminal(&r.plant),
                 r.order,
                 latex::num(r.ours),
@@ -256,6 +258,38 @@ pub fn write_problem_reports(
 #[cfg(test)]
 mod tests {
     use super::FULL_ORDER_MAX_N;
+
+    /// The console table's columns line up whatever the length of the plant names (a name longer
+    /// than the column's 8 characters pushed its row to the right); names of up to 8 keep the
+    /// table as it always was.
+    #[test]
+    fn the_console_table_aligns_long_plant_names() {
+        use super::ReportSummary;
+        use crate::campaign::CompareRow;
+        use crate::design::ObjectiveKind;
+        let row = |plant: &str, order| CompareRow {
+            plant: plant.into(),
+            order,
+            objective: ObjectiveKind::Strong,
+            ours: 1.5,
+            paper: 1.25,
+            literature: vec![],
+            full_order: f64::NAN,
+            ratio: 1.2,
+        };
+        let table = |names: &[&str]| {
+            let compare = names.iter().enumerate().map(|(i, n)| row(n, i)).collect();
+            ReportSummary { files: vec![], best: vec![], compare }.to_string()
+        };
+        let widths = |t: &str| t.lines().map(|l| l.chars().count()).collect::<Vec<_>>();
+        let long = table(&["HE1", "two_mass_spring", "AC10"]);
+        let w = widths(&long);
+        assert!(w.iter().all(|&x| x == w[0]), "{long}");
+        assert_eq!(w[0], widths(&table(&["HE1"]))[0] + "two_mass_spring".len() - 8);
+        let short = table(&["HE1", "Enns"]);
+        assert!(short.starts_with(&format!("{:<8} {:>3} ", "plant", "nK")), "{short}");
+        assert!(short.lines().nth(1).unwrap().starts_with(&format!("{:<8} {:>3} ", "HE1", 0)), "{short}");
+    }
 
     /// campaigns/FORMAT.md states the limit in prose; it must say what the code does.
     #[test]

@@ -3,7 +3,7 @@
 //! shard plan of `--shards N`, and the report files of the journaled records. The command line
 //! (`cli/campaign.rs`) only prints these.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -149,22 +149,28 @@ pub struct ShardLoad {
     pub wall_bound_s: f64,
 }
 
-/// How `--shard K/N` splits the jobs: per shard, its jobs, CPU budget and a wall-time bound by
-/// list scheduling on `threads` workers: Σ cpumax / threads + its longest chain of jobs that
-/// wait for others (warm start, order chaining; Graham's bound; jobs stop at their CPU budget, and a worker thread gets a CPU to itself).
-pub fn shard_plan(jobs: &[Job], n: usize, threads: usize) -> Vec<ShardLoad> {
+/// How `--shard K/N` splits the jobs: per shard, its jobs left to run (those not in `done`, the
+/// journaled ones, which `campaign run` skips), their CPU budget and a wall-time bound by list
+/// scheduling on `threads` workers: Σ cpumax / threads + its longest chain of jobs left to run
+/// that wait for others (warm start, order chaining; Graham's bound; jobs stop at their CPU
+/// budget, and a worker thread gets a CPU to itself). The shards are those of every job, as
+/// `run --shard` takes them.
+pub fn shard_plan(jobs: &[Job], n: usize, threads: usize, done: &HashSet<&JobId>) -> Vec<ShardLoad> {
     let assign = shard::assign(jobs, n);
     let index: HashMap<_, _> = jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect();
+    let left = |i: usize| !done.contains(&jobs[i].id);
+    let budget = |i: usize| if left(i) { jobs[i].options.cpumax } else { 0.0 };
     // budget of the chain up to and including each job
     let mut chain = vec![0.0f64; jobs.len()];
     for (i, j) in jobs.iter().enumerate() {
         let before = j.predecessors().filter_map(|p| index.get(p)).map(|&p| chain[p]).fold(0.0, f64::max);
-        chain[i] = before + j.options.cpumax;
+        chain[i] = before + budget(i);
     }
     (0..n)
         .map(|k| {
-            let mine: Vec<usize> = (0..jobs.len()).filter(|&i| assign[i] == k).collect();
-            let cpu_s: f64 = mine.iter().map(|&i| jobs[i].options.cpumax).sum();
+            let mine: Vec<usize> = (0..jobs.len()).filter(|&i| assign[i] == k && left(i)).collect();
+            // + 0.0: an empty `sum` of f64 is −0 (printed "-0 s"), and −0 + 0 is +0
+            let cpu_s = mine.iter().map(|&i| budget(i)).sum::<f64>() + 0.0;
             let longest = mine.iter().map(|&i| chain[i]).fold(0.0, f64::max);
             ShardLoad { jobs: mine.len(), cpu_s, wall_bound_s: cpu_s / threads as f64 + longest }
         })

@@ -2,9 +2,10 @@
 //! [--maxevals N] [--stall-starts 60] [--stall-rtol 1e-6] [--stop-on-stall] [--max-starts N] [--hop-scales 0.01,0.1,1]
 //! [--central-gammas 1.1,2] [--random-scales 1,0.1,0.01] [--no-open-loop-start] [--no-continue-at-maxit]
 //! [--continued-maxit 3000] [--keep-gs-reserve]
-//! [--variable-scaling off|alternate|always] [--init K.json] [--structure S.json] [--no-strong] [--json] --out K.json`: one HIFOO design. Prints a short summary
+//! [--variable-scaling off|alternate|always] [--init K.json] [--structure S.json] [--no-strong] [--json] [--out K.json]`: one HIFOO design. Prints a short summary
 //! (or the whole outcome as JSON with `--json`) and writes the controller file that
-//! `campaign check` reads, atomically and durably (`crate::fs_atomic`).
+//! `campaign check` reads, atomically and durably (`crate::fs_atomic`). `--out` may be left out
+//! with `--json` only (the controller is then in the JSON, `controller`, and no file is written).
 //!
 //! Only a stabilising controller (closed loop stable and, with the strong objective, the
 //! controller too, both with the verification margin of `lti::is_stable_with_margin`) is written
@@ -188,12 +189,12 @@ pub struct DesignArgs {
     pub json: bool,
     /// Where to write the controller: JSON {AK, BK, CK, DK}, or a MATLAB level-5 file with the
     /// variables AK BK CK DK when the name ends in `.mat`. Only a stabilising controller is
-    /// written here.
-    #[arg(long)]
-    pub out: PathBuf,
+    /// written here. Required unless --json is given (the JSON holds the controller).
+    #[arg(long, required_unless_present = "json")]
+    pub out: Option<PathBuf>,
     /// When the run finds no stabilising controller, write the one it ended with anyway, as
     /// `<stem>.unverified.<ext>` next to --out (never to --out itself).
-    #[arg(long)]
+    #[arg(long, requires = "out")]
     pub out_unverified: bool,
 }
 
@@ -294,7 +295,9 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         None => None,
     };
     let names = problem.terms.iter().map(|t| for_terminal(&t.plant.name)).collect::<Vec<_>>().join(", ");
-    check_writable(&a.out).with_context(|| format!("--out {}", a.out.display()))?;
+    if let Some(out) = &a.out {
+        check_writable(out).with_context(|| format!("--out {}", out.display()))?;
+    }
     let cancel = signals::install();
     let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
     let outcome = run_problem(&problem, &opts, init.as_ref(), structure.as_ref(), &ctl, &mut NoDesignObserver)
@@ -311,10 +314,11 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
             outcome.objective
         );
     }
-    let written = match (good, a.out_unverified) {
-        (true, _) => Some(a.out.clone()),
-        (false, true) => Some(unverified_path(&a.out)),
-        (false, false) => None,
+    let written = match (&a.out, good, a.out_unverified) {
+        (None, _, _) => None,
+        (Some(out), true, _) => Some(out.clone()),
+        (Some(out), false, true) => Some(unverified_path(out)),
+        (Some(_), false, false) => None,
     };
     if let Some(path) = &written {
         if crate::lti::is_mat_path(path) {
@@ -329,19 +333,20 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     } else {
         print!("{}", summary(plant, &opts, &outcome));
     }
-    let what = match (&written, good) {
-        (Some(p), true) => format!("controller written to {}", p.display()),
-        (Some(p), false) => {
+    let what = match (&a.out, &written, good) {
+        (None, _, _) => "no --out: no controller file written (the JSON above holds it, `controller`)".to_string(),
+        (Some(_), Some(p), true) => format!("controller written to {}", p.display()),
+        (Some(out), Some(p), false) => {
             format!(
                 "NOT STABILISING controller written to {} (--out-unverified); {} untouched",
                 p.display(),
-                a.out.display()
+                out.display()
             )
         }
-        (None, _) => format!(
+        (Some(out), None, _) => format!(
             "no controller written: it does not stabilise ({} untouched; --out-unverified writes it to {})",
-            a.out.display(),
-            unverified_path(&a.out).display()
+            out.display(),
+            unverified_path(out).display()
         ),
     };
     if a.json {
@@ -527,6 +532,26 @@ mod tests {
         .unwrap();
         let a = cli.design_args().expect("a design command");
         assert_eq!(options(a).unwrap(), DesignOptions { order: 2, ..DesignOptions::default() });
+    }
+
+    /// One search everywhere (issue 51, item 3): a campaign job that sets no option designs with
+    /// exactly the options of `campaign design` given only the required flags, both the option
+    /// table's defaults. (The Python package's defaults are the same `DesignOptions::default`,
+    /// python/tests/test_defaults.py.)
+    #[test]
+    fn a_campaign_job_designs_as_campaign_design_does() {
+        use clap::Parser;
+        let cli = crate::cli::Cli::try_parse_from([
+            "campaign", "design", "--plant", "HE1", "--order", "2", "--out", "K.json",
+        ])
+        .unwrap();
+        let flags = options(cli.design_args().expect("a design command")).unwrap();
+        let text = "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [2]\n";
+        let campaign = crate::campaign::Campaign::from_toml_str(text, Path::new("t.toml")).unwrap();
+        let jobs = crate::campaign::expand(&campaign, crate::campaign::RunnerTag::Design);
+        assert_eq!(jobs.len(), 1);
+        assert_eq!(jobs[0].options, flags);
+        assert_eq!(flags, DesignOptions { order: 2, ..DesignOptions::default() });
     }
 
     #[test]

@@ -661,9 +661,43 @@ pub fn options_markdown() -> String {
     out
 }
 
+impl DesignOptions {
+    /// The options of a JSON object that names some options (the others at their defaults,
+    /// [`DesignOptions::default`]), as a program driving the design from outside gives them (the
+    /// Python package). Not plain deserialisation: a *record* lacking a field reads it as the
+    /// behaviour before the field existed (e.g. `stall_starts` 0, no hops), which is right for an
+    /// old journal line and wrong for a caller who left the option out to get the default.
+    /// An unknown name is an error, as in a campaign file.
+    pub fn from_json_over_defaults(given: serde_json::Map<String, serde_json::Value>) -> serde_json::Result<Self> {
+        let mut all = match serde_json::to_value(DesignOptions::default())? {
+            serde_json::Value::Object(m) => m,
+            _ => serde_json::Map::new(),
+        };
+        all.extend(given);
+        serde_json::from_value(serde_json::Value::Object(all))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Options left out of the object are the defaults, not a record's "missing field" values
+    /// (stall_starts 0, no hops, no open-loop or central starts); given ones are taken as given.
+    #[test]
+    fn options_over_the_defaults() {
+        let none = DesignOptions::from_json_over_defaults(serde_json::Map::new()).unwrap();
+        assert_eq!(none, DesignOptions::default());
+        let record = serde_json::from_str::<DesignOptions>("{}").unwrap();
+        assert_ne!(record.stall_starts, none.stall_starts, "the test must show the difference");
+        let given = serde_json::json!({"order": 2, "stall_starts": 5, "hop_scales": []});
+        let serde_json::Value::Object(given) = given else { unreachable!() };
+        let o = DesignOptions::from_json_over_defaults(given).unwrap();
+        let want = DesignOptions { order: 2, stall_starts: 5, hop_scales: vec![], ..DesignOptions::default() };
+        assert_eq!(o, want);
+        let serde_json::Value::Object(bad) = serde_json::json!({"stall_start": 5}) else { unreachable!() };
+        assert!(DesignOptions::from_json_over_defaults(bad).unwrap_err().to_string().contains("stall_start"));
+    }
 
     /// The job ids of the results already journaled are hashes of this form: it must not change.
     /// The options of a journaled job of campaigns/strong-stab.toml (results/strong-stab), as
