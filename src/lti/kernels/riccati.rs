@@ -94,7 +94,7 @@ pub struct CareSolution {
     pub x: Mat<f64>,
     /// Sign-function iterations used.
     pub iterations: usize,
-    /// Relative residual (see the module docs; above [`CARE_RESIDUAL_TOL`] only for a solution
+    /// Relative residual (see the module docs; above its tolerance 1e-8 only for a solution
     /// accepted by its subspace backward error).
     pub residual: f64,
     /// Spectral abscissa of the closed loop `A − G X` (negative).

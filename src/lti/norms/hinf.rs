@@ -386,13 +386,9 @@ fn hinf_norm_from(
         }
         stop.poll()?;
         let Some(LevelSet { crossings: ws, probes }) = ham.crossings(gamma, best.freq) else { break };
+        let verify = |crossings| Verify { level: gamma, sigma_d, crossings, modes: &modes_scan };
         if ws.is_empty() && probes.is_empty() {
-            if verify_stop(
-                fr,
-                &mut best,
-                Verify { level: gamma, sigma_d, crossings: &ws, modes: &modes_scan },
-                &mut seen,
-            ) {
+            if verify_stop(fr, &mut best, verify(&ws), &mut seen) {
                 continue;
             }
             break;
@@ -446,12 +442,7 @@ fn hinf_norm_from(
         if ws.is_empty() {
             count(Step::Probe);
             if !raised(&best) {
-                if verify_stop(
-                    fr,
-                    &mut best,
-                    Verify { level: gamma, sigma_d, crossings: &ws, modes: &modes_scan },
-                    &mut seen,
-                ) {
+                if verify_stop(fr, &mut best, verify(&ws), &mut seen) {
                     continue;
                 }
                 break; // the probes were off any peak above γ_L
@@ -469,12 +460,7 @@ fn hinf_norm_from(
             break;
         }
         if !raised(&best) {
-            if verify_stop(
-                fr,
-                &mut best,
-                Verify { level: gamma, sigma_d, crossings: &ws, modes: &modes_scan },
-                &mut seen,
-            ) {
+            if verify_stop(fr, &mut best, verify(&ws), &mut seen) {
                 continue;
             }
             break; // no progress: the crossings were spurious
