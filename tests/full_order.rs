@@ -118,3 +118,55 @@ fn feedthrough_bound_case() {
     assert!(rel(r.gamma, 2.0) < 2e-8, "{r}");
     assert_eq!(r.binding, Binding::Feedthrough);
 }
+
+fn fixture_plant(name: &str) -> Plant {
+    Plant::load(format!("{}/tests/fixtures/full_order/plants/{name}.json", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// The general plant (tests/fixtures/full_order/cross_terms.py): one disturbance enters a state
+/// and the measurement (B1·D21ᵀ ≠ 0, D21 square, so the filter Riccati equation's constant term is
+/// exactly 0), and its transpose-dual (D12ᵀ·C1 ≠ 0, D12 square). Before the constant terms were
+/// formed as Gram products and the CARE accepted a stable subspace exact to rounding with X ≈ 0,
+/// both failed: "no feasible gamma up to 1e12 (Y: CARE relative residual 2.51e-1)". SB10AD
+/// bisection to 1e-10 (its own feasibility test agrees between the two plants to 2e-8).
+#[test]
+fn cross_term_plants_match_sb10ad() {
+    let mut gammas = Vec::new();
+    for name in ["two_mass_cross", "two_mass_cross_dual"] {
+        let p = fixture_plant(name);
+        let r = full_order_gamma(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(r.regularisation, None);
+        let f = fixture(name, None);
+        assert!(rel(r.gamma, f) < 5e-8, "{name}: {} vs SB10AD {f}", r.gamma);
+        gammas.push(r.gamma);
+    }
+    // A plant and its transpose-dual have the same γ_opt (‖Gᵀ‖∞ = ‖G‖∞, K ↦ Kᵀ).
+    assert!(rel(gammas[0], gammas[1]) < 2e-8, "{gammas:?}");
+}
+
+/// The central controller of the cross-term plants at 1.1·γ_opt: stabilising, closed-loop norm
+/// below the level (the central starts of a design use it).
+#[test]
+fn cross_term_plants_central_controller_meets_its_level() {
+    use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, CentralProblem, HinfParams};
+    for name in ["two_mass_cross", "two_mass_cross_dual"] {
+        let p = fixture_plant(name);
+        let cp = CentralProblem::new(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let level = 1.1 * cp.gamma_opt;
+        let k = cp.controller(level).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let cl = closed_loop(&p, &k).unwrap();
+        assert!(spectral_abscissa(cl.a.as_ref()) < 0.0, "{name}: not stabilising");
+        let g = hinf_norm(&cl, &HinfParams::new(1e-10)).unwrap().value;
+        assert!(g < level, "{name}: closed loop {g} above the level {level}");
+    }
+}
+
+/// With the cross terms zero the value is the one computed before the general plant was handled
+/// (commit 10ba035, `campaign plant examples/own-plant/two_mass.mat --json`), to 1e-12.
+#[test]
+fn zero_cross_terms_unchanged() {
+    let p = Plant::load(format!("{}/examples/own-plant/two_mass.mat", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let before = 0.8769144643283485;
+    let r = full_order_gamma(&p).unwrap();
+    assert!(rel(r.gamma, before) <= 1e-12, "{} vs {before}", r.gamma);
+}

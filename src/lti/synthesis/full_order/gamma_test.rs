@@ -19,12 +19,17 @@
 //! standing assumption is only that D12 has full column rank and D21 full row rank (plus the
 //! imaginary-axis rank conditions). D11 ≠ 0 is handled directly (no loop shifting needed). D22
 //! does not affect γ_opt (it is removed by a loop transformation of the controller) and is ignored.
+//! The constant terms `C1ᵀ (I − D1• R⁻¹ D1•ᵀ) C1` and `B1 (I − D•1ᵀ R̃⁻¹ D•1) B1ᵀ` are not formed
+//! as written but as Gram products in the normalised coordinates (`exogenous_weights.rs`): as
+//! differences they cancel to rounding noise where the exact value is 0 or small (a square D21
+//! with B1·D21ᵀ ≠ 0, a square D12 with D12ᵀ·C1 ≠ 0), and that noise made the γ-test fail at every γ.
 //! Each Riccati equation is solved by [`solve_care`] (matrix sign function, with
 //! finiteness, residual and stabilising checks); any failure there means "γ infeasible".
 //!
 
 use faer::Mat;
 
+use super::exogenous_weights::ExogenousWeight;
 use super::linalg::{concat_cols, concat_rows, feedthrough_bound, solve, sym_eig};
 use super::{Binding, FullOrderError};
 use crate::lti::kernels::riccati::solve_care;
@@ -68,14 +73,16 @@ pub(crate) struct Problem {
     a: Mat<f64>,
     b: Mat<f64>,
     c: Mat<f64>,
-    /// D1•ᵀ D1• ((m1+m2)²), D1•ᵀ C1, C1ᵀ C1.
+    /// D1•ᵀ D1• ((m1+m2)²), D1•ᵀ C1.
     d1t_d1: Mat<f64>,
     d1t_c1: Mat<f64>,
-    c1t_c1: Mat<f64>,
-    /// D•1 D•1ᵀ ((p1+p2)²), D•1 B1ᵀ, B1 B1ᵀ.
+    /// The X equation's constant term as a function of γ.
+    qx: ExogenousWeight,
+    /// D•1 D•1ᵀ ((p1+p2)²), D•1 B1ᵀ.
     dd1_dd1t: Mat<f64>,
     dd1_b1t: Mat<f64>,
-    b1_b1t: Mat<f64>,
+    /// The Y equation's constant term as a function of γ.
+    qy: ExogenousWeight,
     /// Condition (i) bound.
     pub(crate) gamma_d: f64,
 }
@@ -91,6 +98,8 @@ impl Problem {
         let d1 = concat_cols(d11.as_ref(), d12.as_ref());
         let dd1 = concat_rows(d11.as_ref(), d21.as_ref());
         let gamma_d = feedthrough_bound(d11.as_ref(), d12.as_ref(), d21.as_ref())?;
+        let qx = ExogenousWeight::state_feedback(c1.as_ref(), d11.as_ref(), d12.as_ref())?;
+        let qy = ExogenousWeight::filter(b1.as_ref(), d11.as_ref(), d21.as_ref())?;
         Ok(Problem {
             n,
             m1,
@@ -98,10 +107,10 @@ impl Problem {
             a: plant.a.clone(),
             d1t_d1: d1.transpose() * &d1,
             d1t_c1: d1.transpose() * &c1,
-            c1t_c1: c1.transpose() * &c1,
+            qx,
             dd1_dd1t: &dd1 * dd1.transpose(),
             dd1_b1t: &dd1 * b1.transpose(),
-            b1_b1t: &b1 * b1.transpose(),
+            qy,
             b,
             c,
             gamma_d,
@@ -125,7 +134,10 @@ impl Problem {
         let (r_dc, r_bt) = (m.subcols(0, n), m.subcols(n, n));
         let ax = &self.a - &self.b * r_dc;
         let gx = &self.b * r_bt;
-        let qx = &self.c1t_c1 - self.d1t_c1.transpose() * r_dc;
+        let qx = self
+            .qx
+            .at(gamma)
+            .ok_or((Binding::Feedthrough, "I - D11 D11'/gamma^2 not positive definite".to_string()))?;
         let x = solve_care(ax.as_ref(), gx.as_ref(), qx.as_ref())
             .map_err(|e| (Binding::StateFeedback, format!("X: {e}")))?
             .x;
@@ -143,7 +155,10 @@ impl Problem {
         // CARE in transposed form: A_yᵀ Y + Y A_y − Y G_y Y + Q_y with A_y = (A − B1 D•1ᵀ R̃⁻¹ C)ᵀ.
         let ay = self.a.transpose() - self.c.transpose() * rt_db;
         let gy = self.c.transpose() * rt_c;
-        let qy = &self.b1_b1t - self.dd1_b1t.transpose() * rt_db;
+        let qy = self
+            .qy
+            .at(gamma)
+            .ok_or((Binding::Feedthrough, "I - D11' D11/gamma^2 not positive definite".to_string()))?;
         let y = solve_care(ay.as_ref(), gy.as_ref(), qy.as_ref()).map_err(|e| (Binding::Filter, format!("Y: {e}")))?.x;
         let (yl, _) = sym_eig(y.as_ref()).ok_or((Binding::Filter, "eig(Y) failed".to_string()))?;
         psd_check(&yl).map_err(|s| (Binding::Filter, format!("Y: {s}")))?;

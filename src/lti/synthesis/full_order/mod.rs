@@ -3,6 +3,8 @@
 //!
 //! * `gamma_test.rs`: the γ-test — for a given γ, the X and Y Riccati equations, X, Y ⪰ 0 and the
 //!   coupling ρ(XY) < γ² (the theory and references are there);
+//! * `exogenous_weights.rs`: the γ-test's Riccati constant terms as Gram products in the
+//!   normalised coordinates (no cancellation when B1·D21ᵀ ≠ 0 or D12ᵀ·C1 ≠ 0);
 //! * `bracketing.rs`: the γ-iteration — feasibility is monotone in γ, so γ_opt is bracketed and
 //!   bisected to [`GAMMA_RTOL`];
 //! * `regularisation.rs`: plants with a rank-deficient D12 or D21 — δ-weighted channels are added
@@ -22,11 +24,14 @@ use crate::lti::system::plant::Plant;
 use crate::numeric::all_finite;
 
 mod bracketing;
+mod exogenous_weights;
 mod gamma_test;
 pub(super) mod linalg;
 mod regularisation;
 
 pub use bracketing::{GAMMA_MAX, GAMMA_RTOL};
+/// The absolute part of the X ⪰ 0 / Y ⪰ 0 test, shared with the central controller.
+pub(crate) use gamma_test::PSD_ATOL;
 /// The δ-augmentation of a singular D12/D21, shared with the central-controller start.
 pub(crate) use regularisation::augment;
 pub use regularisation::{Regularisation, FLAT_RTOL, REGULARISATION_DELTAS};
