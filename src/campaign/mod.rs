@@ -16,6 +16,7 @@ mod jobs;
 pub(crate) mod journal;
 pub(crate) mod latex;
 mod lookup;
+pub mod methods;
 mod model;
 pub mod plot;
 pub(crate) mod progress;
