@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::campaign::methods::{compare_methods, load_sources, DEFAULT_RTOL};
+use crate::campaign::{compare_methods, load_sources, DEFAULT_RTOL};
 
 /// Arguments of `campaign compare`.
 #[derive(clap::Args, Debug)]
