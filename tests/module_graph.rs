@@ -232,7 +232,7 @@ const CAMPAIGN_PARTS: &[(&str, &[&str])] = &[
     ("model", &["model", "spec", "jobs"]),
     ("records", &["record", "journal", "claims", "shard"]),
     ("execution", &["scheduler", "trace", "progress", "run", "fake"]),
-    ("reduction", &["reduce", "compare", "latex", "report", "plot", "status", "lookup"]),
+    ("reduction", &["reduce", "compare", "latex", "report", "plot", "status", "lookup", "methods", "html"]),
 ];
 
 /// Rank of the part holding a campaign module (`plot::render` → that of `plot`).

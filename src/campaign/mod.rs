@@ -13,10 +13,12 @@ pub(crate) mod claims;
 mod compare;
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) mod fake;
+pub mod html;
 mod jobs;
 pub(crate) mod journal;
 pub(crate) mod latex;
 mod lookup;
+pub mod methods;
 mod model;
 pub mod plot;
 pub(crate) mod progress;
@@ -37,6 +39,7 @@ mod trace_filter;
 pub use claims::unix_now;
 #[cfg(any(test, feature = "test-support"))]
 pub use fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
+pub use html::{report_html, write_html_report};
 pub use jobs::{
     chained_job_id, expand, job_id, problem_fingerprint, problem_job_id, Job, JobId, ProblemKey, RunnerTag,
     JOB_ID_VERSION,
@@ -47,6 +50,7 @@ pub use journal::{
 };
 pub use latex::{campaign_table, compare_tex, cost_table, sig4, sig_figs, tables_tex, tables_tex_about};
 pub use lookup::{find_record, Entry, LookupError};
+pub use methods::{compare_methods, load_sources, MethodsError, MethodsOutcome, SourceError, DEFAULT_RTOL};
 pub use progress::{Display as ProgressDisplay, Reporter};
 pub use provenance::Provenance;
 pub use record::{FailureKind, JobFailure, JobRecord, JobResult, JobStatus, Unverifiable, SCHEMA_VERSION};

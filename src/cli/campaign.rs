@@ -149,7 +149,7 @@ fn budget_note(c: &Campaign, compare: &[crate::campaign::CompareRow]) -> Option<
 
 /// Reduces `records` (the campaign's, duplicates included) to the report files in `dir` and
 /// prints the comparison, and how many jobs were journaled more than once.
-fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Result<()> {
+fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Result<crate::campaign::CampaignReport> {
     let report = crate::campaign::report(dir, c, records)?;
     print!("{}", report.summary);
     if let Some(note) = budget_note(c, &report.summary.compare) {
@@ -163,7 +163,7 @@ fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Resul
             dups.len()
         );
     }
-    Ok(())
+    Ok(report)
 }
 
 /// `campaign run FILE`.
@@ -370,11 +370,13 @@ fn finished_records(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<Vec<JobRe
     Ok(records)
 }
 
-/// `campaign report FILE`.
+/// `campaign report FILE`: the tables, and the page `report/index.html` (`campaign::html`).
 pub fn report(a: ReportArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
-    report_into(&l.dir, &l.campaign, &records)?;
+    let r = report_into(&l.dir, &l.campaign, &records)?;
+    let page = crate::campaign::write_html_report(&l.dir, &r.summary.best, &r.summary.compare, &records)?;
+    eprintln!("report page: {}", for_terminal(&page.display().to_string()));
     Ok(ExitCode::SUCCESS)
 }
 

@@ -19,6 +19,7 @@ use crate::campaign::JobRunner;
 
 mod campaign;
 mod check;
+mod compare;
 mod design;
 mod export;
 mod plants;
@@ -56,6 +57,9 @@ enum Command {
     Trace(campaign::TraceArgs),
     /// Draw a campaign's figures (γ vs order, convergence, σ-plots) as PNG and SVG.
     Plot(campaign::PlotArgs),
+    /// Compare methods (results folders, CSV files of published values) entry by entry: tables,
+    /// wins/ties/losses, performance profiles.
+    Compare(compare::CompareArgs),
     /// Print a controller as MATLAB or python-control code (sign convention u = K y).
     Export(export::ExportArgs),
     /// List the benchmark plants shipped in plants/.
@@ -117,6 +121,7 @@ fn run_command_line(fake: Option<Box<dyn JobRunner>>) -> ExitCode {
         Command::Report(a) => campaign::report(a, fake),
         Command::Trace(a) => campaign::trace(a),
         Command::Plot(a) => campaign::plot(a, fake),
+        Command::Compare(a) => compare::run(a),
         Command::Export(a) => export::run(a),
         Command::Plants(a) => plants::list(a),
         Command::Plant(a) => plants::show(a),
