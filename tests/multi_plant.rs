@@ -43,18 +43,6 @@ fn design(problem: &Problem, o: &DesignOptions, s: Option<&Structure>) -> Result
     run_problem(problem, o, None, s, &RunControl::new(o.cpumax), &mut NoDesignObserver)
 }
 
-/// HE1 with D21 = [0.5, 1] (HE1's is 0) and D11 = D12·X·D21 (X = [0.3; −0.2]): a continuous H2
-/// objective then fixes Dk = −X (D12 is invertible and D21 has rank 1 = p2, so the set of
-/// feedthroughs is one point).
-fn he1_with_feedthrough() -> Plant {
-    let mut p = Plant::load(resolve_plant("HE1").unwrap()).unwrap();
-    p.d21 = faer::mat![[0.5, 1.0]];
-    let x = faer::mat![[0.3], [-0.2]];
-    p.d11 = &p.d12 * &x * &p.d21;
-    p.name = "HE1-D11".into();
-    p
-}
-
 /// Central differences of both phases of a problem's objective, for every objective kind, with
 /// weights and an active bound, at a controller where they are smooth (early in a search).
 #[test]
@@ -97,7 +85,7 @@ fn every_objective_has_an_exact_gradient() {
 /// The H2 objective's gradient through the projection of Dk onto D11 + D12 Dk D21 = 0.
 #[test]
 fn the_h2_gradient_through_the_feedthrough_projection_is_exact() {
-    let problem = Problem { terms: vec![term(he1_with_feedthrough(), PlantObjective::H2, 1.0, None)] };
+    let problem = Problem { terms: vec![term(common::he1_with_feedthrough(), PlantObjective::H2, 1.0, None)] };
     let h2 = problem.validate().unwrap().expect("a constraint on Dk");
     let o = design(&problem, &opts(1, 0, 300), None).unwrap();
     let x0: Vec<f64> =
@@ -114,7 +102,7 @@ fn the_h2_gradient_through_the_feedthrough_projection_is_exact() {
 /// feedthrough, and the outcome's ‖Tzw‖₂ is that of the returned controller.
 #[test]
 fn an_h2_design_keeps_the_loop_strictly_proper() {
-    let p = he1_with_feedthrough();
+    let p = common::he1_with_feedthrough();
     let problem = Problem { terms: vec![term(p.clone(), PlantObjective::H2, 1.0, None)] };
     let o = design(&problem, &opts(1, 0, 1500), None).unwrap();
     assert!(o.gamma.is_finite() && o.gamma > 0.0, "{}", o.gamma);
@@ -258,10 +246,10 @@ fn bad_problems_are_named_errors() {
         let e = Problem { terms: vec![term(he1(), PlantObjective::Hinf, w, b)] }.validate().unwrap_err();
         assert!(matches!(e, ProblemError::Weight { .. } | ProblemError::Bound { .. }), "{e}");
     }
-    let e = two(he1(), PlantObjective::H2, he1_with_feedthrough(), PlantObjective::H2).validate().unwrap_err();
+    let e = two(he1(), PlantObjective::H2, common::he1_with_feedthrough(), PlantObjective::H2).validate().unwrap_err();
     assert!(matches!(e, ProblemError::H2Mixed { first: 1, index: 2, .. }), "{e}");
     // a structure that fixes DK where the H2 objective constrains it
-    let problem = Problem { terms: vec![term(he1_with_feedthrough(), PlantObjective::H2, 1.0, None)] };
+    let problem = Problem { terms: vec![term(common::he1_with_feedthrough(), PlantObjective::H2, 1.0, None)] };
     let shape = ControllerShape::for_plant(problem.first(), 1);
     let s = Structure::from_json(r#"{"DK": [[0.1], [null]]}"#, "s.json", shape).unwrap();
     let e = design(&problem, &opts(1, 0, 100), Some(&s)).unwrap_err();

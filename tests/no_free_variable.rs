@@ -1,7 +1,7 @@
 //! A design with no free variable is evaluated once and answered at once (search stop
 //! `no_free_variable`), under a budget that would otherwise let the search restart for minutes:
 //! the continuous H2 objective on a plant whose feedthrough constraint D11 + D12·Dk·D21 = 0 has
-//! one solution, at order 0; and a structure that fixes every entry. Its figures are those of
+//! one solution (`common::he1_with_feedthrough`: Dk = −[0.3; −0.2]), at order 0; and a structure that fixes every entry. Its figures are those of
 //! the one controller, recomputed here by the norms themselves.
 
 use std::time::Instant;
@@ -13,20 +13,11 @@ use hinfix::design::{
 use hinfix::lti::{closed_loop, h2_norm, hinf_norm, resolve_plant, HinfParams, Plant};
 use hinfix::optim::RunControl;
 
-/// HE1 with D21 = [0.5, 1] and D11 = D12·X·D21, X = [0.3; −0.2]: the continuous H2 objective
-/// forces Dk = −X (tests/multi_plant.rs has the same plant).
-fn he1_with_feedthrough() -> Plant {
-    let mut p = Plant::load(resolve_plant("HE1").unwrap()).unwrap();
-    p.d21 = faer::mat![[0.5, 1.0]];
-    let x = faer::mat![[0.3], [-0.2]];
-    p.d11 = &p.d12 * &x * &p.d21;
-    p.name = "HE1-D11".into();
-    p
-}
+mod common;
 
 #[test]
 fn h2_at_order_zero_with_a_forced_feedthrough_is_answered_at_once() {
-    let p = he1_with_feedthrough();
+    let p = common::he1_with_feedthrough();
     let problem = Problem {
         terms: vec![PlantTerm { plant: p.clone(), objective: PlantObjective::H2, weight: 1.0, bound: None }],
     };

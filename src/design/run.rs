@@ -268,18 +268,46 @@ pub fn run_problem_chained(
     let k = perf_obj.controller_at(&final_x);
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
-    let mut fig = figures(plant, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+    let (fig, plants) =
+        evaluate(plant, multi, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+    Ok(outcome(k, fig, plants, opts, (status, certificate), res.phases, ctl.cpu_elapsed(), res.summary))
+}
+
+/// The figures of `k` on the first plant ([`figures`]), or the problem's with each plant's value
+/// for a problem of several plants (`multi`).
+fn evaluate(
+    plant: &Plant,
+    multi: Option<&Problem>,
+    opts: &DesignOptions,
+    k: &Controller,
+    stop: Interrupt<'_>,
+) -> (Figures, Vec<PlantValue>) {
+    let mut fig = figures(plant, opts, k, stop);
     let plants = match multi {
         None => Vec::new(),
         Some(p) => {
-            let values = plant_values(p, &k, opts.hinf_tol);
+            let values = plant_values(p, k, opts.hinf_tol);
             problem_figures(&mut fig, &values, opts);
             values
         }
     };
-    let iterations = res.phases.iter().map(|p| p.iters).sum();
-    let evaluations = res.phases.iter().map(|p| p.evals).sum();
-    Ok(DesignOutcome {
+    (fig, plants)
+}
+
+/// The outcome of a run that returns `k` with figures `fig` (and `plants`), how it ended, its
+/// phases' counters, CPU seconds and search summary.
+#[allow(clippy::too_many_arguments)]
+fn outcome(
+    k: Controller,
+    fig: Figures,
+    plants: Vec<PlantValue>,
+    opts: &DesignOptions,
+    (status, certificate): (DesignStatus, Option<Certificate>),
+    phases: Vec<PhaseStats>,
+    design_cpu_s: f64,
+    search: SearchSummary,
+) -> DesignOutcome {
+    DesignOutcome {
         status,
         controller: k,
         gamma: fig.gamma,
@@ -289,13 +317,13 @@ pub fn run_problem_chained(
         objective: fig.objective,
         controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
         certificate,
-        iterations,
-        evaluations,
-        phases: res.phases,
-        design_cpu_s: ctl.cpu_elapsed(),
-        search: res.summary,
+        iterations: phases.iter().map(|p| p.iters).sum(),
+        evaluations: phases.iter().map(|p| p.evals).sum(),
+        phases,
+        design_cpu_s,
+        search,
         plants,
-    })
+    }
 }
 
 /// The design's free variables: the structure's free entries (every entry without one), Dk's
@@ -337,52 +365,30 @@ fn fixed_design(
         Some(h) => Controller { dk: h.project(&k.dk), ..k },
         None => k,
     };
-    let mut fig = figures(plant, opts, &k, Interrupt::NEVER);
     let multi = (!problem.is_single_hinf()).then_some(problem);
-    let plants = match multi {
-        None => Vec::new(),
-        Some(p) => {
-            let values = plant_values(p, &k, opts.hinf_tol);
-            problem_figures(&mut fig, &values, opts);
-            values
-        }
-    };
+    let (fig, plants) = evaluate(plant, multi, opts, &k, Interrupt::NEVER);
     let strong = opts.objective == ObjectiveKind::Strong;
     let alpha = match fig.alpha_k {
         Some(a) if strong => nan_max(fig.alpha_cl, opts.eps * a),
         _ => fig.alpha_cl,
     };
-    let (status, certificate) = if is_stable(alpha) {
+    let ended = if is_stable(alpha) {
         (DesignStatus::Converged, Some(Certificate { dnorm: 0.0, evaldist: 0.0 }))
     } else {
         (DesignStatus::NotStabilised { best_alpha: alpha }, None)
     };
     let cpu = crate::optim::thread_cpu_time() - cpu0;
-    DesignOutcome {
-        status,
-        controller: k,
-        gamma: fig.gamma,
-        k_hinf: fig.k_hinf,
-        alpha_cl: fig.alpha_cl,
-        alpha_k: fig.alpha_k,
-        objective: fig.objective,
-        controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
-        certificate,
-        iterations: 0,
-        evaluations: 1,
-        phases: vec![PhaseStats { phase: Phase::Stabilisation, iters: 0, evals: 1, cpu_s: cpu }],
-        design_cpu_s: cpu,
-        search: SearchSummary {
-            starts: 0,
-            best_start: 0,
-            best_start_kind: None,
-            best_start_scaled: false,
-            cpu_to_best_s: cpu,
-            evals_to_best: 1,
-            stop: SearchStop::NoFreeVariable,
-        },
-        plants,
-    }
+    let phases = vec![PhaseStats { phase: Phase::Stabilisation, iters: 0, evals: 1, cpu_s: cpu }];
+    let search = SearchSummary {
+        starts: 0,
+        best_start: 0,
+        best_start_kind: None,
+        best_start_scaled: false,
+        cpu_to_best_s: cpu,
+        evals_to_best: 1,
+        stop: SearchStop::NoFreeVariable,
+    };
+    outcome(k, fig, plants, opts, ended, phases, cpu, search)
 }
 
 /// A problem's figures in place of the first plant's (`run_problem`): γ the largest weighted value

@@ -282,3 +282,15 @@ pub fn worst_fd_error(obj: &mut impl hinfix::optim::Objective, x0: &[f64], label
     }
     worst
 }
+
+/// HE1 with D21 = [0.5, 1] (HE1's is 0) and D11 = D12·X·D21 (X = [0.3; −0.2]): a continuous H2
+/// objective then fixes Dk = −X (D12 is invertible and D21 has rank 1 = p2, so the set of
+/// feedthroughs is one point).
+pub fn he1_with_feedthrough() -> hinfix::lti::Plant {
+    let mut p = hinfix::lti::Plant::load(hinfix::lti::resolve_plant("HE1").unwrap()).unwrap();
+    p.d21 = faer::mat![[0.5, 1.0]];
+    let x = faer::mat![[0.3], [-0.2]];
+    p.d11 = &p.d12 * &x * &p.d21;
+    p.name = "HE1-D11".into();
+    p
+}
