@@ -9,7 +9,8 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
     closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_discrete, hinf_norm_with_poles, is_stable,
-    stability_measure, stability_measure_of, Controller, HinfParams, Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
+    is_stable_with_margin, stability_measure, stability_measure_of, Controller, HinfParams, Interrupt, Plant,
+    TimeDomain, NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
 
@@ -246,6 +247,7 @@ pub fn run_problem(
             values
         }
     };
+    let status = verified_status(status, problem, opts, &k, &plants);
     let iterations = res.phases.iter().map(|p| p.iters).sum();
     let evaluations = res.phases.iter().map(|p| p.evals).sum();
     Ok(DesignOutcome {
@@ -265,6 +267,60 @@ pub fn run_problem(
         search: res.summary,
         plants,
     })
+}
+
+/// Whether `k` stabilises every plant of `problem` as `opts` asks, with the verification margin
+/// (`lti::is_stable_with_margin`, the test of `campaign check`, `design --out` and `campaign
+/// report`): every closed loop stable and, with the strong objective, the controller too. `Err`
+/// holds the largest of the closed-loop measures and ε·α(A_K) (strong), as
+/// [`DesignStatus::NotStabilised`] reports it.
+pub fn stabilises(problem: &Problem, opts: &DesignOptions, k: &Controller) -> Result<(), f64> {
+    let mut worst = f64::NEG_INFINITY;
+    let mut stable = true;
+    for t in &problem.terms {
+        match closed_loop(&t.plant, k) {
+            Ok(cl) => {
+                let s = stability_measure(t.plant.domain, cl.a.as_ref());
+                worst = nan_max(worst, s);
+                stable &= is_stable_with_margin(s, cl.a.as_ref());
+            }
+            Err(_) => (worst, stable) = (f64::INFINITY, false),
+        }
+    }
+    if opts.objective == ObjectiveKind::Strong && k.order() > 0 {
+        let s = stability_measure(k.domain, k.ak.as_ref());
+        worst = nan_max(worst, opts.eps * s);
+        stable &= is_stable_with_margin(s, k.ak.as_ref());
+    }
+    if stable {
+        Ok(())
+    } else {
+        Err(worst)
+    }
+}
+
+/// The status the returned controller itself supports. The search calls a point stable once
+/// its measure is below 0, so it can end on the boundary (the abscissa objective under strong
+/// stabilisation ended at α ≈ −4e-12 and was journaled "stopped" while `design` refused to write
+/// the controller): a controller that is not stable with the verification margin
+/// ([`stabilises`]) is [`DesignStatus::NotStabilised`] whatever the search said, and a
+/// stabilising one that violates a plant's bound is [`DesignStatus::BoundViolated`]. Interrupted
+/// and not-stabilised runs keep their status.
+fn verified_status(
+    status: DesignStatus,
+    problem: &Problem,
+    opts: &DesignOptions,
+    k: &Controller,
+    plants: &[PlantValue],
+) -> DesignStatus {
+    if matches!(status, DesignStatus::Interrupted | DesignStatus::NotStabilised { .. }) {
+        return status;
+    }
+    match stabilises(problem, opts, k) {
+        Err(best_alpha) => DesignStatus::NotStabilised { best_alpha },
+        Ok(()) if plants.iter().any(|v| !v.bound_met()) => DesignStatus::BoundViolated,
+        Ok(()) => status,
+    }
 }
 
 /// A problem's figures in place of the first plant's (`run_problem`): γ the largest weighted value
