@@ -448,7 +448,10 @@ pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
 fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     let mode = match opts.objective {
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
-        ObjectiveKind::Plain => "plain H∞".to_string(),
+        // "plain H∞" only for the single-plant H∞ problem: an H2, abscissa or radius design (or
+        // several plants) is plain too, but not H∞
+        ObjectiveKind::Plain if o.plants.is_empty() => "plain H∞".to_string(),
+        ObjectiveKind::Plain => "plain (the controller may be unstable)".to_string(),
     };
     let names = match o.plants.len() {
         0 | 1 => for_terminal(&plant.name),

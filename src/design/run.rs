@@ -140,6 +140,7 @@ pub fn run_problem(
         if s.nfree() == 0 {
             return Err(opt_err("structure", "every entry is fixed, there is nothing to design"));
         }
+        fixed_ak_stable(s, shape, opts, plant.domain)?;
     }
     for t in &problem.terms {
         strongly_stabilisable(&t.plant, opts)?;
@@ -336,6 +337,35 @@ fn problem_figures(fig: &mut Figures, values: &[PlantValue], opts: &DesignOption
     };
     let top = nan_max(free_max, k_term);
     fig.objective = if top == f64::NEG_INFINITY { 0.0 } else { top } + PENALTY_WEIGHT * violation;
+}
+
+/// With the strong objective, refuses at once a structure that fixes every entry of A_K at a
+/// matrix that is not stable with the verification margin: no controller of it is stable, and
+/// the search would spend its whole budget and then not say why.
+fn fixed_ak_stable(
+    s: &Structure,
+    shape: ControllerShape,
+    opts: &DesignOptions,
+    domain: TimeDomain,
+) -> Result<(), DesignError> {
+    let nk = shape.nk;
+    if opts.objective != ObjectiveKind::Strong || nk == 0 {
+        return Ok(());
+    }
+    let Some(ak) = s.entries()[..nk * nk].iter().copied().collect::<Option<Vec<f64>>>() else { return Ok(()) };
+    let ak = faer::Mat::from_fn(nk, nk, |i, j| ak[i + j * nk]);
+    let measure = stability_measure(domain, ak.as_ref());
+    if is_stable_with_margin(measure, ak.as_ref()) {
+        return Ok(());
+    }
+    let (name, value) = domain.stability_quantity(measure);
+    Err(opt_err(
+        "structure",
+        format!(
+            "fixes every entry of AK at a matrix that is not stable ({name}(AK) = {value:+.6e}): no controller of this \
+             structure is stable, as the strong objective requires; free an entry of AK or use the plain objective"
+        ),
+    ))
 }
 
 /// With the strong objective, refuses at once a plant that no stable controller stabilises:

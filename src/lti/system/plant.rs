@@ -28,7 +28,8 @@ use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
 use crate::lti::io::mat_file::{
-    json_number, read_char_var, read_mat_vars, scalar_var_to_json, var_to_json, write_mat, MatReadError, MatVar,
+    json_number, read_char_var, read_mat_vars_with_text, scalar_var_to_json, var_to_json, write_mat, MatReadError,
+    MatVar,
 };
 use crate::lti::io::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
 
@@ -241,7 +242,7 @@ impl Plant {
     /// the dimensions are inferred from the blocks (an empty `[]` block is then a zero block).
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let err = |kind| PlantError { file: file.as_ref().to_path_buf(), kind };
-        let mut doc: Value = serde_json::from_str(text)
+        let mut doc: Value = crate::input::parse_json_unique_keys(text)
             .map_err(|e| err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() }))?;
         if let Value::Object(o) = &mut doc {
             let stem = file.as_ref().file_stem().map_or_else(|| "plant".into(), |s| s.to_string_lossy().into_owned());
@@ -515,7 +516,7 @@ fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind
 /// The JSON plant document a plant MAT-file stands for (validated by the caller with the JSON
 /// plant checks). `stem` names the plant when the file has no `name` variable.
 fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
-    let vars = read_mat_vars(bytes)?;
+    let vars = read_mat_vars_with_text(bytes, &["name"])?;
     for (key, _, _) in MATRICES {
         match vars.get(key) {
             None => {
