@@ -11,12 +11,12 @@
 //! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices
 //! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows; optional `notes` and `check` are
 //! kept as provenance, and an optional `order` must equal `dims.n`. An optional `Ts` is the
-//! sampling time in seconds of a discrete-time plant (absent or 0: continuous time,
-//! [`TimeDomain`]). No entry may exceed 1e50
+//! sampling time in seconds of a discrete-time plant (absent or 0: continuous time; else from
+//! 1e-50 to 1e50, [`TimeDomain`]). No entry may exceed 1e50
 //! in absolute value, and a non-zero matrix needs an entry of 1e-50 or more
 //! (`matrix_json::check_magnitudes`). Any other top-level
 //! key is an error naming it ([`PlantErrorKind::UnknownKey`]): a misspelt `D12` or a key this version does
-//! not know must not be silently ignored. [`Plant::from_json_str`] validates everything and names
+//! not know must not be silently ignored; so is a key given twice (`input::parse_json_unique_keys`). [`Plant::from_json_str`] validates everything and names
 //! the file, the field and the row/column of the first thing wrong.
 
 use std::collections::BTreeMap;
