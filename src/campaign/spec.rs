@@ -75,7 +75,7 @@ pub enum SpecProblem {
     #[error("cannot read the campaign file: {0}")]
     Read(std::io::Error),
     /// Not TOML, an unknown key or a value of the wrong type (toml's message, its serde jargon
-    /// in the project's words: [`plain_words`]).
+    /// in the project's words: `plain_words`).
     #[error("{}", plain_words(.0.message().trim()))]
     Toml(Box<toml::de::Error>),
     /// The campaign name is longer than [`MAX_NAME_CHARS`].
