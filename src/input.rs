@@ -13,6 +13,9 @@ const MIB: u64 = 1 << 20;
 pub const MAX_PLANT_BYTES: u64 = 256 * MIB;
 /// Largest controller file: 64 MiB.
 pub const MAX_CONTROLLER_BYTES: u64 = 64 * MIB;
+/// Largest controller-structure file (`--structure`, a campaign's `structure`): 64 MiB, as a
+/// controller file.
+pub const MAX_STRUCTURE_BYTES: u64 = MAX_CONTROLLER_BYTES;
 /// Largest campaign file: 1 MiB.
 pub const MAX_CAMPAIGN_BYTES: u64 = MIB;
 /// Largest journal `runs.jsonl`: 1 GiB (a few hundred thousand records with their controllers).
@@ -84,6 +87,77 @@ pub fn read_capped_string(path: &Path, limit: u64, what: &str) -> io::Result<Str
     }
     String::from_utf8(bytes)
         .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not UTF-8 text ({})", e.utf8_error())))
+}
+
+/// Parses JSON text as `serde_json::from_str` does, but a key that appears twice in one object is
+/// an error naming it (at its line and column): serde_json keeps the last value silently, and a
+/// structure or plant file with a block given twice must not lose the first one unnoticed.
+pub fn parse_json_unique_keys(text: &str) -> Result<serde_json::Value, serde_json::Error> {
+    serde_json::from_str::<UniqueKeys>(text).map(|u| u.0)
+}
+
+/// A JSON value whose objects have no repeated key ([`parse_json_unique_keys`]).
+struct UniqueKeys(serde_json::Value);
+
+impl<'de> serde::Deserialize<'de> for UniqueKeys {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(UniqueKeysVisitor).map(UniqueKeys)
+    }
+}
+
+struct UniqueKeysVisitor;
+
+impl<'de> serde::de::Visitor<'de> for UniqueKeysVisitor {
+    type Value = serde_json::Value;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E>(self, v: bool) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+    fn visit_i64<E>(self, v: i64) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+    fn visit_u64<E>(self, v: u64) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+    fn visit_f64<E>(self, v: f64) -> Result<Self::Value, E> {
+        Ok(serde_json::Number::from_f64(v).map_or(serde_json::Value::Null, serde_json::Value::Number))
+    }
+    fn visit_str<E>(self, v: &str) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+    fn visit_string<E>(self, v: String) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+    fn visit_unit<E>(self) -> Result<Self::Value, E> {
+        Ok(serde_json::Value::Null)
+    }
+    fn visit_none<E>(self) -> Result<Self::Value, E> {
+        Ok(serde_json::Value::Null)
+    }
+    fn visit_some<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        d.deserialize_any(self)
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut out = Vec::new();
+        while let Some(UniqueKeys(v)) = seq.next_element()? {
+            out.push(v);
+        }
+        Ok(serde_json::Value::Array(out))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let mut out = serde_json::Map::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if out.contains_key(&key) {
+                return Err(serde::de::Error::custom(format!("the key \"{key}\" is given twice in one object")));
+            }
+            let UniqueKeys(v) = map.next_value()?;
+            out.insert(key, v);
+        }
+        Ok(serde_json::Value::Object(out))
+    }
 }
 
 /// The UTF-8 byte-order mark.

@@ -5,6 +5,17 @@
 
 use faer::MatRef;
 
+/// A number as people read it and programs read back: Rust's shortest round-trip form, in
+/// scientific notation outside [1e-4, 1e16) (Rust's `{}` never uses an exponent: a sampling time
+/// of 1e-200 s printed 200 zeros). `readable(x).parse::<f64>()` is `x` bit for bit, −0 included.
+pub fn readable(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Σᵢ aᵢbᵢ, summed left to right (over the shorter length if the lengths differ).
 ///
 /// The summation order is part of the result's rounding, and the optimiser's iterates depend on
@@ -102,6 +113,20 @@ mod tests {
         assert!(!all_finite(m.as_ref()));
         m[(1, 2)] = f64::NEG_INFINITY;
         assert!(!all_finite(m.as_ref()));
+    }
+
+    #[test]
+    fn readable_numbers_are_short_and_round_trip() {
+        assert_eq!(readable(0.01), "0.01");
+        assert_eq!(readable(1e-200), "1e-200");
+        assert_eq!(readable(2.5e200), "2.5e200");
+        assert_eq!(readable(1234.5), "1234.5");
+        assert_eq!(readable(f64::INFINITY), "inf");
+        for x in [0.1, -1.0 / 3.0, 1e-300, 5e-324, 1e16, 9.99e15, 1e-4, 9.9e-5, -0.0, f64::MAX] {
+            let back: f64 = readable(x).parse().unwrap();
+            assert_eq!(back.to_bits(), x.to_bits(), "{x}");
+            assert!(readable(x).len() <= 24, "{}", readable(x));
+        }
     }
 
     /// The tests run in the release profile (`cargo test --release`), where Cargo.toml turns

@@ -1,7 +1,9 @@
 //! Property-based fuzzing of every reader of outside input:
-//! the plant and controller JSON readers, the campaign-file reader, the journal reader, the MCAP
-//! trace reader (mutations of a real trace), the MAT-file reader (mutations of real plant files,
-//! plain and compressed), and `design::validate`. The property is always the same: any input gives `Ok` or a clear `Err`,
+//! the plant and controller JSON readers, the campaign-file reader (single-plant problems, and
+//! `[[problem]]` tables of several plants with objectives, weights, bounds and a structure), the
+//! journal reader, the MCAP trace reader (mutations of a real trace), the MAT-file reader
+//! (mutations of real plant files, plain and compressed), the controller-structure readers (JSON
+//! and .mat), and `design::validate`. The property is always the same: any input gives `Ok` or a clear `Err`,
 //! never a panic (proptest turns a panic into a failing case and shrinks it).
 //!
 //! Inputs are partly free (arbitrary JSON, TOML-ish text, bytes) and partly mutations of valid
@@ -21,7 +23,9 @@ use hinfix::campaign::parse_journal;
 use hinfix::campaign::JobRecord;
 use hinfix::campaign::{expand, Campaign, RunnerTag};
 use hinfix::campaign::{summarise_bytes, TraceError, TraceLevel, TraceWriter};
-use hinfix::design::{validate, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats};
+use hinfix::design::{
+    validate, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats, Structure,
+};
 use hinfix::lti::{read_mat_vars, Controller, Plant};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -473,6 +477,137 @@ fn mat_target(cases: u32) -> Counts {
     })
 }
 
+/// A structure for HE1 at order 1 (nk = 1, m = 2, p = 1): AK free, BK fixed, CK and DK mixed.
+const STRUCTURE: &str = r#"{"AK": [[null]], "BK": [[0.5]], "CK": [[null], [1.0]], "DK": [[null], [-0.0]]}"#;
+
+fn he1_order1() -> ControllerShape {
+    ControllerShape::for_plant(he1(), 1)
+}
+
+/// A structure read is one whose fixed entries every projected controller keeps.
+fn structure_accepted(s: Result<Structure, hinfix::design::StructureError>) -> bool {
+    match s {
+        Ok(s) => {
+            let k = s.project(&Controller::zeros(1, 2, 1));
+            assert!(s.violation(&k).is_none(), "a projected controller keeps the fixed entries");
+            true
+        }
+        Err(e) => {
+            assert!(!e.to_string().is_empty());
+            false
+        }
+    }
+}
+
+fn structure_json_target(cases: u32) -> Counts {
+    fuzz("structure JSON", cases, arb_doc(STRUCTURE), |text| {
+        structure_accepted(Structure::from_json(&text, "s.json", he1_order1()))
+    })
+}
+
+/// [`STRUCTURE`] as a MAT-file (NaN = free).
+fn structure_mat() -> &'static [u8] {
+    static B: OnceLock<Vec<u8>> = OnceLock::new();
+    B.get_or_init(|| {
+        let m = |r: usize, c: usize, v: &[f64]| faer::Mat::from_fn(r, c, |i, j| v[i + j * r]);
+        let (ak, bk, ck, dk) =
+            (m(1, 1, &[f64::NAN]), m(1, 1, &[0.5]), m(2, 1, &[f64::NAN, 1.0]), m(2, 1, &[f64::NAN, -0.0]));
+        hinfix::lti::write_mat(
+            &[("AK", ak.as_ref()), ("BK", bk.as_ref()), ("CK", ck.as_ref()), ("DK", dk.as_ref())],
+            "s",
+        )
+    })
+}
+
+fn structure_mat_target(cases: u32) -> Counts {
+    fuzz("structure .mat", cases, arb_bytes(structure_mat()), |bytes| {
+        structure_accepted(Structure::from_mat_bytes(&bytes, "s.mat", he1_order1()))
+    })
+}
+
+/// Campaign text with `[[problem]]` tables of several plants: plant lists, objectives, weights,
+/// bounds, names and a structure drawn from mostly valid and every kind of invalid value.
+fn arb_multi_campaign() -> impl Strategy<Value = String> {
+    let plant = prop_oneof![
+        4 => Just("\"HE1\"".to_string()),
+        4 => (1..=3).prop_map(|i| format!("{:?}", manifest(&format!("examples/multi-model/HE1_op{i}.json")))),
+        1 => Just(format!("{:?}", manifest("examples/discrete/HE1_Ts0.1.json"))),
+        1 => Just("\"AC8\"".to_string()),
+        1 => ".{0,6}".prop_map(|s| format!("{s:?}")),
+    ];
+    let plants = prop::collection::vec(plant, 0..4).prop_map(|v| format!("[{}]", v.join(", ")));
+    let objective = prop_oneof![
+        4 => proptest::sample::select(vec!["\"hinf\"", "\"h2\"", "\"abscissa\"", "\"radius\""]).prop_map(str::to_string),
+        1 => Just("\"H2\"".to_string()),
+        1 => Just("3".to_string()),
+    ];
+    let number = prop_oneof![
+        6 => (1e-3f64..10.0).prop_map(|x| format!("{x:?}")),
+        1 => any::<f64>().prop_map(|x| format!("{x:?}")),
+        1 => prop_oneof![Just("1e308"), Just("-1.0"), Just("0"), Just("nan"), Just("inf"), Just("1e-320")].prop_map(str::to_string),
+    ];
+    let bound = prop_oneof![2 => Just("\"none\"".to_string()), 2 => number.clone(), 1 => Just("\"nope\"".to_string())];
+    fn per_plant(one: impl Strategy<Value = String> + Clone) -> impl Strategy<Value = String> {
+        prop_oneof![
+            one.clone(),
+            prop::collection::vec(one, 0..4).prop_map(|v| format!("[{}]", v.join(", "))),
+            Just("{ a = 1 }".to_string()),
+        ]
+    }
+    let structure = prop_oneof![
+        3 => Just(None),
+        1 => Just(Some(format!("{:?}", manifest("tests/fixtures/structure-fuzz-does-not-exist.json")))),
+        1 => Just(Some("\"/dev/zero\"".to_string())),
+    ];
+    let optional = |s: BoxedStrategy<String>| prop::option::weighted(0.7, s);
+    (
+        plants,
+        optional(per_plant(objective).boxed()),
+        optional(per_plant(number).boxed()),
+        optional(per_plant(bound).boxed()),
+        prop::option::weighted(0.7, "[a-z]{1,6}"),
+        structure,
+        prop_oneof![Just("[0]"), Just("[1]"), Just("{ from = 0, to = 2 }"), Just("[9]")],
+        any::<bool>(),
+    )
+        .prop_map(|(plants, objectives, weights, bounds, name, structure, orders, warm)| {
+            let mut s = format!(
+                "name = \"m\"\n[defaults]\nmaxevals = 100\n[[problem]]\nplants = {plants}\norders = {orders}\n"
+            );
+            for (key, v) in
+                [("objectives", objectives), ("weights", weights), ("bounds", bounds), ("structure", structure)]
+            {
+                if let Some(v) = v {
+                    s += &format!("{key} = {v}\n");
+                }
+            }
+            if let Some(n) = name {
+                s += &format!("name = \"{n}\"\n");
+            }
+            if warm {
+                s += "warm_start = true\n";
+            }
+            s
+        })
+}
+
+fn multi_campaign_target(cases: u32) -> Counts {
+    std::env::set_var(hinfix::lti::PLANTS_ENV, manifest("plants"));
+    fuzz("several-plant problems", cases, arb_multi_campaign(), |text| {
+        match Campaign::from_toml_str(&text, Path::new("fuzz.toml")) {
+            Ok(c) => {
+                let _ = expand(&c, RunnerTag::Design);
+                true
+            }
+            Err(e) => {
+                let m = e.to_string();
+                assert!(!m.contains("untagged") && !m.contains("usize"), "serde jargon: {m}");
+                false
+            }
+        }
+    })
+}
+
 #[allow(clippy::needless_update)]
 fn validate_target(cases: u32) -> Counts {
     // Mostly valid values, so that every check is reached, and every kind of invalid one.
@@ -526,6 +661,9 @@ fn all(cases: u32) -> Vec<(&'static str, Counts)> {
         ("trace reader", trace_target(cases)),
         ("MAT-file reader", mat_target(cases)),
         ("design::validate", validate_target(cases)),
+        ("structure JSON", structure_json_target(cases)),
+        ("structure .mat", structure_mat_target(cases)),
+        ("several-plant problems", multi_campaign_target(cases)),
     ]
 }
 

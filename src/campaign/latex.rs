@@ -271,7 +271,9 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
     let ts = about.sampling_times.get(fp).copied();
     let (radius, domain) = match ts {
         None => ("spectral abscissa $\\alpha(A_K)$", String::new()),
-        Some(ts) => ("spectral radius $\\rho(A_K)$", format!(" (discrete time, $T_s = {ts}$~s)")),
+        Some(ts) => {
+            ("spectral radius $\\rho(A_K)$", format!(" (discrete time, $T_s = {}$~s)", crate::numeric::readable(ts)))
+        }
     };
     let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
     let _ = writeln!(

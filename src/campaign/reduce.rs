@@ -133,7 +133,8 @@ pub fn verify_controller(k: &Controller, order: usize, objective: ObjectiveKind,
 
 /// Re-verifies one record's controller against every plant of `problem` ([`verify`] on each, a
 /// rejection naming the plant), with each plant's value recomputed: γ is the problem's
-/// (`design::problem_gamma`), α(A_cl) the largest.
+/// (`design::problem_gamma`), α(A_cl) the largest. A controller that violates a plant's bound
+/// is rejected (it does not solve the problem).
 pub fn verify_problem(record: &JobRecord, problem: &Problem) -> Verdict {
     match (recorded_controller(record), problem.terms.first()) {
         (Ok(k), _) => verify_problem_controller(k, record.order, record.options.objective, problem),
@@ -159,6 +160,14 @@ pub fn verify_problem_controller(k: &Controller, order: usize, objective: Object
         return Verdict::Rejected("no plant".into());
     };
     let plants = plant_values(problem, k, DEFAULT_HINF_TOL);
+    if let Some(v) = plants.iter().find(|v| !v.bound_met()) {
+        return Verdict::Rejected(format!(
+            "plant {}: bound violated (w·g = {} > {})",
+            v.plant,
+            crate::numeric::readable(v.weighted()),
+            crate::numeric::readable(v.bound.unwrap_or(f64::NAN))
+        ));
+    }
     let gamma = problem_gamma(&plants);
     if !gamma.is_finite() {
         return Verdict::Rejected(format!("γ not finite ({gamma})"));

@@ -74,8 +74,9 @@ pub enum SpecProblem {
     /// The file could not be read.
     #[error("cannot read the campaign file: {0}")]
     Read(std::io::Error),
-    /// Not TOML, an unknown key or a value of the wrong type (toml's message).
-    #[error("{}", .0.message().trim())]
+    /// Not TOML, an unknown key or a value of the wrong type (toml's message, its serde jargon
+    /// in the project's words: `plain_words`).
+    #[error("{}", plain_words(.0.message().trim()))]
     Toml(Box<toml::de::Error>),
     /// The campaign name is longer than [`MAX_NAME_CHARS`].
     #[error("campaign name is longer than {MAX_NAME_CHARS} characters")]
@@ -528,6 +529,45 @@ impl Source<'_> {
     fn error(&self, span: Range<usize>, message: SpecProblem) -> SpecError {
         SpecError { file: self.file.to_path_buf(), location: Location::of_offset(self.text, span.start), message }
     }
+}
+
+/// A TOML/serde message with the Rust type names it quotes said in words: "data did not match any
+/// variant of untagged enum PerPlant" and "expected usize" meant nothing to a campaign author.
+fn plain_words(message: &str) -> String {
+    const UNTAGGED: &str = "data did not match any variant of untagged enum ";
+    const WORDS: [(&str, &str); 7] = [
+        (
+            "PerPlant",
+            "must be one value for every plant or a list of one value per plant (objectives: \"hinf\", \"h2\", \
+             \"abscissa\" or \"radius\"; weights: numbers > 0; bounds: numbers or \"none\")",
+        ),
+        ("BoundValue", "must be a number or \"none\""),
+        ("Number", "must be a number"),
+        ("Seeds", "must be a count of seeds (a whole number) or a list of seeds"),
+        ("One", "must be a number"),
+        ("OptionValue", "has a value of the wrong kind"),
+        ("", "has a value of the wrong kind"),
+    ];
+    let mut out = match message.find(UNTAGGED) {
+        Some(at) => {
+            let name = message[at + UNTAGGED.len()..].split(|c: char| !c.is_alphanumeric()).next().unwrap_or("");
+            let words = WORDS.iter().find(|(n, _)| *n == name || n.is_empty()).map_or("", |(_, w)| w);
+            format!("{}{words}{}", &message[..at], &message[at + UNTAGGED.len() + name.len()..])
+        }
+        None => message.to_string(),
+    };
+    for (rust, words) in [
+        ("expected usize", "expected a whole number ≥ 0"),
+        ("expected u64", "expected a whole number ≥ 0"),
+        ("expected u32", "expected a whole number ≥ 0"),
+        ("expected i64", "expected a whole number"),
+        ("expected f64", "expected a number"),
+        ("expected a sequence", "expected a list [ … ]"),
+        ("expected a map", "expected a table { … }"),
+    ] {
+        out = out.replace(rust, words);
+    }
+    out
 }
 
 /// Step 1: the TOML into the raw tables (unknown keys and wrong types fail here, at their span).

@@ -385,7 +385,8 @@ pub fn plot(a: PlotArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<Exi
     let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
     let reference = load_default_reference().context("reading the paper's reference table")?;
-    let s = crate::campaign::plot::write_plots(&l.dir, &records, &plant_map(&l.campaign), &reference)?;
+    let (plants, problems) = (plant_map(&l.campaign), crate::campaign::problem_map(&l.campaign));
+    let s = crate::campaign::plot::write_plots(&l.dir, &records, &plants, &problems, &reference)?;
     for f in &s.files {
         println!("{}", f.display());
     }

@@ -281,7 +281,7 @@ fn peak_text(r: &CheckReport) -> String {
         } else if w == 0.0 {
             "0".to_string()
         } else {
-            format!("{w:.6}")
+            super::fmt_num(w, 6)
         }
     };
     match r.peak_freqs.as_slice() {

@@ -14,7 +14,8 @@
 //! With the strong objective, a plant that no stable controller stabilises (the parity
 //! interlacing property fails) is refused at once, naming the zeros and poles that prove it.
 //! Exit codes: 0 for a stabilising controller (converged, stopped by a limit, budget exhausted,
-//! stabilised only), 4 when it is NOT STABILISED or the plant is not strongly stabilisable,
+//! stabilised only), 4 when it is NOT STABILISED or the plant is not strongly stabilisable, 5
+//! when it stabilises but a plant's bound does not hold (status `bound_violated`),
 //! 130/143/129 after Ctrl-C/SIGTERM/SIGHUP (the run is cancelled; the best controller so far is
 //! still written if it stabilises). `--out` is checked (not a directory, writable, with a
 //! probe file of a unique name, so that concurrent runs writing one file do not trip) before
@@ -30,15 +31,15 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::design::{
-    run_problem, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, ObjectiveKind,
-    PlantObjective, PlantTerm, PlantValue, Problem, Structure, VariableScaling,
+    run_problem, stabilises, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver,
+    ObjectiveKind, PlantObjective, PlantTerm, PlantValue, Problem, SearchStop, Structure, VariableScaling,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
 use crate::optim::RunControl;
 use anyhow::Context;
 
-use super::{fmt_num, signals, EXIT_NOT_STABILISED};
+use super::{fmt_num, signals, EXIT_BOUND_VIOLATED, EXIT_NOT_STABILISED};
 use crate::campaign::for_terminal;
 
 /// The default of a flag: the option's default ([`DesignOptions::default`], the option table of
@@ -209,22 +210,11 @@ fn unverified_path(out: &Path) -> PathBuf {
     out.with_file_name(name)
 }
 
-/// Whether `o`'s controller stabilises `plant` as the objective asks: the closed loop and (strong
-/// objective) the controller stable with the verification margin — the test `campaign report`
-/// applies to a journaled controller.
+/// Whether `o`'s controller stabilises every plant as the objective asks: the closed loops and
+/// (strong objective) the controller stable with the verification margin (`design::stabilises`,
+/// the test `campaign report` applies to a journaled controller).
 fn stabilising(problem: &Problem, opts: &DesignOptions, o: &DesignOutcome) -> bool {
-    if matches!(o.status, DesignStatus::NotStabilised { .. }) {
-        return false;
-    }
-    let k = &o.controller;
-    let domain = problem.first().domain;
-    let stable = |a: faer::MatRef<'_, f64>| {
-        crate::lti::is_stable_with_margin(crate::lti::verified_stability_measure(domain, a), a)
-    };
-    let loops_stable =
-        problem.terms.iter().all(|t| crate::lti::closed_loop(&t.plant, k).is_ok_and(|cl| stable(cl.a.as_ref())));
-    let k_stable = k.order() == 0 || stable(k.ak.as_ref());
-    loops_stable && (k_stable || opts.objective == ObjectiveKind::Plain)
+    !matches!(o.status, DesignStatus::NotStabilised { .. }) && stabilises(problem, opts, &o.controller).is_ok()
 }
 
 /// A per-plant list of `flag`'s values: none (every plant `default`), one (every plant), or one
@@ -357,6 +347,8 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     Ok(match outcome.status {
         DesignStatus::Interrupted => ExitCode::from(signals::exit_code()),
         DesignStatus::NotStabilised { .. } => ExitCode::from(EXIT_NOT_STABILISED),
+        DesignStatus::BoundViolated => ExitCode::from(EXIT_BOUND_VIOLATED),
+        _ if !good => ExitCode::from(EXIT_NOT_STABILISED),
         _ => ExitCode::SUCCESS,
     })
 }
@@ -412,16 +404,30 @@ fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(crate::fs_atomic::check_writable(path)?)
 }
 
-fn status_text(s: &DesignStatus) -> String {
+/// The status as printed; a budget that ran out is named by the search's stop reason (a run
+/// `--maxevals` ended was once said to have exhausted its CPU budget).
+fn status_text(s: &DesignStatus, stop: SearchStop) -> String {
     match s {
         DesignStatus::Converged => "converged (optimality certificate met)".into(),
         DesignStatus::Stopped => "stopped by a limit before the optimality certificate was met".into(),
         DesignStatus::StabilisedOnly => "stabilised only (the optimisation made no progress)".into(),
-        DesignStatus::NotStabilised { best_alpha } => {
-            format!("NOT STABILISED (best max(α(A_cl), ε·α(Ak)) = {best_alpha:+.6e})")
-        }
-        DesignStatus::BudgetExhausted => "CPU budget exhausted (best controller so far)".into(),
+        DesignStatus::NotStabilised { best_alpha } => format!(
+            "NOT STABILISED with the verification margin (best max(α(A_cl), ε·α(Ak)) = {best_alpha:+.6e}; stable means \
+             below −1e-12·max(1, ‖A‖₂))"
+        ),
+        DesignStatus::BoundViolated => "BOUND VIOLATED: the controller stabilises, but a bound does not hold".into(),
+        DesignStatus::BudgetExhausted => format!("{} exhausted (best controller so far)", budget_name(stop)),
         DesignStatus::Interrupted => "interrupted (best controller so far)".into(),
+    }
+}
+
+/// The budget a search's stop reason names.
+fn budget_name(stop: SearchStop) -> &'static str {
+    match stop {
+        SearchStop::Budget => "CPU budget (--cpumax)",
+        SearchStop::Maxevals => "evaluation budget (--maxevals)",
+        SearchStop::Starts => "start budget (--max-starts)",
+        _ => "budget",
     }
 }
 
@@ -452,7 +458,10 @@ pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
 fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     let mode = match opts.objective {
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
-        ObjectiveKind::Plain => "plain H∞".to_string(),
+        // "plain H∞" only for the single-plant H∞ problem: an H2, abscissa or radius design (or
+        // several plants) is plain too, but not H∞
+        ObjectiveKind::Plain if o.plants.is_empty() => "plain H∞".to_string(),
+        ObjectiveKind::Plain => "plain (the controller may be unstable)".to_string(),
     };
     let names = match o.plants.len() {
         0 | 1 => for_terminal(&plant.name),
@@ -462,12 +471,15 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         "{} (n = {}{}), order {}, {}, seed {}\n",
         names,
         plant.dims.n,
-        plant.domain.ts().map_or(String::new(), |ts| format!(", discrete time Ts = {ts} s")),
+        plant
+            .domain
+            .ts()
+            .map_or(String::new(), |ts| format!(", discrete time Ts = {} s", crate::numeric::readable(ts))),
         opts.order,
         mode,
         opts.seed
     );
-    s += &format!("status:   {}\n", status_text(&o.status));
+    s += &format!("status:   {}\n", status_text(&o.status, o.search.stop));
     s += &plant_lines(&o.plants);
     // A problem's γ is its plants' largest weighted value (`design::run_problem`).
     let gamma_name = if o.plants.is_empty() { "‖Tzw‖∞" } else { "max w·g" };

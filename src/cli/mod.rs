@@ -79,6 +79,9 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 /// Exit code of `design` when no (strongly) stabilising controller was found, and of `check`
 /// when the closed loop is unstable.
 pub const EXIT_NOT_STABILISED: u8 = 4;
+/// Exit code of `design` when the controller stabilises but a plant's bound w·g ≤ b does not
+/// hold (status `bound_violated`; `--json` says which plant in its `plants[].bound_met`).
+pub const EXIT_BOUND_VIOLATED: u8 = 5;
 
 /// A number for people: fixed-point with `prec` decimals in [1e-3, 1e6), scientific outside
 /// (ε = 1e308 must not print a 309-digit objective).

@@ -49,10 +49,11 @@ pub use outcome::{
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use problem::{
     plant_part, plant_value, plant_values, problem_gamma, H2Feedthrough, PlantObjective, PlantTerm, PlantValue,
-    Problem, ProblemError, UnknownObjective, BOUND_RTOL, PENALTY_WEIGHT,
+    Problem, ProblemError, UnknownObjective, BOUND_RTOL, MAX_BOUND, MAX_WEIGHT, MIN_WEIGHT, PENALTY_WEIGHT,
 };
 pub use run::{
-    run, run_problem, run_problem_chained, run_with_control, run_with_structure, strongly_stabilisable, validate,
+    run, run_problem, run_problem_chained, run_with_control, run_with_structure, stabilises, strongly_stabilisable,
+    validate,
 };
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};

@@ -51,10 +51,15 @@ pub enum DesignStatus {
         #[serde(with = "serde_f64_or_string")]
         best_alpha: f64,
     },
-    /// The CPU budget ran out during optimisation; the best controller so far is returned.
+    /// A budget (`cpumax` or `maxevals`, the search summary's stop reason says which) ran out
+    /// before HIFOO's first starts were all made; the best controller so far is returned.
     BudgetExhausted,
     /// Stopped by a cancel request or an observer.
     Interrupted,
+    /// The controller stabilises, but a plant's bound w·g ≤ b does not hold (to
+    /// `design::BOUND_RTOL`): the constraints were not met, whatever the certificate says; the
+    /// outcome's `plants` say which (`bound_met`).
+    BoundViolated,
 }
 
 impl DesignStatus {
@@ -67,6 +72,7 @@ impl DesignStatus {
             DesignStatus::NotStabilised { .. } => "not_stabilised",
             DesignStatus::BudgetExhausted => "budget_exhausted",
             DesignStatus::Interrupted => "interrupted",
+            DesignStatus::BoundViolated => "bound_violated",
         }
     }
 }

@@ -37,6 +37,17 @@ use crate::lti::{
 /// (docs/ALGORITHMS.md §14.2).
 pub const PENALTY_WEIGHT: f64 = 10.0;
 
+/// Largest weight w_j of a plant. Weights and bounds are checked before a design starts so that
+/// the objective cannot overflow after the search (a weight of 1e308 once journaled γ = inf and
+/// exited 0): with plant entries below 1e50 (`lti::MAX_PLANT_MAGNITUDE`) the values g_j a
+/// stabilising controller reaches stay far enough below f64's 1.8e308.
+pub const MAX_WEIGHT: f64 = 1e50;
+/// Smallest weight w_j of a plant: a smaller one makes w·g underflow to 0 and the plant's term
+/// vanish from the objective.
+pub const MIN_WEIGHT: f64 = 1e-50;
+/// Largest |b_j| of a bound (see [`MAX_WEIGHT`]).
+pub const MAX_BOUND: f64 = 1e50;
+
 /// Relative tolerance of [`PlantValue::bound_met`]: the exact penalty ends a design on the
 /// constraint w·g = b when the bound is active, where the rounding of the norms decides which side
 /// the recomputed value falls (HE1 at two operating points, bound 0.135 on the second:
@@ -160,8 +171,12 @@ pub enum ProblemError {
         /// Plant 1's.
         first: String,
     },
-    /// A weight that is not a finite positive number.
-    #[error("plant {index} ({name}): weight {value} must be a finite number > 0")]
+    /// A weight outside [[`MIN_WEIGHT`], [`MAX_WEIGHT`]].
+    #[error(
+        "plant {index} ({name}): weight {} must be a number from {MIN_WEIGHT:e} to {MAX_WEIGHT:e} (the weighted \
+         values w·g, and the penalty on violated bounds, must stay finite)",
+        crate::numeric::readable(*value)
+    )]
     Weight {
         /// 1-based position.
         index: usize,
@@ -170,8 +185,11 @@ pub enum ProblemError {
         /// The weight.
         value: f64,
     },
-    /// A bound that is not finite.
-    #[error("plant {index} ({name}): bound {value} must be a finite number")]
+    /// A bound that is not finite or larger than [`MAX_BOUND`] in absolute value.
+    #[error(
+        "plant {index} ({name}): bound {} must be a finite number from −{MAX_BOUND:e} to {MAX_BOUND:e}",
+        crate::numeric::readable(*value)
+    )]
     Bound {
         /// 1-based position.
         index: usize,
@@ -279,10 +297,10 @@ impl Problem {
                 let (domain, first) = (t.plant.domain.to_string(), first.plant.domain.to_string());
                 return Err(ProblemError::Domain { index, name, domain, first });
             }
-            if !(t.weight.is_finite() && t.weight > 0.0) {
+            if !(MIN_WEIGHT..=MAX_WEIGHT).contains(&t.weight) {
                 return Err(ProblemError::Weight { index, name, value: t.weight });
             }
-            if let Some(b) = t.bound.filter(|b| !b.is_finite()) {
+            if let Some(b) = t.bound.filter(|b| !(b.abs() <= MAX_BOUND)) {
                 return Err(ProblemError::Bound { index, name, value: b });
             }
             match t.objective {
@@ -346,6 +364,11 @@ pub struct PlantValue {
     /// The closed loop's stability measure (α, or ρ − 1 in discrete time).
     #[serde(with = "super::float_serde::serde_f64_or_string")]
     pub alpha_cl: f64,
+    /// Whether its bound holds ([`PlantValue::bound_met`]): `null` without a bound, `true` met,
+    /// `false` violated (`design --json`, the journal; absent, read as `null`, in records of
+    /// older builds).
+    #[serde(default)]
+    pub bound_met: Option<bool>,
 }
 
 impl PlantValue {
@@ -354,9 +377,15 @@ impl PlantValue {
         self.weight * self.value
     }
 
-    /// Whether its bound holds to [`BOUND_RTOL`] (true without a bound).
+    /// Whether its bound holds to [`BOUND_RTOL`] (true without a bound; false when w·g is NaN).
     pub fn bound_met(&self) -> bool {
         self.bound.is_none_or(|b| self.weighted() <= b + BOUND_RTOL * b.abs())
+    }
+
+    /// With the field [`PlantValue::bound_met`] set from the values.
+    pub fn with_bound_verdict(self) -> Self {
+        let met = self.bound.map(|_| self.bound_met());
+        PlantValue { bound_met: met, ..self }
     }
 }
 
@@ -378,7 +407,9 @@ pub fn plant_values(problem: &Problem, k: &Controller, hinf_tol: f64) -> Vec<Pla
                 bound: t.bound,
                 value,
                 alpha_cl,
+                bound_met: None,
             }
+            .with_bound_verdict()
         })
         .collect()
 }
@@ -425,17 +456,24 @@ mod tests {
 
     #[test]
     fn the_plant_part_is_the_max_of_the_free_and_the_sum_of_the_violations() {
-        let v = |value: f64, weight: f64, bound: Option<f64>| PlantValue {
-            plant: "P".into(),
-            objective: PlantObjective::Hinf,
-            weight,
-            bound,
-            value,
-            alpha_cl: -1.0,
+        let v = |value: f64, weight: f64, bound: Option<f64>| {
+            PlantValue {
+                plant: "P".into(),
+                objective: PlantObjective::Hinf,
+                weight,
+                bound,
+                value,
+                alpha_cl: -1.0,
+                bound_met: None,
+            }
+            .with_bound_verdict()
         };
         let values = [v(2.0, 1.0, None), v(1.0, 3.0, None), v(5.0, 1.0, Some(4.0)), v(1.0, 1.0, Some(4.0))];
         assert_eq!(plant_part(&values), (3.0, 1.0));
         assert!(!values[2].bound_met() && values[3].bound_met());
+        let met: Vec<Option<bool>> = values.iter().map(|v| v.bound_met).collect();
+        assert_eq!(met, [None, None, Some(false), Some(true)]);
+        assert_eq!(serde_json::to_value(&values[2]).unwrap()["bound_met"], serde_json::json!(false));
         assert_eq!(plant_part(&values[2..]).0, f64::NEG_INFINITY);
     }
 }

@@ -9,7 +9,8 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
     closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_discrete, hinf_norm_with_poles, is_stable,
-    stability_measure, stability_measure_of, Controller, HinfParams, Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
+    is_stable_with_margin, stability_measure, stability_measure_of, verified_stability_measure, Controller, HinfParams, Interrupt, Plant,
+    TimeDomain, NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
 
@@ -163,6 +164,7 @@ pub fn run_problem_chained(
                 ),
             ));
         }
+        fixed_ak_stable(s, shape, opts, plant.domain)?;
     }
     for t in &problem.terms {
         strongly_stabilisable(&t.plant, opts)?;
@@ -270,7 +272,7 @@ pub fn run_problem_chained(
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
     let (fig, plants) =
         evaluate(plant, multi, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
-    Ok(outcome(k, fig, plants, opts, (status, certificate), res.phases, ctl.cpu_elapsed(), res.summary))
+    Ok(outcome(problem, k, fig, plants, opts, (status, certificate), res.phases, ctl.cpu_elapsed(), res.summary))
 }
 
 /// The figures of `k` on the first plant ([`figures`]), or the problem's with each plant's value
@@ -294,10 +296,12 @@ fn evaluate(
     (fig, plants)
 }
 
-/// The outcome of a run that returns `k` with figures `fig` (and `plants`), how it ended, its
-/// phases' counters, CPU seconds and search summary.
+/// The outcome of a run of `problem` that returns `k` with figures `fig` (and `plants`), how it
+/// ended (the status as the returned controller supports it: [`verified_status`]), its phases'
+/// counters, CPU seconds and search summary.
 #[allow(clippy::too_many_arguments)]
 fn outcome(
+    problem: &Problem,
     k: Controller,
     fig: Figures,
     plants: Vec<PlantValue>,
@@ -307,6 +311,7 @@ fn outcome(
     design_cpu_s: f64,
     search: SearchSummary,
 ) -> DesignOutcome {
+    let status = verified_status(status, problem, opts, &k, &plants);
     DesignOutcome {
         status,
         controller: k,
@@ -388,7 +393,61 @@ fn fixed_design(
         evals_to_best: 1,
         stop: SearchStop::NoFreeVariable,
     };
-    outcome(k, fig, plants, opts, ended, phases, cpu, search)
+    outcome(problem, k, fig, plants, opts, ended, phases, cpu, search)
+}
+
+/// Whether `k` stabilises every plant of `problem` as `opts` asks, with the verification margin
+/// (`lti::is_stable_with_margin`, the test of `campaign check`, `design --out` and `campaign
+/// report`): every closed loop stable and, with the strong objective, the controller too. `Err`
+/// holds the largest of the closed-loop measures and ε·α(A_K) (strong), as
+/// [`DesignStatus::NotStabilised`] reports it.
+pub fn stabilises(problem: &Problem, opts: &DesignOptions, k: &Controller) -> Result<(), f64> {
+    let mut worst = f64::NEG_INFINITY;
+    let mut stable = true;
+    for t in &problem.terms {
+        match closed_loop(&t.plant, k) {
+            Ok(cl) => {
+                let s = verified_stability_measure(t.plant.domain, cl.a.as_ref());
+                worst = nan_max(worst, s);
+                stable &= is_stable_with_margin(s, cl.a.as_ref());
+            }
+            Err(_) => (worst, stable) = (f64::INFINITY, false),
+        }
+    }
+    if opts.objective == ObjectiveKind::Strong && k.order() > 0 {
+        let s = verified_stability_measure(k.domain, k.ak.as_ref());
+        worst = nan_max(worst, opts.eps * s);
+        stable &= is_stable_with_margin(s, k.ak.as_ref());
+    }
+    if stable {
+        Ok(())
+    } else {
+        Err(worst)
+    }
+}
+
+/// The status the returned controller itself supports. The search calls a point stable once
+/// its measure is below 0, so it can end on the boundary (the abscissa objective under strong
+/// stabilisation ended at α ≈ −4e-12 and was journaled "stopped" while `design` refused to write
+/// the controller): a controller that is not stable with the verification margin
+/// ([`stabilises`]) is [`DesignStatus::NotStabilised`] whatever the search said, and a
+/// stabilising one that violates a plant's bound is [`DesignStatus::BoundViolated`]. Interrupted
+/// and not-stabilised runs keep their status.
+fn verified_status(
+    status: DesignStatus,
+    problem: &Problem,
+    opts: &DesignOptions,
+    k: &Controller,
+    plants: &[PlantValue],
+) -> DesignStatus {
+    if matches!(status, DesignStatus::Interrupted | DesignStatus::NotStabilised { .. }) {
+        return status;
+    }
+    match stabilises(problem, opts, k) {
+        Err(best_alpha) => DesignStatus::NotStabilised { best_alpha },
+        Ok(()) if plants.iter().any(|v| !v.bound_met()) => DesignStatus::BoundViolated,
+        Ok(()) => status,
+    }
 }
 
 /// A problem's figures in place of the first plant's (`run_problem`): γ the largest weighted value
@@ -404,6 +463,35 @@ fn problem_figures(fig: &mut Figures, values: &[PlantValue], opts: &DesignOption
     };
     let top = nan_max(free_max, k_term);
     fig.objective = if top == f64::NEG_INFINITY { 0.0 } else { top } + PENALTY_WEIGHT * violation;
+}
+
+/// With the strong objective, refuses at once a structure that fixes every entry of A_K at a
+/// matrix that is not stable with the verification margin: no controller of it is stable, and
+/// the search would spend its whole budget and then not say why.
+fn fixed_ak_stable(
+    s: &Structure,
+    shape: ControllerShape,
+    opts: &DesignOptions,
+    domain: TimeDomain,
+) -> Result<(), DesignError> {
+    let nk = shape.nk;
+    if opts.objective != ObjectiveKind::Strong || nk == 0 {
+        return Ok(());
+    }
+    let Some(ak) = s.entries()[..nk * nk].iter().copied().collect::<Option<Vec<f64>>>() else { return Ok(()) };
+    let ak = faer::Mat::from_fn(nk, nk, |i, j| ak[i + j * nk]);
+    let measure = verified_stability_measure(domain, ak.as_ref());
+    if is_stable_with_margin(measure, ak.as_ref()) {
+        return Ok(());
+    }
+    let (name, value) = domain.stability_quantity(measure);
+    Err(opt_err(
+        "structure",
+        format!(
+            "fixes every entry of AK at a matrix that is not stable ({name}(AK) = {value:+.6e}): no controller of this \
+             structure is stable, as the strong objective requires; free an entry of AK or use the plain objective"
+        ),
+    ))
 }
 
 /// With the strong objective, refuses at once a plant that no stable controller stabilises:

@@ -170,10 +170,14 @@ impl Structure {
     pub fn load(path: &Path, shape: ControllerShape) -> Result<Self, StructureError> {
         let file = path.display().to_string();
         let io = |e: std::io::Error| StructureError::Io { file: file.clone(), message: e.to_string() };
+        // bounded like every input file (`--structure /dev/zero` read until memory ran out), and a
+        // JSON file with a UTF-8 byte-order mark read as plant files are
+        let limit = crate::input::MAX_STRUCTURE_BYTES;
         let s = if is_mat_path(path) {
-            Self::from_mat_bytes(&std::fs::read(path).map_err(io)?, &file, shape)?
+            Self::from_mat_bytes(&crate::input::read_capped(path, limit, "structure file").map_err(io)?, &file, shape)?
         } else {
-            Self::from_json(&std::fs::read_to_string(path).map_err(io)?, &file, shape)?
+            let text = crate::input::read_capped_string(path, limit, "structure file").map_err(io)?;
+            Self::from_json(&text, &file, shape)?
         };
         Ok(s)
     }
@@ -182,7 +186,9 @@ impl Structure {
     /// structure with no free entry is not refused here.
     pub fn from_json(text: &str, file: &str, shape: ControllerShape) -> Result<Self, StructureError> {
         let syntax = |message: String| StructureError::Syntax { file: file.into(), message };
-        let v: Value = serde_json::from_str(text).map_err(|e| syntax(format!("not valid JSON: {e}")))?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let v: Value =
+            crate::input::parse_json_unique_keys(text).map_err(|e| syntax(format!("not valid JSON: {e}")))?;
         Self::from_value(v, file, shape)
     }
 

@@ -92,4 +92,4 @@ pub use system::export::{export_code, ExportTarget};
 pub use system::plant::{plant_to_mat, Dims, Plant, PlantError, PlantErrorKind};
 pub use system::plant_library::{library_plants, plants_dir, resolve_plant, shipped_plants, LibraryPlant, PLANTS_ENV};
 pub use system::state_space::StateSpace;
-pub use system::time_domain::{BadSamplingTime, TimeDomain};
+pub use system::time_domain::{BadSamplingTime, TimeDomain, MAX_TS, MIN_TS};

@@ -6,7 +6,8 @@
 //!   job of each (plant, order) against CPU time from its MCAP trace, a thinned sample of its
 //!   local searches behind it (`_plain` appended for the plain objective's best job);
 //! * `sigma_<plant>_nK<k>` — [`SigmaFigure`]: σmax of T_zw(iω) and of K(iω) for the best controller of
-//!   each (plant, order), peak marked.
+//!   each (plant, order), peak marked; for a problem of several plants (or another objective)
+//!   one per plant, `sigma_<problem>_nK<k>_<plant>`.
 //!
 //! Like the report files, the figures are pure functions of the journal, the traces, the plants
 //! and the reference table. Drawing is `plotters` with a bundled font (`render.rs`), so nothing
@@ -21,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use super::compare::full_order_rows;
 use super::record::JobRecord;
-use super::reduce::{best_per_order, verify, BestRow, PlantMap, Verdict};
+use super::reduce::{best_per_problem, verify, verify_problem, BestRow, PlantMap, ProblemMap, Verdict};
 use super::reference::{RefMethod, ReferenceRow};
 use super::report::ReportError;
 use super::trace::{read_iterations, TraceError};
@@ -92,6 +93,21 @@ pub fn file_part(name: &str) -> String {
     super::sanitise::as_key(name, |c| c.is_ascii_alphanumeric() || "-_.".contains(c), '_', MAX_FILE_PART)
 }
 
+/// [`file_part`] of `name` among the plant names `all` of one campaign: when another name's part
+/// differs from this one's in letter case only ("Case" and "case"), both get the name's short
+/// hash appended, so their figures do not overwrite each other on a case-insensitive file system
+/// (macOS, Windows). Names without such a twin keep their part.
+pub fn file_part_among(name: &str, all: &[&str]) -> String {
+    let part = file_part(name);
+    let twin = all.iter().any(|o| *o != name && file_part(o).eq_ignore_ascii_case(&part));
+    if !twin {
+        return part;
+    }
+    use sha2::Digest;
+    let hash: String = sha2::Sha256::digest(name.as_bytes())[..4].iter().map(|b| format!("{b:02x}")).collect();
+    format!("{}-{hash}", &part[..part.len().min(MAX_FILE_PART - 9)])
+}
+
 /// The γ-vs-order figure of each plant in `best`.
 pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<GammaOrderFigure> {
     let full = full_order_rows(best, plants, reference);
@@ -123,28 +139,35 @@ pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[Ref
 /// `<campaign_dir>/traces/`; a best job without a trace (or with a trace that cannot be read) is
 /// skipped with its reason in the summary, and a figure that cannot be drawn or written is in
 /// its `failed` list: neither stops the other figures. Only a plots folder that cannot be made
-/// is an error.
+/// is an error. `problems` are the campaign's problems of several plants or another objective
+/// (`campaign::problem_map`): their rows are verified as `campaign report` verifies them, and
+/// the σ-plot of their best controller is drawn on each of their plants
+/// (`sigma_<problem>_nK<k>_<plant>`; the figure of a plant whose objective is not H∞ still shows
+/// σmax of its closed loop, its title naming the objective).
 pub fn write_plots(
     campaign_dir: &Path,
     records: &[JobRecord],
     plants: &PlantMap,
+    problems: &ProblemMap,
     reference: &[ReferenceRow],
 ) -> Result<PlotSummary, PlotError> {
     let dir = campaign_dir.join("plots");
     std::fs::create_dir_all(&dir).map_err(|source| ReportError::Io { path: dir.clone(), source })?;
-    let best = best_per_order(records, plants);
+    let best = best_per_problem(records, plants, problems);
+    let names: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
+    let part = |name: &str| file_part_among(name, &names);
     let mut out = PlotSummary::default();
     let keep = |made: Result<Vec<PathBuf>, PlotError>, out: &mut PlotSummary| match made {
         Ok(files) => out.files.extend(files),
         Err(e) => out.failed.push(e.to_string()),
     };
     for fig in gamma_order_figures(&best, plants, reference) {
-        keep(write_png_and_svg(&fig, &dir.join(format!("gamma-vs-order_{}", file_part(&fig.plant)))), &mut out);
+        keep(write_png_and_svg(&fig, &dir.join(format!("gamma-vs-order_{}", part(&fig.plant)))), &mut out);
     }
     for row in &best {
         // a plain row's figures are told apart by the objective (a strong row keeps its old name)
         let plain = row.objective == ObjectiveKind::Plain;
-        let tag = format!("{}_nK{}{}", file_part(&row.plant), row.order, if plain { "_plain" } else { "" });
+        let tag = format!("{}_nK{}{}", part(&row.plant), row.order, if plain { "_plain" } else { "" });
         let Some(job) = row.job_id.as_deref() else {
             out.skipped.push(format!("{} n_K = {}: no verified controller", row.plant, row.order));
             continue;
@@ -170,18 +193,46 @@ pub fn write_plots(
         } else {
             out.skipped.push(format!("convergence of {tag}: no trace {}", trace.display()));
         }
-        let Some(plant) = plants.get(&row.plant_fingerprint) else { continue };
+        let fp = &row.plant_fingerprint;
         // The job's record that re-verified best (the one the row reports), not merely the
         // first record of the job id: a duplicate may carry another controller.
-        let verified = records.iter().filter(|r| r.job_id.0 == job).filter_map(|r| match verify(r, plant) {
+        let verdict = |r: &JobRecord| match (problems.get(fp), plants.get(fp)) {
+            (Some(p), _) => Some(verify_problem(r, p)),
+            (None, Some(plant)) => Some(verify(r, plant)),
+            (None, None) => None,
+        };
+        let verified = records.iter().filter(|r| r.job_id.0 == job).filter_map(|r| match verdict(r)? {
             Verdict::Verified { gamma, .. } => Some((gamma, r)),
             Verdict::Rejected(_) => None,
         });
-        let Some((_, rec)) = verified.min_by(|a, b| a.0.total_cmp(&b.0)) else { continue };
+        let Some((_, rec)) = verified.min_by(|a, b| a.0.total_cmp(&b.0)) else {
+            out.skipped.push(format!("σ-plot of {tag}: no re-verified controller of job {job}"));
+            continue;
+        };
         let Some(k) = rec.controller() else { continue };
-        let made = sigma_figure(plant, k, format!("σ-plot: {title}"))
-            .and_then(|fig| write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}"))));
-        keep(made, &mut out);
+        match problems.get(fp) {
+            None => {
+                let Some(plant) = plants.get(fp) else { continue };
+                let made = sigma_figure(plant, k, format!("σ-plot: {title}"))
+                    .and_then(|fig| write_png_and_svg(&fig, &dir.join(format!("sigma_{tag}"))));
+                keep(made, &mut out);
+            }
+            Some(problem) => {
+                let names: Vec<&str> = problem.terms.iter().map(|t| t.plant.name.as_str()).collect();
+                for (j, t) in problem.terms.iter().enumerate() {
+                    let what = format!(
+                        "σ-plot: {title}, plant {} of {}: {} (objective {})",
+                        j + 1,
+                        names.len(),
+                        t.plant.name,
+                        t.objective.name()
+                    );
+                    let file = format!("sigma_{tag}_{}", file_part_among(&t.plant.name, &names));
+                    let made = sigma_figure(&t.plant, k, what).and_then(|fig| write_png_and_svg(&fig, &dir.join(file)));
+                    keep(made, &mut out);
+                }
+            }
+        }
     }
     Ok(out)
 }
@@ -206,5 +257,11 @@ mod tests {
         assert_eq!(long.len(), MAX_FILE_PART);
         assert_ne!(long, file_part(&"Y".repeat(301)));
         assert!(file_part("ü/..").chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)));
+        // names differing in case only get distinct parts on a case-insensitive file system
+        let all = ["Case", "case", "HE1"];
+        let (a, b) = (file_part_among("Case", &all), file_part_among("case", &all));
+        assert!(!a.eq_ignore_ascii_case(&b), "{a} {b}");
+        assert_eq!(file_part_among("HE1", &all), "HE1");
+        assert_eq!(file_part_among("Case", &["Case", "HE1"]), "Case");
     }
 }

@@ -52,14 +52,18 @@ impl SigmaFigure {
         v.iter().copied().filter(|p| p.1 > 0.0 && p.1.is_finite())
     }
 
-    /// Where the peak is drawn: its frequency, clamped to the grid when it is 0 or +∞.
+    /// Where the peak is drawn: its frequency, moved to the grid's nearer end when it is 0 or
+    /// +∞; `None` when there is nothing to mark (no finite peak, no grid, or a grid whose ends
+    /// are not an interval of positive frequencies).
     pub fn peak_point(&self) -> Option<(f64, f64)> {
         let (g, w) = self.peak;
         if !g.is_finite() || w.is_nan() {
             return None;
         }
         let (w0, w1) = (self.closed_loop.first()?.0, self.closed_loop.last()?.0);
-        Some((w.clamp(w0, w1), g))
+        // not `clamp`: it panics on NaN or reversed bounds
+        let grid = w0 > 0.0 && w0 <= w1 && w1.is_finite();
+        grid.then(|| (w.max(w0).min(w1), g))
     }
 }
 
@@ -114,7 +118,10 @@ impl Figure for SigmaFigure {
             .configure_mesh()
             .x_desc(match self.ts {
                 None => "frequency ω (rad/s)".to_string(),
-                Some(ts) => format!("frequency ω (rad/s), up to the Nyquist frequency π/Ts (Ts = {ts} s)"),
+                Some(ts) => format!(
+                    "frequency ω (rad/s), up to the Nyquist frequency π/Ts (Ts = {} s)",
+                    crate::numeric::readable(ts)
+                ),
             })
             .y_desc("largest singular value σ_max")
             .x_label_formatter(&|v| tick(*v))

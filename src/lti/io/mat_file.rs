@@ -71,8 +71,16 @@ pub enum MatReadError {
 
 /// Reads every numeric variable of a level-5 MAT-file (`bytes`) as a real 2-D matrix, by name.
 /// Complex or N-d (N > 2) variables are errors; integer and single classes are converted to f64
-/// exactly.
+/// exactly. A variable of any other class (char, cell, struct, object, sparse, …) is an error
+/// naming it and its class: `matfile` skips them, and a skipped `Ts` or structure block was once
+/// silently read as absent (continuous time, a free block).
 pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadError> {
+    read_mat_vars_with_text(bytes, &[])
+}
+
+/// As [`read_mat_vars`], with character variables of the names in `text` allowed (and left out
+/// of the result: `read_char_var` reads them), such as a plant's `name`.
+pub(crate) fn read_mat_vars_with_text(bytes: &[u8], text: &[&str]) -> Result<BTreeMap<String, MatVar>, MatReadError> {
     if bytes.len() < 128 {
         return Err(MatReadError::Format(format!("{} bytes, shorter than the 128-byte header", bytes.len())));
     }
@@ -81,10 +89,34 @@ pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadEr
     }
     let plain = super::mat_inflate::inflate_elements(bytes, super::mat_inflate::MAX_MAT_INFLATED_BYTES)
         .map_err(MatReadError::Format)?;
+    let classes = variable_classes(&plain);
+    for (name, class) in classes.iter().cloned() {
+        let allowed = class == MX_CHAR_CLASS && text.contains(&name.as_str());
+        if !allowed && !(MX_DOUBLE_CLASS..=MX_UINT64_CLASS).contains(&class) {
+            return Err(MatReadError::Variable {
+                name,
+                problem: format!(
+                    "is {}; only full real numeric matrices are read here (in MATLAB: `X = full(double(X))`)",
+                    class_name(class)
+                ),
+            });
+        }
+    }
     // The last resort for a parser we do not own: a panic on damaged data is a format error.
     let file = crate::panic_guard::catch_quietly(|| matfile::MatFile::parse(plain.as_slice()))
         .map_err(|panic| MatReadError::Format(format!("damaged file: {panic}")))?
-        .map_err(|e| MatReadError::Format(e.to_string()))?;
+        .map_err(|e| match classes.iter().find(|(_, c)| *c != MX_DOUBLE_CLASS) {
+            // matfile fails on some integer and single arrays (data stored in a smaller type):
+            // name the variable rather than call the whole file unreadable
+            Some((name, class)) => MatReadError::Variable {
+                name: name.clone(),
+                problem: format!(
+                    "is {} and could not be decoded ({e}); save it as a double matrix (`X = double(X)`)",
+                    class_name(*class)
+                ),
+            },
+            None => MatReadError::Format(e.to_string()),
+        })?;
     let mut out = BTreeMap::new();
     for a in file.arrays() {
         let bad = |problem: String| MatReadError::Variable { name: a.name().to_string(), problem };
@@ -99,6 +131,67 @@ pub fn read_mat_vars(bytes: &[u8]) -> Result<BTreeMap<String, MatVar>, MatReadEr
         out.insert(a.name().to_string(), MatVar { rows, cols, data });
     }
     Ok(out)
+}
+
+/// The (name, array class) of every top-level variable of an uncompressed level-5 file (after
+/// `mat_inflate`), in either byte order; elements that cannot be parsed are left to `matfile`,
+/// which reports them.
+fn variable_classes(plain: &[u8]) -> Vec<(String, u8)> {
+    let big = plain.get(126..128) == Some(b"MI");
+    let u32_at = |b: &[u8], i: usize| -> Option<u32> {
+        let w: [u8; 4] = b.get(i..i.checked_add(4)?)?.try_into().ok()?;
+        Some(if big { u32::from_be_bytes(w) } else { u32::from_le_bytes(w) })
+    };
+    // one sub-element of a miMATRIX body at `pos`: (data, next position), long or small form
+    let sub = |b: &[u8], pos: usize| -> Option<(Vec<u8>, usize)> {
+        let tag = u32_at(b, pos)?;
+        if tag >> 16 != 0 {
+            let len = (tag >> 16) as usize;
+            return Some((b.get(pos + 4..pos + 4 + len.min(4))?.to_vec(), pos + 8));
+        }
+        let len = u32_at(b, pos + 4)? as usize;
+        let end = (pos + 8).checked_add(len)?;
+        Some((b.get(pos + 8..end)?.to_vec(), pos + 8 + len.div_ceil(8) * 8))
+    };
+    let mut out = Vec::new();
+    let mut pos = 128;
+    while let (Some(ty), Some(len)) = (u32_at(plain, pos), u32_at(plain, pos + 4)) {
+        let len = len as usize;
+        let Some(body) = plain.get(pos + 8..(pos + 8).saturating_add(len)) else { break };
+        if ty == MI_MATRIX {
+            let parsed = (|| {
+                let (flags, next) = sub(body, 0)?;
+                // the class is the low byte of the first flags word, in the file's byte order
+                let class = if big { *flags.get(3)? } else { *flags.first()? };
+                let (_, next) = sub(body, next)?; // dimensions
+                let (name, _) = sub(body, next)?;
+                Some((String::from_utf8_lossy(&name).into_owned(), class))
+            })();
+            out.extend(parsed);
+        }
+        pos += 8 + len.div_ceil(8) * 8;
+    }
+    out
+}
+
+/// A MATLAB array class as the error messages name it.
+fn class_name(class: u8) -> String {
+    match class {
+        1 => "a cell array".into(),
+        2 => "a struct".into(),
+        3 => "an object".into(),
+        MX_CHAR_CLASS => "a char array (text)".into(),
+        5 => "a sparse matrix".into(),
+        16 => "a function handle".into(),
+        17 => "an opaque object (a string, table or class instance)".into(),
+        7 => "a single-precision array".into(),
+        8..=15 => {
+            let names = ["int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64"];
+            let name = names[usize::from(class - 8)];
+            format!("{} {name} array", if name.starts_with('i') { "an" } else { "a" })
+        }
+        c => format!("of MATLAB array class {c}"),
+    }
 }
 
 /// The real part as f64, or None when the data are complex.
@@ -209,6 +302,7 @@ const MI_UTF16: u32 = 17;
 const MI_UTF32: u32 = 18;
 const MX_CHAR_CLASS: u8 = 4;
 const MX_DOUBLE_CLASS: u8 = 6;
+const MX_UINT64_CLASS: u8 = 15;
 
 /// Writes `vars` (name, matrix) as a level-5 MAT-file (see the module docs). Names must be valid
 /// MATLAB identifiers (the callers' names are fixed ones such as `AK`).

@@ -85,11 +85,24 @@ pub fn frequency_band(domain: TimeDomain, systems: &[&StateSpace], extra: &[f64]
     let (lo, hi) = mags.fold((f64::INFINITY, 0f64), |(l, h), m| (l.min(m), h.max(m)));
     let (lo, hi) = if lo <= hi { (lo, hi) } else { (1.0, 1.0) };
     let band = (10f64.powf((lo / 10.0).log10().floor()), 10f64.powf((hi * 10.0).log10().ceil()));
-    match domain.nyquist() {
+    let band = match domain.nyquist() {
         None => band,
         Some(nyquist) => (band.0.min(nyquist * 1e-3), nyquist),
+    };
+    // A log-spaced grid needs finite positive ends: modes near 0 or beyond 1e300 rad/s (a
+    // controller's huge entries) must not make an end 0 or +∞ (the grid, and a plot's axis,
+    // would be NaN).
+    let (lo, hi) = (band.0.clamp(BAND_LIMITS.0, BAND_LIMITS.1), band.1.clamp(BAND_LIMITS.0, BAND_LIMITS.1));
+    if lo < hi {
+        (lo, hi)
+    } else {
+        (lo.min(hi / 10.0).max(BAND_LIMITS.0), hi.max(lo * 10.0).min(BAND_LIMITS.1))
     }
 }
+
+/// The widest band [`frequency_band`] returns (rad/s): wide enough for every plant (entries and
+/// sampling times within 1e-50..1e50), narrow enough that its log-spaced grid is finite.
+const BAND_LIMITS: (f64, f64) = (1e-300, 1e300);
 
 /// (ω, σmax(G(iω))) on `band`, ascending in ω: [`SIGMA_BASE_POINTS`] log-spaced points, then
 /// midpoints (in log ω) inserted next to every point where σmax changes by more than

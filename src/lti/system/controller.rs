@@ -173,7 +173,7 @@ impl Controller {
     /// (m × p) and AK (nk × nk) and every block is checked against them.
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Controller, ControllerError> {
         let err = |kind| ControllerError { file: file.as_ref().to_path_buf(), kind };
-        let doc: Value = serde_json::from_str(text).map_err(|e| {
+        let doc: Value = crate::input::parse_json_unique_keys(text).map_err(|e| {
             err(ControllerErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() })
         })?;
         Self::from_json_value(&doc).map_err(err)

@@ -31,18 +31,24 @@ pub enum ExportTarget {
     Python,
 }
 
-/// Shortest representation that reads back to the same f64.
-fn number(x: f64) -> String {
+/// Shortest representation that reads back to the same f64 in `target`. MATLAB reads every
+/// literal as a double, so "2" and "-0" will do; Python reads "-0" as the integer 0, which numpy
+/// turns into +0.0 (a fixed −0.0 came back as +0.0), so a Python number keeps its ".0".
+fn number(x: f64, target: ExportTarget) -> String {
     let s = format!("{x:?}");
-    s.strip_suffix(".0").map_or(s.clone(), str::to_string)
+    match target {
+        ExportTarget::Matlab => s.strip_suffix(".0").map_or(s.clone(), str::to_string),
+        ExportTarget::Python => s,
+    }
 }
 
 fn matlab_matrix(m: MatRef<'_, f64>) -> String {
     if m.nrows() == 0 || m.ncols() == 0 {
         return format!("zeros({}, {})", m.nrows(), m.ncols());
     }
-    let rows: Vec<String> =
-        (0..m.nrows()).map(|i| (0..m.ncols()).map(|j| number(m[(i, j)])).collect::<Vec<_>>().join(", ")).collect();
+    let rows: Vec<String> = (0..m.nrows())
+        .map(|i| (0..m.ncols()).map(|j| number(m[(i, j)], ExportTarget::Matlab)).collect::<Vec<_>>().join(", "))
+        .collect();
     format!("[{}]", rows.join(";\n      "))
 }
 
@@ -51,7 +57,12 @@ fn python_matrix(m: MatRef<'_, f64>) -> String {
         return format!("np.zeros(({}, {}))", m.nrows(), m.ncols());
     }
     let rows: Vec<String> = (0..m.nrows())
-        .map(|i| format!("[{}]", (0..m.ncols()).map(|j| number(m[(i, j)])).collect::<Vec<_>>().join(", ")))
+        .map(|i| {
+            format!(
+                "[{}]",
+                (0..m.ncols()).map(|j| number(m[(i, j)], ExportTarget::Python)).collect::<Vec<_>>().join(", ")
+            )
+        })
         .collect();
     format!("np.array([{}])", rows.join(",\n               "))
 }
@@ -63,7 +74,7 @@ pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String
     let mats = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
     let mut s = String::new();
     let update = if k.domain.is_discrete() { "xk[t+1] = AK xk[t] + BK y[t]" } else { "xk' = AK xk + BK y" };
-    let ts = k.domain.ts().map(number);
+    let ts = k.domain.ts().map(|ts| number(ts, target));
     match target {
         ExportTarget::Matlab => {
             s += &format!(
@@ -114,8 +125,13 @@ mod tests {
 
     #[test]
     fn numbers_round_trip_and_empty_blocks_have_shapes() {
-        for x in [0.1, -1.0 / 3.0, 1e-300, 123456789.0, -0.0] {
-            assert_eq!(number(x).parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x}");
+        for x in [0.1, -1.0 / 3.0, 1e-300, 123456789.0, -0.0, 2.0] {
+            for t in [ExportTarget::Matlab, ExportTarget::Python] {
+                assert_eq!(number(x, t).parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x}");
+            }
+            // Python reads a literal without '.', 'e' or "inf" as an integer: −0 would become +0.0
+            let py = number(x, ExportTarget::Python);
+            assert!(py.contains('.') || py.contains('e'), "{py}");
         }
         let k = Controller::continuous(
             Mat::zeros(0, 0),
@@ -131,6 +147,9 @@ mod tests {
         assert!(m.contains("K = ss(AK, BK, CK, DK);") && m.contains("u = K y"));
         let p = export_code(&k, ExportTarget::Python, "k.json");
         assert!(p.contains("BK = np.zeros((0, 2))") && p.contains("DK = np.array([[0.5, 1.5]])"), "{p}");
+        let neg_zero =
+            Controller::continuous(Mat::zeros(0, 0), Mat::zeros(0, 1), Mat::zeros(1, 0), Mat::full(1, 1, -0.0));
+        assert!(export_code(&neg_zero, ExportTarget::Python, "k.json").contains("DK = np.array([[-0.0]])"));
         assert!(p.contains("K = control.ss(AK, BK, CK, DK)") && p.contains("sign=1"));
         assert!(!m.contains("Ts") && !p.contains("dt="));
     }

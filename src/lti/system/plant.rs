@@ -11,12 +11,12 @@
 //! or an object with at least `citation`), `dims` {n, m1, m2, p1, p2}, and the nine matrices
 //! `A, B1, B2, C1, C2, D11, D12, D21, D22` as arrays of rows; optional `notes` and `check` are
 //! kept as provenance, and an optional `order` must equal `dims.n`. An optional `Ts` is the
-//! sampling time in seconds of a discrete-time plant (absent or 0: continuous time,
-//! [`TimeDomain`]). No entry may exceed 1e50
+//! sampling time in seconds of a discrete-time plant (absent or 0: continuous time; else from
+//! 1e-50 to 1e50, [`TimeDomain`]). No entry may exceed 1e50
 //! in absolute value, and a non-zero matrix needs an entry of 1e-50 or more
 //! (`matrix_json::check_magnitudes`). Any other top-level
 //! key is an error naming it ([`PlantErrorKind::UnknownKey`]): a misspelt `D12` or a key this version does
-//! not know must not be silently ignored. [`Plant::from_json_str`] validates everything and names
+//! not know must not be silently ignored; so is a key given twice (`input::parse_json_unique_keys`). [`Plant::from_json_str`] validates everything and names
 //! the file, the field and the row/column of the first thing wrong.
 
 use std::collections::BTreeMap;
@@ -28,7 +28,8 @@ use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
 use crate::lti::io::mat_file::{
-    json_number, read_char_var, read_mat_vars, scalar_var_to_json, var_to_json, write_mat, MatReadError, MatVar,
+    json_number, read_char_var, read_mat_vars_with_text, scalar_var_to_json, var_to_json, write_mat, MatReadError,
+    MatVar,
 };
 use crate::lti::io::matrix_json::{check_magnitudes, json_shape, matrix_from_json, MatrixJsonError};
 
@@ -257,7 +258,7 @@ impl Plant {
     /// the dimensions are inferred from the blocks (an empty `[]` block is then a zero block).
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let err = |kind| PlantError { file: file.as_ref().to_path_buf(), kind };
-        let mut doc: Value = serde_json::from_str(text)
+        let mut doc: Value = crate::input::parse_json_unique_keys(text)
             .map_err(|e| err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() }))?;
         if let Value::Object(o) = &mut doc {
             let stem = file.as_ref().file_stem().map_or_else(|| "plant".into(), |s| s.to_string_lossy().into_owned());
@@ -553,7 +554,7 @@ fn first_non_finite(name: &'static str, v: &MatVar) -> Result<(), PlantErrorKind
 /// The JSON plant document a plant MAT-file stands for (validated by the caller with the JSON
 /// plant checks). `stem` names the plant when the file has no `name` variable.
 fn plant_document(bytes: &[u8], stem: &str) -> Result<Value, PlantErrorKind> {
-    let vars = read_mat_vars(bytes)?;
+    let vars = read_mat_vars_with_text(bytes, &["name"])?;
     for (key, _, _) in MATRICES {
         match vars.get(key) {
             None => {

@@ -24,19 +24,32 @@ pub enum TimeDomain {
     },
 }
 
+/// Smallest sampling time accepted (seconds): the smallest magnitude a plant's entries may
+/// have (`MIN_PLANT_MAGNITUDE`). Outside [`MIN_TS`, `MAX_TS`] frequencies in rad/s (θ/Ts up to
+/// the Nyquist frequency π/Ts) leave the range where a frequency grid, a plot axis or a printed
+/// frequency can be formed (Ts = 5e-324 made π/Ts infinite and the σ-plot's axis NaN).
+pub const MIN_TS: f64 = crate::lti::io::matrix_json::MIN_PLANT_MAGNITUDE;
+/// Largest sampling time accepted (seconds): the largest magnitude of a plant's entries
+/// (`MAX_PLANT_MAGNITUDE`); see [`MIN_TS`].
+pub const MAX_TS: f64 = crate::lti::io::matrix_json::MAX_PLANT_MAGNITUDE;
+
 /// What is wrong with a sampling time.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("must be a finite number of seconds ≥ 0 (0: continuous time), found {0}")]
+#[error(
+    "must be 0 (continuous time) or a number of seconds from {MIN_TS:e} to {MAX_TS:e} (the magnitude limits of a \
+     plant's entries), found {}",
+    crate::numeric::readable(*.0)
+)]
 pub struct BadSamplingTime(pub f64);
 
 impl TimeDomain {
-    /// The domain of a file's `Ts`: 0 is continuous time, a finite Ts > 0 discrete time; anything
-    /// else (negative, NaN, infinite) is an error. (python-control's `dt = True`, "discrete with
+    /// The domain of a file's `Ts`: 0 is continuous time, Ts in [[`MIN_TS`], [`MAX_TS`]] discrete
+    /// time; anything else (negative, NaN, infinite, subnormal, out of that range) is an error. (python-control's `dt = True`, "discrete with
     /// unspecified sampling time", has no file form here: a sampling time must be given.)
     pub fn from_ts(ts: f64) -> Result<Self, BadSamplingTime> {
         if ts == 0.0 {
             Ok(TimeDomain::Continuous)
-        } else if ts.is_finite() && ts > 0.0 {
+        } else if (MIN_TS..=MAX_TS).contains(&ts) {
             Ok(TimeDomain::Discrete { ts })
         } else {
             Err(BadSamplingTime(ts))
@@ -117,12 +130,13 @@ impl TimeDomain {
     }
 }
 
-/// "continuous time" or "discrete time (Ts = 0.01 s)".
+/// "continuous time" or "discrete time (Ts = 0.01 s)" (Ts as `numeric::readable` prints it:
+/// "1e-40", not forty zeros).
 impl fmt::Display for TimeDomain {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             TimeDomain::Continuous => write!(f, "continuous time"),
-            TimeDomain::Discrete { ts } => write!(f, "discrete time (Ts = {ts} s)"),
+            TimeDomain::Discrete { ts } => write!(f, "discrete time (Ts = {} s)", crate::numeric::readable(*ts)),
         }
     }
 }
@@ -135,9 +149,15 @@ mod tests {
     fn sampling_times() {
         assert_eq!(TimeDomain::from_ts(0.0), Ok(TimeDomain::Continuous));
         assert_eq!(TimeDomain::from_ts(0.1), Ok(TimeDomain::Discrete { ts: 0.1 }));
-        for bad in [-0.1, f64::NAN, f64::INFINITY] {
+        for bad in [-0.1, f64::NAN, f64::INFINITY, 5e-324, 1e-51, 1e51, f64::MAX] {
             assert!(TimeDomain::from_ts(bad).is_err(), "{bad}");
         }
+        for good in [MIN_TS, MAX_TS] {
+            assert_eq!(TimeDomain::from_ts(good), Ok(TimeDomain::Discrete { ts: good }));
+        }
+        assert_eq!(TimeDomain::Discrete { ts: 1e-40 }.to_string(), "discrete time (Ts = 1e-40 s)");
+        let e = TimeDomain::from_ts(5e-324).unwrap_err().to_string();
+        assert!(e.contains("found 5e-324") && e.contains("1e-50"), "{e}");
         let d = TimeDomain::Discrete { ts: 0.5 };
         assert_eq!(d.to_rad_per_s(PI), 2.0 * PI);
         assert_eq!(d.from_rad_per_s(2.0 * PI), PI);
