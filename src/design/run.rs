@@ -9,8 +9,8 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
     closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_discrete, hinf_norm_with_poles, is_stable,
-    is_stable_with_margin, stability_measure, stability_measure_of, verified_stability_measure, Controller, HinfParams, Interrupt, Plant,
-    TimeDomain, NORM_TIE_RTOL,
+    is_stable_with_margin, stability_measure, stability_measure_of, verified_stability_measure, Controller, HinfParams,
+    Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
 
