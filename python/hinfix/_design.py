@@ -34,7 +34,8 @@ class DesignResult:
     ``alpha_k`` the stability measures of the closed loop and of K (spectral abscissa; ρ − 1 in
     discrete time; ``alpha_k`` is None for order 0), ``objective`` max(γ, ε‖K‖∞) (strong) or γ
     (plain). ``status`` is one of "converged", "stopped", "stabilised_only", "not_stabilised",
-    "budget_exhausted", "interrupted". ``certificate`` is {"dnorm", "evaldist"} of the final
+    "bound_violated" (a stabilising controller that violates a plant's bound: see each plant's
+    ``bound_met`` in ``plants``), "budget_exhausted", "interrupted". ``certificate`` is {"dnorm", "evaldist"} of the final
     point (None if the optimisation phase did not run), ``search`` the multi-start search's
     summary (starts, best start, time to best, why it stopped). ``closed_loop`` is
     ``P.lft(K)`` (of the first plant; ``closed_loops`` has every plant's), ``plants`` each
