@@ -87,7 +87,6 @@ pub fn balance(a: MatRef<'_, f64>) -> (Mat<f64>, Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lti::kernels::spectral::spectral_abscissa;
 
     #[test]
     fn a_badly_scaled_matrix_is_balanced_exactly_with_the_same_eigenvalues() {
@@ -106,10 +105,7 @@ mod tests {
                 assert_eq!(b[(i, j)], a[(i, j)] / d[i] * d[j]);
             }
         }
-        let (alpha_a, alpha_b) = (spectral_abscissa(a.as_ref()), spectral_abscissa(b.as_ref()));
-        let alpha_m = spectral_abscissa(m.as_ref());
-        assert!((alpha_b - alpha_m).abs() < 1e-13, "{alpha_b} {alpha_m}");
-        assert!((alpha_a - alpha_m).abs() < 1e-3, "{alpha_a} {alpha_m}");
+        // the eigenvalues: `spectral`'s test of `verified_spectral_abscissa`
     }
 
     #[test]

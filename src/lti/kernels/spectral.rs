@@ -318,6 +318,19 @@ mod tests {
     use super::*;
 
     #[test]
+    fn verified_abscissa_of_a_badly_scaled_matrix_is_accurate() {
+        // A = T·M·T⁻¹, T = diag(1, 1e6, 1e-6): the same eigenvalues as M, entries up to 1e12
+        let m = faer::mat![[-1.0, 2.0, 0.5], [-3.0, -1.0, 1.0], [0.25, -0.5, -2.0]];
+        let t = [1.0, 1e6, 1e-6];
+        let a = Mat::from_fn(3, 3, |i, j| t[i] * m[(i, j)] / t[j]);
+        let alpha_m = spectral_abscissa(m.as_ref());
+        assert!((verified_spectral_abscissa(a.as_ref()) - alpha_m).abs() < 1e-13);
+        assert!(stability_margin(a.as_ref()) < 1e-10, "{}", stability_margin(a.as_ref()));
+        // a well-scaled matrix: the optimiser's abscissa, bit for bit
+        assert_eq!(verified_spectral_abscissa(m.as_ref()).to_bits(), alpha_m.to_bits());
+    }
+
+    #[test]
     fn the_verification_margin_scales_with_the_matrix() {
         // Α = −4.4e-16 was called stable.
         let one = faer::Mat::from_fn(2, 2, |i, j| if i == j { -1.0 } else { 0.0 });

@@ -236,7 +236,7 @@ impl Plant {
             return Self::from_mat_bytes(&bytes, path);
         }
         let err = |kind| PlantError { file: path.to_path_buf(), kind };
-        if crate::lti::system::plant_library::is_gzip_json_path(path) {
+        if is_gzip_json_path(path) {
             let text = read_gzip_text(path).map_err(err)?;
             return Self::from_json_str(&text, path);
         }
@@ -425,6 +425,11 @@ impl Plant {
         }
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
+}
+
+/// Whether `path` names a gzip-compressed plant file (`*.json.gz`).
+pub fn is_gzip_json_path(path: &Path) -> bool {
+    path.to_str().is_some_and(|s| s.to_ascii_lowercase().ends_with(".json.gz"))
 }
 
 /// The text of a gzip-compressed plant file: at most `MAX_PLANT_BYTES` read, and at most as many

@@ -12,7 +12,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::plant::{PlantError, PlantErrorKind};
+use super::plant::{is_gzip_json_path, PlantError, PlantErrorKind};
 
 /// Environment variable that overrides the plant library directory.
 pub const PLANTS_ENV: &str = "HINFIX_PLANTS";
@@ -74,11 +74,6 @@ fn plants_in(dir: &Path, collection: Option<&str>) -> std::io::Result<Vec<Librar
         .collect();
     found.sort_by(|a, b| a.name.cmp(&b.name).then(a.path.cmp(&b.path)));
     Ok(found)
-}
-
-/// Whether `path` names a gzip-compressed plant file (`*.json.gz`).
-pub fn is_gzip_json_path(path: &Path) -> bool {
-    path.to_str().is_some_and(|s| s.to_ascii_lowercase().ends_with(".json.gz"))
 }
 
 /// Resolves a plant argument: an existing file or a `.json`/`.json.gz`/`.mat` path as given, else
