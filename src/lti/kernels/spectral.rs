@@ -80,7 +80,7 @@ pub const STABILITY_MARGIN_RTOL: f64 = 1e-12;
 
 /// The stability margin of a system matrix `a`: [`STABILITY_MARGIN_RTOL`] · max(1, ‖B‖_F) with B
 /// the balanced `a` where balancing pays
-/// ([`balanced_for_eigenvalues`](super::balance::balanced_for_eigenvalues): the same eigenvalues,
+/// (`kernels::balance::balanced_for_eigenvalues`: the same eigenvalues,
 /// computed with a rounding error of about ε_mach·‖B‖ by [`verified_spectral_abscissa`]), else
 /// `a` itself. The Frobenius norm
 /// bounds the 2-norm and costs one pass. For a well-scaled matrix B = A; for a badly scaled one
