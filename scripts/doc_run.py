@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Runs the command blocks of the README files that are marked to run, so that they cannot drift
-from the program (issue 49: docs that run verbatim). `.ci/run` calls it after the build.
+from the program (the docs run verbatim). `.ci/run` calls it after the build.
 
 A fenced block runs when the line before it (blank lines aside) is an HTML comment, invisible
 on the rendered page:

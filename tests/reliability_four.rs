@@ -1,4 +1,4 @@
-//! Reliability, round four (issue 47): the edges of the newer surfaces (several plants, the H2,
+//! Reliability of the newer surfaces (several plants, the H2,
 //! abscissa and radius objectives, structures, discrete time), one regression test per class of
 //! what a hostile user found: (1) panics, (2) false claims and wrong numbers, (3) silent losses,
 //! (4) unclear errors. Each test feeds a class of inputs, not the one reported input.

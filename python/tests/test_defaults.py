@@ -1,4 +1,4 @@
-"""One search everywhere (issue 51, item 3): ``hinfix.design`` searches with the same defaults as
+"""One search everywhere: ``hinfix.design`` searches with the same defaults as
 ``campaign design`` and campaign jobs. The defaults come from the crate (``DesignOptions::default``,
 ``hinfix.default_options()``); a Rust test (src/cli/design.rs) holds the command's flags and a
 campaign job to the same, and this file holds Python to them."""
@@ -20,7 +20,7 @@ def test_an_option_left_out_is_the_crates_default():
     want = dict(hinfix.default_options(), order=1, maxevals=300)
     assert info.options == {k: v for k, v in want.items() if k in info.options}
     assert {k for k in want if k not in info.options} <= {"max_starts", "refine_rtol", "stall_cpu"}  # off: left out
-    # the search of issue 51: not HIFOO's bare starts (stall_starts 0, no hops, no open-loop or
+    # the multi-start search: not HIFOO's bare starts (stall_starts 0, no hops, no open-loop or
     # central starts), which a record without these fields reads as
     assert info.options["stall_starts"] > 0
     assert info.options["hop_scales"] and info.options["central_gammas"]

@@ -1,4 +1,4 @@
-"""The Python package on a par with the command (issue 49): discrete-time plants, several plants
+"""The Python package on a par with the command: discrete-time plants, several plants
 with objectives, weights and bounds, structures, K's signal names, the closed loop, progress,
 types; every figure checked against python-control."""
 import importlib.metadata

@@ -546,7 +546,7 @@ mod tests {
         assert_eq!(options(a).unwrap(), DesignOptions { order: 2, ..DesignOptions::default() });
     }
 
-    /// One search everywhere (issue 51, item 3): a campaign job that sets no option designs with
+    /// One search everywhere: a campaign job that sets no option designs with
     /// exactly the options of `campaign design` given only the required flags, both the option
     /// table's defaults. (The Python package's defaults are the same `DesignOptions::default`,
     /// python/tests/test_defaults.py.)
