@@ -1,0 +1,6 @@
+//! The leaves of `campaign`, importing no other part: the provenance of a record, the paper's
+//! reference values, escaping for the terminal, CSV and LaTeX, and what a sparse trace keeps.
+pub(crate) mod provenance;
+pub(crate) mod reference;
+pub(crate) mod sanitise;
+pub(crate) mod trace_filter;

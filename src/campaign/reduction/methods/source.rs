@@ -1,0 +1,366 @@
+//! The sources of `campaign compare`: each `LABEL=PATH` is a results folder (its `best.csv`, and
+//! the CPU seconds of its journals) or an external CSV file of one method's values (columns
+//! `plant, order, objective, gamma`, optional `cpu_s`, `stable`, `plant_fingerprint`; any other
+//! column is ignored). Every bad cell of an external file is an error naming the file, the line
+//! and the column (campaigns/FORMAT.md, "Comparing methods").
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::campaign::records::journal::{journals_in, read_journal, JournalError};
+use crate::campaign::reduction::reduce::BestRow;
+use crate::design::ObjectiveKind;
+
+/// Largest source file read (an external CSV or a `best.csv`): 64 MiB.
+pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
+
+/// Longest method label, in characters.
+pub const MAX_LABEL_CHARS: usize = 40;
+
+/// One method's value of one entry (plant, order, objective).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceEntry {
+    /// Plant name.
+    pub plant: String,
+    /// The plant's content fingerprint, when the source gives it.
+    pub fingerprint: Option<String>,
+    /// Controller order n_K.
+    pub order: usize,
+    /// Design objective.
+    pub objective: ObjectiveKind,
+    /// γ; not finite when the method found no (strongly) stabilising controller.
+    pub gamma: f64,
+    /// CPU seconds spent on the entry, when the source gives them.
+    pub cpu_s: Option<f64>,
+    /// Whether the method's controller is stable, when the source says.
+    pub stable: Option<bool>,
+}
+
+impl SourceEntry {
+    /// Whether the method solved the entry: a finite positive γ, and for the strong objective a
+    /// controller not declared unstable.
+    pub fn solved(&self) -> bool {
+        self.gamma.is_finite()
+            && self.gamma > 0.0
+            && !(self.objective == ObjectiveKind::Strong && self.stable == Some(false))
+    }
+}
+
+/// One method: its label, where its values came from, and the values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Source {
+    /// The label (a table column, a legend entry).
+    pub label: String,
+    /// The results folder or CSV file.
+    pub path: PathBuf,
+    /// Its entries, in the file's order.
+    pub entries: Vec<SourceEntry>,
+}
+
+impl Source {
+    /// Whether every solved entry has its CPU seconds (the CPU profile needs them all).
+    pub fn has_cpu(&self) -> bool {
+        self.entries.iter().filter(|e| e.solved()).all(|e| e.cpu_s.is_some())
+    }
+}
+
+/// A source could not be read.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SourceError {
+    /// Not `LABEL=PATH`, or a bad label.
+    #[error("source `{spec}`: {problem}")]
+    Spec {
+        /// The argument.
+        spec: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// Two sources share a label.
+    #[error("two sources are labelled `{0}`")]
+    DuplicateLabel(String),
+    /// A file could not be read.
+    #[error("{}: cannot read: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The CSV structure is broken (e.g. a row with another number of fields).
+    #[error("{}, line {line}: {source}", path.display())]
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: u64,
+        /// The CSV reader's error.
+        #[source]
+        source: csv::Error,
+    },
+    /// A bad cell, or a missing column (line 1, the header).
+    #[error("{}, line {line}, column `{column}`: {problem}", path.display())]
+    Cell {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: u64,
+        /// The column's name.
+        column: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A results folder's journal could not be read.
+    #[error(transparent)]
+    Journal(#[from] JournalError),
+}
+
+/// Parses `LABEL=PATH` (the label: letters, digits and `-_.+`, at most [`MAX_LABEL_CHARS`]).
+pub fn parse_spec(spec: &str) -> Result<(String, PathBuf), SourceError> {
+    let bad = |problem: &str| SourceError::Spec { spec: spec.to_string(), problem: problem.to_string() };
+    let Some((label, path)) = spec.split_once('=') else { return Err(bad("expected LABEL=PATH")) };
+    if label.is_empty() || path.is_empty() {
+        return Err(bad("expected LABEL=PATH, both non-empty"));
+    }
+    if label.chars().count() > MAX_LABEL_CHARS
+        || !label.chars().all(|c| c.is_ascii_alphanumeric() || "-_.+".contains(c))
+    {
+        return Err(bad(&format!("a label is 1 to {MAX_LABEL_CHARS} letters, digits or -_.+")));
+    }
+    Ok((label.to_string(), PathBuf::from(path)))
+}
+
+/// Reads every `LABEL=PATH` source; labels must differ.
+pub fn load_sources(specs: &[String]) -> Result<Vec<Source>, SourceError> {
+    let mut out: Vec<Source> = Vec::new();
+    for spec in specs {
+        let (label, path) = parse_spec(spec)?;
+        if out.iter().any(|s| s.label == label) {
+            return Err(SourceError::DuplicateLabel(label));
+        }
+        out.push(load_source(label, &path)?);
+    }
+    Ok(out)
+}
+
+/// Reads one source: a results folder or an external CSV file.
+pub fn load_source(label: String, path: &Path) -> Result<Source, SourceError> {
+    let entries = if path.is_dir() { results_entries(path)? } else { external_entries(path)? };
+    Ok(Source { label, path: path.to_path_buf(), entries })
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, SourceError> {
+    crate::input::read_capped(path, MAX_SOURCE_BYTES, "comparison source")
+        .map_err(|source| SourceError::Io { path: path.to_path_buf(), source })
+}
+
+/// A results folder's entries: its `best.csv` rows (a row with no verified controller is a
+/// failure), each with the CPU seconds of every journaled job of its (plant, order, objective)
+/// (a job journaled twice counts once) when the folder holds journals.
+fn results_entries(dir: &Path) -> Result<Vec<SourceEntry>, SourceError> {
+    let best_path = dir.join("best.csv");
+    let bytes = read(&best_path)?;
+    let mut reader = csv::Reader::from_reader(bytes.as_slice());
+    let mut rows = Vec::new();
+    for rec in reader.deserialize::<BestRow>() {
+        let row = rec.map_err(|source| SourceError::Csv {
+            path: best_path.clone(),
+            line: source.position().map_or(0, |p| p.line()),
+            source,
+        })?;
+        rows.push(row);
+    }
+    let cpu = journal_cpu(dir)?;
+    Ok(rows
+        .into_iter()
+        .map(|r| {
+            let key = (r.plant_fingerprint.clone(), r.order, r.objective.name());
+            SourceEntry {
+                cpu_s: cpu.as_ref().and_then(|c| c.get(&key).copied()),
+                plant: r.plant,
+                fingerprint: Some(r.plant_fingerprint),
+                order: r.order,
+                objective: r.objective,
+                gamma: if r.job_id.is_some() { r.gamma } else { f64::INFINITY },
+                stable: r.controller_stable,
+            }
+        })
+        .collect())
+}
+
+/// CPU seconds per (fingerprint, order, objective) over the folder's journals (None without
+/// journals).
+type CpuMap = BTreeMap<(String, usize, &'static str), f64>;
+
+fn journal_cpu(dir: &Path) -> Result<Option<CpuMap>, SourceError> {
+    let files = journals_in(dir)?;
+    if files.is_empty() {
+        return Ok(None);
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    let mut cpu = CpuMap::new();
+    for f in files {
+        for r in read_journal(&f)?.records {
+            if seen.insert(r.job_id.0.clone()) {
+                *cpu.entry((r.plant_fingerprint.clone(), r.order, r.options.objective.name())).or_default() += r.cpu_s;
+            }
+        }
+    }
+    Ok(Some(cpu))
+}
+
+/// The columns of an external CSV: required, then optional.
+const REQUIRED: [&str; 4] = ["plant", "order", "objective", "gamma"];
+
+/// An external CSV's entries, every cell checked.
+fn external_entries(path: &Path) -> Result<Vec<SourceEntry>, SourceError> {
+    let bytes = read(path)?;
+    let csv_err = |source: csv::Error| SourceError::Csv {
+        path: path.to_path_buf(),
+        line: source.position().map_or(1, |p| p.line()),
+        source,
+    };
+    let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(bytes.as_slice());
+    let header = reader.headers().map_err(csv_err)?.clone();
+    let col = |name: &str| header.iter().position(|h| h == name);
+    let mut idx = [0usize; 4];
+    for (i, name) in REQUIRED.iter().enumerate() {
+        idx[i] = col(name).ok_or_else(|| SourceError::Cell {
+            path: path.to_path_buf(),
+            line: 1,
+            column: name.to_string(),
+            problem: format!("missing column (the header has: {})", header.iter().collect::<Vec<_>>().join(", ")),
+        })?;
+    }
+    let (cpu_col, stable_col, fp_col) = (col("cpu_s"), col("stable"), col("plant_fingerprint"));
+    let mut out = Vec::new();
+    let mut lines: BTreeMap<(String, Option<String>, usize, &'static str), u64> = BTreeMap::new();
+    for rec in reader.records() {
+        let rec = rec.map_err(csv_err)?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let cell = |i: usize| rec.get(i).unwrap_or("");
+        let bad = |column: &str, problem: String| SourceError::Cell {
+            path: path.to_path_buf(),
+            line,
+            column: column.to_string(),
+            problem,
+        };
+        let plant = cell(idx[0]).to_string();
+        if plant.is_empty() {
+            return Err(bad("plant", "empty plant name".into()));
+        }
+        let order: usize = cell(idx[1])
+            .parse()
+            .map_err(|_| bad("order", format!("`{}` is not an order (0, 1, 2, …)", cell(idx[1]))))?;
+        let objective = match cell(idx[2]) {
+            "strong" => ObjectiveKind::Strong,
+            "plain" => ObjectiveKind::Plain,
+            other => return Err(bad("objective", format!("`{other}` is neither `strong` nor `plain`"))),
+        };
+        let gamma = parse_gamma(cell(idx[3])).map_err(|p| bad("gamma", p))?;
+        let cpu_s = match cpu_col.map(cell).unwrap_or("") {
+            "" => None,
+            s => match s.parse::<f64>() {
+                Ok(x) if x.is_finite() && x >= 0.0 => Some(x),
+                _ => return Err(bad("cpu_s", format!("`{s}` is not a number of seconds ≥ 0"))),
+            },
+        };
+        let stable = match stable_col.map(cell).unwrap_or("") {
+            "" => None,
+            "true" | "stable" => Some(true),
+            "false" | "unstable" => Some(false),
+            s => return Err(bad("stable", format!("`{s}` is not true/false (or stable/unstable)"))),
+        };
+        let fingerprint = match fp_col.map(cell).unwrap_or("") {
+            "" => None,
+            s if s.len() == 64 && s.chars().all(|c| c.is_ascii_hexdigit()) => Some(s.to_ascii_lowercase()),
+            s => return Err(bad("plant_fingerprint", format!("`{s}` is not 64 hexadecimal digits"))),
+        };
+        let key = (plant.clone(), fingerprint.clone(), order, objective.name());
+        if let Some(first) = lines.insert(key, line) {
+            return Err(bad(
+                "plant",
+                format!("duplicate entry: {plant}, order {order}, {} is on line {first} too", objective.name()),
+            ));
+        }
+        out.push(SourceEntry { plant, fingerprint, order, objective, gamma, cpu_s, stable });
+    }
+    Ok(out)
+}
+
+/// A γ cell: a positive number, or empty / `inf` for a failure (no controller found).
+fn parse_gamma(s: &str) -> Result<f64, String> {
+    match s {
+        "" | "inf" | "Inf" | "infinity" => Ok(f64::INFINITY),
+        _ => match s.parse::<f64>() {
+            Ok(g) if g > 0.0 && g.is_finite() => Ok(g),
+            Ok(g) => Err(format!("γ must be positive and finite (or empty/inf for a failure), found {g}")),
+            Err(_) => Err(format!("`{s}` is not a number")),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, text: &str) -> PathBuf {
+        let p = dir.join("m.csv");
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    fn err(text: &str) -> String {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), text);
+        load_source("m".into(), &p).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_good_file_reads_with_optional_columns() {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(
+            d.path(),
+            "plant,order,objective,gamma,cpu_s,stable,note\nHE1,1,strong,0.1235,2.5,true,x\nHE1,2,strong,inf,,,\nAC8,0,plain,2,,false,\n",
+        );
+        let s = load_source("m".into(), &p).unwrap();
+        assert_eq!(s.entries.len(), 3);
+        assert_eq!(s.entries[0].gamma, 0.1235);
+        assert_eq!(s.entries[0].cpu_s, Some(2.5));
+        assert!(s.entries[0].solved() && !s.entries[1].solved());
+        // plain: an unstable controller is still a solution
+        assert!(s.entries[2].solved());
+        assert!(!s.has_cpu());
+    }
+
+    #[test]
+    fn bad_files_name_the_file_line_and_column() {
+        let e = err("plant,order,gamma\nHE1,1,0.5\n");
+        assert!(e.contains("m.csv, line 1, column `objective`: missing column"), "{e}");
+        let e = err("plant,order,objective,gamma\nHE1,1,strong,0.5\nHE1,2,strong,abc\n");
+        assert!(e.contains("m.csv, line 3, column `gamma`") && e.contains("`abc` is not a number"), "{e}");
+        let e = err("plant,order,objective,gamma\nHE1,1,strong,0.5\nHE1,x,strong,1\n");
+        assert!(e.contains("line 3, column `order`"), "{e}");
+        let e = err("plant,order,objective,gamma\nHE1,1,strong,0.5\nAC8,1,strong,2\nHE1,1,strong,0.6\n");
+        assert!(e.contains("line 4, column `plant`") && e.contains("duplicate") && e.contains("line 2"), "{e}");
+        let e = err("plant,order,objective,gamma\nHE1,1,weak,0.5\n");
+        assert!(e.contains("line 2, column `objective`"), "{e}");
+        let e = err("plant,order,objective,gamma\nHE1,1,strong,-1\n");
+        assert!(e.contains("line 2, column `gamma`") && e.contains("positive"), "{e}");
+        let e = err("plant,order,objective,gamma,cpu_s\nHE1,1,strong,1,-3\n");
+        assert!(e.contains("line 2, column `cpu_s`"), "{e}");
+        let e = err("plant,order,objective,gamma\nHE1,1,strong\n");
+        assert!(e.contains("m.csv, line 2"), "{e}");
+    }
+
+    #[test]
+    fn specs_need_a_label_and_a_path() {
+        assert_eq!(parse_spec("ours=results/x").unwrap(), ("ours".to_string(), PathBuf::from("results/x")));
+        assert!(parse_spec("results/x").is_err());
+        assert!(parse_spec("=x").is_err());
+        assert!(parse_spec("a b=x").is_err());
+        let e = load_sources(&["a=/nonexistent/x.csv".into()]).unwrap_err().to_string();
+        assert!(e.contains("/nonexistent/x.csv"), "{e}");
+    }
+}
