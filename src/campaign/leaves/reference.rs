@@ -134,7 +134,7 @@ mod stable_word {
 
 /// The paper's table, built into the program (a plant library chosen with `HINFIX_PLANTS` need
 /// not, and usually does not, hold a copy).
-pub(crate) const REFERENCE_TEXT: &str = include_str!("../../plants/reference/gumussoy-millstone-overton-2008.csv");
+pub(crate) const REFERENCE_TEXT: &str = include_str!("../../../plants/reference/gumussoy-millstone-overton-2008.csv");
 
 /// Reads the reference table at `path`; every row is checked (γ finite and positive).
 pub fn load_reference(path: &Path) -> Result<Vec<ReferenceRow>, ReferenceError> {

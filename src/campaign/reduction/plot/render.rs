@@ -13,7 +13,7 @@ use super::PlotError;
 use crate::campaign::reduction::report::write_atomic;
 
 /// The bundled font (DejaVu Sans 2.37; licence in `assets/fonts/LICENSE-DejaVu.txt`).
-static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
 
 /// Font family name used by every figure.
 pub const FONT_FAMILY: &str = "sans-serif";
