@@ -16,10 +16,7 @@ mod common;
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hinfix-multi-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("multi", tag)
 }
 
 /// A campaign in the example folder (so that `HE1_op*.json` resolve) with this problem body.

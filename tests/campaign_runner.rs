@@ -23,10 +23,7 @@ use common::latex_compiles;
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
 
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hinfix-runner-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("runner", tag)
 }
 
 /// A campaign file in `dir`: HE1 at orders 1–2 warm-started, 2 ε, `seeds` seeds.

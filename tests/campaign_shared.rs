@@ -15,10 +15,7 @@ use hinfix::campaign::{journals_in, read_journal};
 mod common;
 
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hinfix-shared-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("shared", tag)
 }
 
 /// HE1 at orders 1–2 warm-started and REA2 at order 1, 2 ε, `seeds` seeds: 6·seeds jobs.

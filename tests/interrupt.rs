@@ -20,6 +20,8 @@ use hinfix::optim::{bfgs, BfgsOptions, NoObserver, Objective, OptimError, RunCon
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+mod common;
+
 /// A random stable plant (A = R/√n − I with R uniform in [−1, 1]: spectral radius of R/√n ≈ 0.6).
 fn random_plant(n: usize, seed: u64) -> Plant {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -30,25 +32,18 @@ fn random_plant(n: usize, seed: u64) -> Plant {
         a[(i, i)] -= 1.0;
     }
     let (m1, m2, p1, p2) = (2, 2, 2, 2);
-    Plant {
-        name: format!("RAND{n}"),
-        description: "random stable test plant".into(),
-        citation: String::new(),
-        source: serde_json::Value::Null,
-        notes: String::new(),
-        check: None,
-        dims: Dims { n, m1, m2, p1, p2 },
-        domain: Default::default(),
+    let mats = [
         a,
-        b1: m(n, m1, 1.0),
-        b2: m(n, m2, 1.0),
-        c1: m(p1, n, 1.0),
-        c2: m(p2, n, 1.0),
-        d11: m(p1, m1, 0.1),
-        d12: m(p1, m2, 1.0),
-        d21: m(p2, m1, 1.0),
-        d22: Mat::zeros(p2, m2),
-    }
+        m(n, m1, 1.0),
+        m(n, m2, 1.0),
+        m(p1, n, 1.0),
+        m(p2, n, 1.0),
+        m(p1, m1, 0.1),
+        m(p1, m2, 1.0),
+        m(p2, m1, 1.0),
+        Mat::zeros(p2, m2),
+    ];
+    Plant { description: "random stable test plant".into(), ..common::plant_of(&format!("RAND{n}"), mats) }
 }
 
 /// A counter hook: fires from poll number `k + 1` on (so it lets exactly `k` polls pass).

@@ -54,10 +54,7 @@ fn remaining(folder: &Path) -> BTreeSet<String> {
 }
 
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hinfix-jfault-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("jfault", tag)
 }
 
 /// Runs the campaign, applies `fault` to its folder after 3 records, and checks the run's end.

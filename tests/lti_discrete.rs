@@ -111,25 +111,18 @@ fn discrete_full_order_gamma_matches_sb10dd() {
         let name = case["name"].as_str().unwrap();
         let dim = |k: &str| case["dims"][k].as_u64().unwrap() as usize;
         let (n, m1, m2, p1, p2) = (dim("n"), dim("m1"), dim("m2"), dim("p1"), dim("p2"));
-        let plant = Plant {
-            name: name.into(),
-            description: String::new(),
-            citation: String::new(),
-            source: Value::Null,
-            notes: String::new(),
-            check: None,
-            dims: Dims { n, m1, m2, p1, p2 },
-            domain: TimeDomain::Discrete { ts: 1.0 },
-            a: mat(&case["A"], n, n),
-            b1: mat(&case["B1"], n, m1),
-            b2: mat(&case["B2"], n, m2),
-            c1: mat(&case["C1"], p1, n),
-            c2: mat(&case["C2"], p2, n),
-            d11: mat(&case["D11"], p1, m1),
-            d12: mat(&case["D12"], p1, m2),
-            d21: mat(&case["D21"], p2, m1),
-            d22: Mat::zeros(p2, m2),
-        };
+        let mats = [
+            mat(&case["A"], n, n),
+            mat(&case["B1"], n, m1),
+            mat(&case["B2"], n, m2),
+            mat(&case["C1"], p1, n),
+            mat(&case["C2"], p2, n),
+            mat(&case["D11"], p1, m1),
+            mat(&case["D12"], p1, m2),
+            mat(&case["D21"], p2, m1),
+            Mat::zeros(p2, m2),
+        ];
+        let plant = Plant { domain: TimeDomain::Discrete { ts: 1.0 }, ..common::plant_of(name, mats) };
         let want = case["gamma_opt"].as_f64().unwrap();
         let got = full_order_gamma_discrete(&plant, &FullOrderOptions::default()).unwrap();
         // a plant in discrete time takes the same route through the general entry point

@@ -16,6 +16,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
+mod common;
+
 /// H∞ tolerance for the finite differences (tight, so that the norm is smooth to FD accuracy).
 const FD_HINF_TOL: f64 = 1e-13;
 /// Central-difference step.
@@ -29,25 +31,18 @@ fn randn(rng: &mut ChaCha8Rng, r: usize, c: usize, scale: f64) -> Mat<f64> {
 
 fn random_plant(rng: &mut ChaCha8Rng, n: usize, m1: usize, m2: usize, p1: usize, p2: usize, d22: bool) -> Plant {
     let a = randn(rng, n, n, 1.0) - Mat::<f64>::identity(n, n) * faer::Scale(2.0 + (n as f64).sqrt());
-    Plant {
-        name: "random".into(),
-        description: String::new(),
-        citation: String::new(),
-        source: serde_json::Value::Null,
-        notes: String::new(),
-        check: None,
-        dims: Dims { n, m1, m2, p1, p2 },
-        domain: Default::default(),
+    let mats = [
         a,
-        b1: randn(rng, n, m1, 1.0),
-        b2: randn(rng, n, m2, 1.0),
-        c1: randn(rng, p1, n, 1.0),
-        c2: randn(rng, p2, n, 1.0),
-        d11: randn(rng, p1, m1, 0.3),
-        d12: randn(rng, p1, m2, 0.5),
-        d21: randn(rng, p2, m1, 0.5),
-        d22: if d22 { randn(rng, p2, m2, 0.4) } else { Mat::zeros(p2, m2) },
-    }
+        randn(rng, n, m1, 1.0),
+        randn(rng, n, m2, 1.0),
+        randn(rng, p1, n, 1.0),
+        randn(rng, p2, n, 1.0),
+        randn(rng, p1, m1, 0.3),
+        randn(rng, p1, m2, 0.5),
+        randn(rng, p2, m1, 0.5),
+        if d22 { randn(rng, p2, m2, 0.4) } else { Mat::zeros(p2, m2) },
+    ];
+    common::plant_of("random", mats)
 }
 
 fn random_controller(rng: &mut ChaCha8Rng, nk: usize, m: usize, p: usize) -> Controller {

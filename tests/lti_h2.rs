@@ -153,25 +153,9 @@ fn of_rank(rng: &mut ChaCha8Rng, r: usize, c: usize, rank: usize) -> Mat<f64> {
 /// A plant of which only the feedthroughs matter (n = 1).
 fn feedthrough_plant(d11: Mat<f64>, d12: Mat<f64>, d21: Mat<f64>, d22: Mat<f64>) -> Plant {
     let (p1, m1, m2, p2) = (d11.nrows(), d11.ncols(), d12.ncols(), d21.nrows());
-    Plant {
-        name: "feedthrough".into(),
-        description: String::new(),
-        citation: String::new(),
-        source: Value::Null,
-        notes: String::new(),
-        check: None,
-        dims: Dims { n: 1, m1, m2, p1, p2 },
-        domain: Default::default(),
-        a: Mat::from_fn(1, 1, |_, _| -1.0),
-        b1: Mat::from_fn(1, m1, |_, _| 1.0),
-        b2: Mat::from_fn(1, m2, |_, _| 1.0),
-        c1: Mat::from_fn(p1, 1, |_, _| 1.0),
-        c2: Mat::from_fn(p2, 1, |_, _| 1.0),
-        d11,
-        d12,
-        d21,
-        d22,
-    }
+    let one = |r, c| Mat::from_fn(r, c, |_, _| 1.0);
+    let a = Mat::from_fn(1, 1, |_, _| -1.0);
+    common::plant_of("feedthrough", [a, one(1, m1), one(1, m2), one(p1, 1), one(p2, 1), d11, d12, d21, d22])
 }
 
 /// Every Dk = Dk0 + Σ zᵢEᵢ solves D11 + D12·Dk·D21 = 0 to rounding, the Eᵢ are orthonormal and

@@ -81,10 +81,29 @@ fn name_and_dims_may_be_left_out() {
     assert!(Plant::from_json_str(&with_dims, "t.json").is_err());
 }
 
+/// What a bad plant file is expected to give: (what is wrong, the file's text, the error kind,
+/// a phrase of the message).
+type BadCase = (&'static str, String, fn(&PlantErrorKind) -> bool, &'static str);
+
+/// Each case's text is refused with its own error kind and a message naming the file and `msg`.
+fn assert_each_refused(cases: Vec<BadCase>) {
+    for (what, text, check, msg) in cases {
+        let e = Plant::from_json_str(&text, "bad/plant.json").expect_err(what);
+        assert!(check(&e.kind), "{what}: unexpected error kind {:?}", e.kind);
+        let shown = e.to_string();
+        assert!(shown.starts_with("plant file bad/plant.json: "), "{what}: {shown}");
+        assert!(shown.contains(msg), "{what}: `{shown}` should mention `{msg}`");
+    }
+}
+
+/// Whether `k` is a non-number at entry (1, 2) of `matrix`.
+fn not_a_number_at_1_2(k: &PlantErrorKind, matrix: &str) -> bool {
+    matches!(k, PlantErrorKind::Matrix { matrix: m, problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. }, .. } if *m == matrix)
+}
+
 #[test]
 fn bad_plant_files_each_get_their_own_error() {
-    type Check = fn(&PlantErrorKind) -> bool;
-    let cases: Vec<(&str, String, Check, &str)> = vec![
+    let cases: Vec<BadCase> = vec![
         (
             "malformed JSON",
             "{\"name\": \"T\", ".to_string(),
@@ -108,6 +127,29 @@ fn bad_plant_files_each_get_their_own_error() {
             |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "dims.q"),
             "unknown key",
         ),
+        (
+            "order disagrees with dims",
+            with(|o| {
+                o.insert("order".into(), json!(3));
+            }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "order"),
+            "dims.n is 2",
+        ),
+        (
+            "name not a string",
+            with(|o| {
+                o["name"] = json!(7);
+            }),
+            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "name"),
+            "non-empty string",
+        ),
+    ];
+    assert_each_refused(cases);
+}
+
+#[test]
+fn bad_matrices_each_get_their_own_error() {
+    let cases: Vec<BadCase> = vec![
         (
             "missing matrix",
             with(|o| {
@@ -151,16 +193,7 @@ fn bad_plant_files_each_get_their_own_error() {
             with(|o| {
                 o["A"] = json!([[-1.0, "NaN"], [0.0, -2.0]]);
             }),
-            |k| {
-                matches!(
-                    k,
-                    PlantErrorKind::Matrix {
-                        matrix: "A",
-                        problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. },
-                        ..
-                    }
-                )
-            },
+            |k| not_a_number_at_1_2(k, "A"),
             "entry (1, 2)",
         ),
         (
@@ -168,16 +201,7 @@ fn bad_plant_files_each_get_their_own_error() {
             with(|o| {
                 o["C1"] = json!([[1.0, null]]);
             }),
-            |k| {
-                matches!(
-                    k,
-                    PlantErrorKind::Matrix {
-                        matrix: "C1",
-                        problem: MatrixJsonError::NotNumber { row: 1, col: 2, .. },
-                        ..
-                    }
-                )
-            },
+            |k| not_a_number_at_1_2(k, "C1"),
             "not a number",
         ),
         (
@@ -196,30 +220,8 @@ fn bad_plant_files_each_get_their_own_error() {
             |k| matches!(k, PlantErrorKind::Matrix { matrix: "D11", problem: MatrixJsonError::NotArray { .. }, .. }),
             "array of rows",
         ),
-        (
-            "order disagrees with dims",
-            with(|o| {
-                o.insert("order".into(), json!(3));
-            }),
-            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "order"),
-            "dims.n is 2",
-        ),
-        (
-            "name not a string",
-            with(|o| {
-                o["name"] = json!(7);
-            }),
-            |k| matches!(k, PlantErrorKind::BadField { field, .. } if field == "name"),
-            "non-empty string",
-        ),
     ];
-    for (what, text, check, msg) in cases {
-        let e = Plant::from_json_str(&text, "bad/plant.json").expect_err(what);
-        assert!(check(&e.kind), "{what}: unexpected error kind {:?}", e.kind);
-        let shown = e.to_string();
-        assert!(shown.starts_with("plant file bad/plant.json: "), "{what}: {shown}");
-        assert!(shown.contains(msg), "{what}: `{shown}` should mention `{msg}`");
-    }
+    assert_each_refused(cases);
 }
 
 #[test]

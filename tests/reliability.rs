@@ -22,10 +22,7 @@ const BIN: &str = env!("CARGO_BIN_EXE_campaign");
 const PLANTS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/plants");
 
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hinfix-rel-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("rel", tag)
 }
 
 fn cli(args: &[&str]) -> Command {
@@ -39,6 +36,14 @@ fn fake_cli(args: &[&str], pause_ms: &str) -> Command {
     let mut c = Command::new(common::fake_campaign_bin());
     c.args(args).env("HINFIX_PLANTS", PLANTS).env(FAKE_RUNNER_ENV, pause_ms);
     c
+}
+
+/// `campaign run F --results DIR/r --no-progress EXTRA…` with the fake runner pausing `pause_ms`.
+fn fake_run(f: &Path, dir: &Path, extra: &[&str], pause_ms: &str) -> Command {
+    let results = dir.join("r");
+    let mut args = vec!["run", f.to_str().unwrap(), "--results", results.to_str().unwrap(), "--no-progress"];
+    args.extend_from_slice(extra);
+    fake_cli(&args, pause_ms)
 }
 
 /// `campaign design --plant PLANT --order ORDER EXTRA… --out OUT`.
@@ -282,10 +287,7 @@ fn campaign_check_calls_design_validate_before_any_job() {
     let dir = scratch("validate");
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [9]\n").unwrap();
-    let (code, _, err) = output(&mut fake_cli(
-        &["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"],
-        "1",
-    ));
+    let (code, _, err) = output(&mut fake_run(&f, &dir, &[], "1"));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("c.toml:4:10") && err.contains("order"), "{err}");
     assert!(!dir.join("r/t/runs.jsonl").exists());
@@ -367,14 +369,7 @@ fn slow_campaign(dir: &Path) -> PathBuf {
 
 fn spawn_slow(dir: &Path) -> std::process::Child {
     let f = slow_campaign(dir);
-    fake_cli(
-        &["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress", "--threads", "2"],
-        "100",
-    )
-    .stdout(Stdio::piped())
-    .stderr(Stdio::piped())
-    .spawn()
-    .unwrap()
+    fake_run(&f, dir, &["--threads", "2"], "100").stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap()
 }
 
 fn signal(child: &std::process::Child, sig: i32) {
@@ -423,12 +418,7 @@ fn second_ctrl_c_stops_at_once() {
     // flight to reach their next check, then prints its summary. The second Ctrl-C must end the
     // process at once, without that summary: which of the two happened is read from stderr, so
     // the test does not depend on how fast the machine is.
-    let child =
-        fake_cli(&["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"], "60000")
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+    let child = fake_run(&f, &dir, &[], "60000").stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
     wait_started(&dir);
     signal(&child, libc::SIGINT);
     std::thread::sleep(Duration::from_millis(100));
@@ -452,10 +442,7 @@ fn hostile_names_reach_no_output_raw() {
     std::fs::write(dir.join("evil.json"), doc.to_string()).unwrap();
     let f = dir.join("c.toml");
     std::fs::write(&f, "name = \"t\"\n[[problem]]\nplant = \"evil.json\"\norders = [1]\n").unwrap();
-    let (code, out, err) = output(&mut fake_cli(
-        &["run", f.to_str().unwrap(), "--results", dir.join("r").to_str().unwrap(), "--no-progress"],
-        "1",
-    ));
+    let (code, out, err) = output(&mut fake_run(&f, &dir, &[], "1"));
     assert_eq!(code, Some(0), "{err}");
     for (what, s) in [("stdout", out.as_str()), ("stderr", err.as_str())] {
         assert!(!s.contains('\u{1b}') && !s.contains('\u{0}'), "{what}: {s:?}");

@@ -13,11 +13,10 @@ use serde_json::{json, Value};
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
 const PLANTS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/plants");
 
+mod common;
+
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hinfix-rel4-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("rel4", tag)
 }
 
 /// Runs the CLI: (exit code, stdout, stderr), and no panic whatever the input.

@@ -294,3 +294,37 @@ pub fn he1_with_feedthrough() -> hinfix::lti::Plant {
     p.name = "HE1-D11".into();
     p
 }
+
+/// An empty scratch folder `hinfix-<test>-<tag>-<pid>` in the system's temporary folder (what
+/// was there removed first).
+pub fn scratch(test: &str, tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("hinfix-{test}-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A continuous-time plant named `name` of the matrices A, B1, B2, C1, C2, D11, D12, D21, D22
+/// (the dimensions read off them), with no description, citation or check.
+pub fn plant_of(name: &str, [a, b1, b2, c1, c2, d11, d12, d21, d22]: [faer::Mat<f64>; 9]) -> hinfix::lti::Plant {
+    let (n, m1, m2, p1, p2) = (a.nrows(), b1.ncols(), b2.ncols(), c1.nrows(), c2.nrows());
+    hinfix::lti::Plant {
+        name: name.into(),
+        description: String::new(),
+        citation: String::new(),
+        source: serde_json::Value::Null,
+        notes: String::new(),
+        check: None,
+        dims: hinfix::lti::Dims { n, m1, m2, p1, p2 },
+        domain: Default::default(),
+        a,
+        b1,
+        b2,
+        c1,
+        c2,
+        d11,
+        d12,
+        d21,
+        d22,
+    }
+}

@@ -280,11 +280,17 @@ mod tests {
         ClaimOwner::this_process(Path::new("runs.jsonl"))
     }
 
-    #[test]
-    fn a_claim_is_exclusive_until_released_and_listed_meanwhile() {
+    /// A claim folder in a fresh temporary folder (kept while the guard lives), and a job id of
+    /// the hex digits `hex` repeated.
+    fn claim_dir(hex: &str) -> (tempfile::TempDir, ClaimDir, JobId) {
         let dir = tempfile::tempdir().unwrap();
         let claims = ClaimDir::new(dir.path());
-        let id = JobId("ab".repeat(32));
+        (dir, claims, JobId(hex.repeat(32)))
+    }
+
+    #[test]
+    fn a_claim_is_exclusive_until_released_and_listed_meanwhile() {
+        let (_dir, claims, id) = claim_dir("ab");
         let TryClaim::Claimed(g) = claims.try_claim(&id, 10.0, &owner()).unwrap() else { panic!("free claim refused") };
         // A second claimant (another open file description, as another process would have).
         assert!(matches!(claims.try_claim(&id, 10.0, &owner()).unwrap(), TryClaim::Busy));
@@ -299,9 +305,7 @@ mod tests {
 
     #[test]
     fn a_dropped_lock_leaves_a_stale_file_that_can_be_claimed() {
-        let dir = tempfile::tempdir().unwrap();
-        let claims = ClaimDir::new(dir.path());
-        let id = JobId("cd".repeat(32));
+        let (_dir, claims, id) = claim_dir("cd");
         let TryClaim::Claimed(g) = claims.try_claim(&id, 10.0, &owner()).unwrap() else { panic!() };
         drop(g); // as a killed process: lock gone, file left
         let list = claims.list().unwrap();
@@ -311,9 +315,7 @@ mod tests {
 
     #[test]
     fn only_an_overdue_claim_of_another_host_is_broken() {
-        let dir = tempfile::tempdir().unwrap();
-        let claims = ClaimDir::new(dir.path());
-        let id = JobId("ef".repeat(32));
+        let (_dir, claims, id) = claim_dir("ef");
         let old = unix_now() - overdue_after(10.0) - 1.0;
         for (host, since, broken) in
             [("elsewhere", old, true), ("elsewhere", unix_now(), false), (owner().host.as_str(), old, false)]

@@ -58,6 +58,14 @@ fn label_key(name: &str) -> String {
     crate::campaign::leaves::sanitise::as_key(name, |c| c.is_ascii_alphanumeric(), '-', 64)
 }
 
+/// The opening of a table float: `\begin{table}`, its caption, its label `tab:hinfix-<label>`,
+/// and a booktabs `tabular` of columns `cols` with the header row `head`.
+fn table_start(caption: &str, label: &str, cols: &str, head: &str) -> String {
+    format!(
+        "\\begin{{table}}[!htbp]\n\\centering\n\\caption{{{caption}}}\n\\label{{tab:hinfix-{label}}}\n\\begin{{tabular}}{{{cols}}}\n\\toprule\n{head} \\\\\n\\midrule\n"
+    )
+}
+
 /// `tables.tex`, in the layout of the paper's tables: one `table` per plant with a caption and a
 /// `\label{tab:hinfix-<plant>}`; first the full-order bound (computed here, or the paper's value
 /// marked †, with whether the paper's full-order controller is stable), then per n_K from the
@@ -111,14 +119,12 @@ pub fn tables_tex_about(
 /// g_j and closed-loop stability measure for the row's best controller
 /// (`tab:hinfix-<problem>-plants`).
 pub fn plants_table(p: &str, rows: &[&BestRow]) -> String {
-    let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
-    let _ = writeln!(
-        s,
-        "\\caption{{{}: one controller for several plants. Per order $n_K$ and objective, each plant's objective $g_j$ (hinf: $\\|T_{{zw}}\\|_\\infty$, h2: $\\|T_{{zw}}\\|_2$, abscissa: $\\alpha(A_{{cl}})$, radius: $1/r_C$), weight $w_j$, bound $b_j$, value $g_j$ recomputed from the best re-verified controller, and its closed loop's stability measure; $\\gamma$ is the largest $w_j g_j$ of the plants without a bound.}}",
+    let caption = format!(
+        "{}: one controller for several plants. Per order $n_K$ and objective, each plant's objective $g_j$ (hinf: $\\|T_{{zw}}\\|_\\infty$, h2: $\\|T_{{zw}}\\|_2$, abscissa: $\\alpha(A_{{cl}})$, radius: $1/r_C$), weight $w_j$, bound $b_j$, value $g_j$ recomputed from the best re-verified controller, and its closed loop's stability measure; $\\gamma$ is the largest $w_j g_j$ of the plants without a bound.",
         escape(p)
     );
-    let _ = writeln!(s, "\\label{{tab:hinfix-{}-plants}}", label_key(p));
-    s.push_str("\\begin{tabular}{rllllrrr}\n\\toprule\n$n_K$ & objective & plant & $g_j$ & $w_j$ & $b_j$ & value & stability \\\\\n\\midrule\n");
+    let head = "$n_K$ & objective & plant & $g_j$ & $w_j$ & $b_j$ & value & stability";
+    let mut s = table_start(&caption, &format!("{}-plants", label_key(p)), "rllllrrr", head);
     let mut sorted = rows.to_vec();
     sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
     for r in sorted {
@@ -164,18 +170,13 @@ fn paper_table(p: &str, fp: &str, best: &[BestRow], f: Option<&FullOrderRow>, re
         };
         let dagger = f.is_some_and(|f| f.from_paper);
         let paper_full = refs(RefMethod::FullOrder).next();
-        let _ = writeln!(s, "\\begin{{table}}[!htbp]\n\\centering");
-        let _ = writeln!(
-            s,
-            "\\caption{{{}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified stable controller of each order $n_K$ (hinfix), against the HIFOO results of Gumussoy, Millstone \\& Overton (2008).}}",
+        let caption = format!(
+            "{}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified stable controller of each order $n_K$ (hinfix), against the HIFOO results of Gumussoy, Millstone \\& Overton (2008).",
             escape(p)
         );
-        let _ = writeln!(s, "\\label{{tab:hinfix-{}}}", label_key(p));
         let (cols, head) = if has_lit { ("lrrrl", " & literature") } else { ("lrrr", "") };
-        let _ = writeln!(
-            s,
-            "\\begin{{tabular}}{{{cols}}}\n\\toprule\n$n_K$ & ours & paper (HIFOO) & ours/paper{head} \\\\\n\\midrule"
-        );
+        let head = format!("$n_K$ & ours & paper (HIFOO) & ours/paper{head}");
+        s.push_str(&table_start(&caption, &label_key(p), cols, &head));
         if let Some(f) = f {
             let stab = match paper_full {
                 Some(r) if r.controller_stable => ", stable $K$",
@@ -275,16 +276,14 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
             ("spectral radius $\\rho(A_K)$", format!(" (discrete time, $T_s = {}$~s)", crate::numeric::readable(ts)))
         }
     };
-    let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
-    let _ = writeln!(
-        s,
-        "\\caption{{{}{domain}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and {radius}, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.}}",
+    let caption = format!(
+        "{}{domain}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and {radius}, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.",
         escape(p),
         about_text(about)
     );
-    let _ = writeln!(s, "\\label{{tab:hinfix-{}}}", label_key(p));
     let column = if ts.is_some() { "$\\rho(A_K)$" } else { "$\\alpha(A_K)$" };
-    let _ = writeln!(s, "\\begin{{tabular}}{{rlrrrrrr}}\n\\toprule\n$n_K$ & objective & $\\gamma$ & $\\varepsilon$ & seed & $\\|K\\|_\\infty$ & {column} & CPU s \\\\\n\\midrule");
+    let head = format!("$n_K$ & objective & $\\gamma$ & $\\varepsilon$ & seed & $\\|K\\|_\\infty$ & {column} & CPU s");
+    let mut s = table_start(&caption, &label_key(p), "rlrrrrrr", &head);
     // The full-order row holds only its number; what it is goes in a note under the table (a
     // multicolumn row with the text made the table 116–132 pt wider than the page).
     if let Some(f) = f {
@@ -335,14 +334,12 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
 /// objective and whether its controller is stable, γ of the strong one and their ratio (the
 /// comparison of the paper's tables).
 pub fn cost_table(p: &str, rows: &[&CostRow]) -> String {
-    let mut s = String::from("\\begin{table}[!htbp]\n\\centering\n");
-    let _ = writeln!(
-        s,
-        "\\caption{{{}: the cost of strong stabilisation. Per order $n_K$, the best re-verified $\\gamma$ without a stability requirement on $K$ (plain) and whether that $K$ is stable, the best with a stable $K$ (strong), and their ratio.}}",
+    let caption = format!(
+        "{}: the cost of strong stabilisation. Per order $n_K$, the best re-verified $\\gamma$ without a stability requirement on $K$ (plain) and whether that $K$ is stable, the best with a stable $K$ (strong), and their ratio.",
         escape(p)
     );
-    let _ = writeln!(s, "\\label{{tab:hinfix-{}-strong-vs-plain}}", label_key(p));
-    s.push_str("\\begin{tabular}{rrlrr}\n\\toprule\n$n_K$ & $\\gamma$ plain & $K$ & $\\gamma$ strong & strong/plain \\\\\n\\midrule\n");
+    let head = "$n_K$ & $\\gamma$ plain & $K$ & $\\gamma$ strong & strong/plain";
+    let mut s = table_start(&caption, &format!("{}-strong-vs-plain", label_key(p)), "rrlrr", head);
     let mut sorted = rows.to_vec();
     sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
     for r in sorted {

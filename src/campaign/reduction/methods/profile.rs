@@ -6,7 +6,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::campaign::reduction::plot::render::{log_ticks, msg, tick, DrawError, Figure, FONT_FAMILY};
+use crate::campaign::reduction::plot::render::{log_ticks, msg, styled_mesh, DrawError, Figure, FONT_FAMILY};
 
 /// One performance-profile figure.
 #[derive(Debug, Clone, PartialEq)]
@@ -83,15 +83,7 @@ impl Figure for ProfileFigure {
             .y_label_area_size(84)
             .build_cartesian_2d((1.0..tau_max).log_scale().with_key_points(ticks), 0.0..1.04)
             .map_err(msg)?;
-        chart
-            .configure_mesh()
-            .x_desc(&self.x_desc)
-            .y_desc("fraction of entries ρ(τ)")
-            .x_label_formatter(&|v| tick(*v))
-            .y_label_formatter(&|v| tick(*v))
-            .max_light_lines(2)
-            .label_style((FONT_FAMILY, 22))
-            .axis_desc_style((FONT_FAMILY, 24))
+        styled_mesh(chart.configure_mesh().x_desc(&self.x_desc).y_desc("fraction of entries ρ(τ)"), 22)
             .draw()
             .map_err(msg)?;
         for (i, (label, ratios)) in self.methods.iter().enumerate() {

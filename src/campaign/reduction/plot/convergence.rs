@@ -17,7 +17,9 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{colour, draw_legend, msg, padded_range, spans_decades, tick, DrawError, Figure, FONT_FAMILY};
+use super::render::{
+    colour, draw_legend, msg, padded_range, spans_decades, styled_mesh, tick, DrawError, Figure, FONT_FAMILY,
+};
 use crate::campaign::execution::trace::TraceIteration;
 
 /// Name of the stabilisation phase in traces.
@@ -176,17 +178,7 @@ impl ConvergenceFigure {
             (false, _) => "iteration (no CPU time in the trace)",
         };
         let y_desc = if stab { "max(α(A_cl), ε·α(A_K))" } else { "objective max(‖T_zw‖∞, ε‖K‖∞)" };
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .y_label_formatter(&|v| tick(*v))
-            .x_label_formatter(&|v| tick(*v))
-            .max_light_lines(2)
-            .label_style((FONT_FAMILY, 15))
-            .axis_desc_style((FONT_FAMILY, 17))
-            .draw()
-            .map_err(msg)?;
+        styled_mesh(chart.configure_mesh().x_desc(x_desc).y_desc(y_desc), 15).draw().map_err(msg)?;
         let (ylo, yhi) = {
             let r = chart.plotting_area().get_y_range();
             (r.start, r.end)

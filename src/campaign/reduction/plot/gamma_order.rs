@@ -9,7 +9,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::render::{
-    colour, draw_legend, log_ticks, msg, padded_range, spans_decades, tick, DrawError, Figure, FONT_FAMILY,
+    colour, draw_legend, log_ticks, msg, padded_range, spans_decades, styled_mesh, tick, DrawError, Figure, FONT_FAMILY,
 };
 
 /// Data of one γ-vs-order figure.
@@ -56,10 +56,8 @@ impl GammaOrderFigure {
             .y_label_area_size(90)
             .build_cartesian_2d(x, y)
             .map_err(msg)?;
-        chart
-            .configure_mesh()
-            .x_desc("controller order n_K")
-            .y_desc("γ = ‖T_zw‖∞")
+        let mut mesh = chart.configure_mesh();
+        styled_mesh(mesh.x_desc("controller order n_K").y_desc("γ = ‖T_zw‖∞"), 16)
             .x_labels(kmax - kmin + 3)
             .x_label_formatter(&|v| {
                 if (v - v.round()).abs() < 1e-9 && *v >= 0.0 {
@@ -68,10 +66,6 @@ impl GammaOrderFigure {
                     String::new()
                 }
             })
-            .y_label_formatter(&|v| tick(*v))
-            .max_light_lines(2)
-            .label_style((FONT_FAMILY, 16))
-            .axis_desc_style((FONT_FAMILY, 18))
             .draw()
             .map_err(msg)?;
         if let Some((g, from_paper)) = self.full_order {

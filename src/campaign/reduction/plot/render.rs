@@ -160,6 +160,29 @@ pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     })
 }
 
+/// The mesh of a figure in the figures' style: tick labels of both axes by [`tick`], at most two
+/// light lines between ticks, tick labels at `size` and axis descriptions at `size + 2`.
+pub fn styled_mesh<'m, 'a, 'b, X, Y, DB>(
+    mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
+    size: u32,
+) -> &'m mut MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+    DB: DrawingBackend,
+{
+    mesh.x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
+        .max_light_lines(2)
+        .label_style((FONT_FAMILY, size))
+        .axis_desc_style((FONT_FAMILY, size + 2))
+}
+
+/// [`tick`] of a label's value.
+fn tick_label(x: &f64) -> String {
+    tick(*x)
+}
+
 /// A tick or value label: at most 4 significant figures, trailing zeros dropped (`0.5`, `1.25`,
 /// `0.0003512`), scientific outside 10⁻³ … 10⁵ (`1.0e-6`).
 pub fn tick(x: f64) -> String {

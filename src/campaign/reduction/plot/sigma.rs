@@ -131,18 +131,18 @@ impl Figure for SigmaFigure {
             .draw()
             .map_err(msg)?;
         let at = if self.ts.is_some() { "e^(iωTs)" } else { "iω" };
-        let cl_style = colour::OURS.stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(for_screen(Self::positive(&self.closed_loop), (w0, w1), (lo, hi)), cl_style))
-            .map_err(msg)?
-            .label(format!("σ_max(T_zw({at})), closed loop"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], cl_style));
-        let k_style = colour::CONTROLLER.stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(for_screen(Self::positive(&self.controller), (w0, w1), (lo, hi)), k_style))
-            .map_err(msg)?
-            .label(format!("σ_max(K({at})), controller"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], k_style));
+        let curves = [
+            (&self.closed_loop, colour::OURS, format!("σ_max(T_zw({at})), closed loop")),
+            (&self.controller, colour::CONTROLLER, format!("σ_max(K({at})), controller")),
+        ];
+        for (curve, colour, label) in curves {
+            let style = colour.stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(for_screen(Self::positive(curve), (w0, w1), (lo, hi)), style))
+                .map_err(msg)?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+        }
         if let Some(p) = self.peak_point() {
             let (g, w) = self.peak;
             let at = if w.is_infinite() {
