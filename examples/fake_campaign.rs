@@ -1,5 +1,5 @@
 //! Test-only: the `campaign` command line with the deterministic fake runner
-//! (`hinfix::campaign::fake`) in place of the design, for the machinery tests (tests/campaign_runner.rs,
+//! (`hinfix::campaign::FakeRunner`) in place of the design, for the machinery tests (tests/campaign_runner.rs,
 //! campaign_shared.rs, reliability.rs), which find it next to their own executable
 //! (tests/common/mod.rs, `fake_campaign_bin`). It needs the `test-support` feature, which the
 //! crate's dev-dependency on itself turns on: `cargo test` builds it; `cargo build` and

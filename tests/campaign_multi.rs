@@ -158,16 +158,12 @@ fn single_plant_ids_are_unchanged() {
 #[test]
 fn a_two_plant_run_journals_each_plants_value() {
     let dir = scratch("run");
-    let file = dir.join("c.toml");
-    std::fs::write(
-        &file,
-        format!(
-            "name = \"two\"\n[defaults]\nseeds = 1\ncpumax = 60.0\nmaxevals = 2000\n[[problem]]\n\
-             plants = [\"{ROOT}/plants/HE1.json\", \"{ROOT}/examples/multi-model/HE1_op3.json\"]\n\
-             weights = [1.0, 2.0]\norders = [1]\n"
-        ),
-    )
-    .unwrap();
+    let text = format!(
+        "name = \"two\"\n[defaults]\nseeds = 1\ncpumax = 60.0\nmaxevals = 2000\n[[problem]]\n\
+         plants = [\"{ROOT}/plants/HE1.json\", \"{ROOT}/examples/multi-model/HE1_op3.json\"]\n\
+         weights = [1.0, 2.0]\norders = [1]\n"
+    );
+    let file = common::campaign_file(&dir, &text);
     let out = Command::new(env!("CARGO_BIN_EXE_campaign"))
         .args(["run", file.to_str().unwrap(), "--results", dir.to_str().unwrap(), "--no-progress", "--trace", "off"])
         .output()

@@ -329,13 +329,9 @@ fn sparse_trace_is_small_and_still_summarises_and_plots() {
 #[test]
 fn maxevals_campaign_is_identical_at_one_and_two_threads() {
     let dir = scratch("threads");
-    let file = dir.join("c.toml");
-    std::fs::write(
-        &file,
-        "name = \"t\"\n[defaults]\neps = [1e-2, 1e-3]\nseeds = 1\ncpumax = 1000.0\nmaxevals = 1200\n\
-         [[problem]]\nplant = \"REA2\"\norders = [1, 2]\n",
-    )
-    .unwrap();
+    let text = "name = \"t\"\n[defaults]\neps = [1e-2, 1e-3]\nseeds = 1\ncpumax = 1000.0\nmaxevals = 1200\n\
+                [[problem]]\nplant = \"REA2\"\norders = [1, 2]\n";
+    let file = common::campaign_file(&dir, text);
     let mut journals = Vec::new();
     for threads in ["1", "2"] {
         let results = dir.join(format!("r{threads}"));

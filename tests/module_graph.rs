@@ -178,42 +178,57 @@ fn layers_import_only_downwards() {
     }
 }
 
+/// Rank of the part holding `module` among `parts` (bottom up) of `layer`: that of its folder
+/// (`kernels::spectral` → `kernels`); the modules `shared` by all parts rank lowest.
+fn part_rank(layer: &str, parts: &[&str], shared: &[&str], module: &str) -> usize {
+    let part = module.split("::").next().unwrap();
+    if shared.contains(&part) {
+        return 0;
+    }
+    parts
+        .iter()
+        .position(|p| *p == part)
+        .unwrap_or_else(|| panic!("src/{layer}/{module}: in no part of {layer}; add its folder to the parts"))
+}
+
+/// Every module of `layer` imports only its own part and those below it (`parts`, bottom up;
+/// `shared` modules below all), but for the one edge `exception`; every part is found.
+fn assert_parts_import_only_downwards(layer: &str, parts: &[&str], shared: &[&str], exception: (&str, &str)) {
+    let g = graph(layer);
+    for part in parts.iter().filter(|p| !shared.contains(p)) {
+        assert!(g.keys().any(|m| m.split("::").next() == Some(part)), "src/{layer}/{part}: not found");
+    }
+    let rank = |m: &str| part_rank(layer, parts, shared, m);
+    for (m, edges) in &g {
+        for t in edges {
+            if (m.as_str(), t.as_str()) == exception {
+                continue;
+            }
+            assert!(
+                rank(t) <= rank(m) || m.split("::").next() == t.split("::").next(),
+                "src/{layer}/{m} imports {layer}::{t}, a part above its own (order: {parts:?})"
+            );
+        }
+    }
+}
+
 /// The parts of `lti`, bottom up (docs/ARCHITECTURE.md §1): a module may import its own part
 /// and the parts below it, never one above. `error` and `interrupt` are shared by all parts and
 /// import none; `kernel_bench` (bench scaffolding behind the `test-support` feature) sits on top.
 const LTI_PARTS: &[&str] = &["error", "interrupt", "io", "system", "kernels", "norms", "synthesis", "kernel_bench"];
 
-/// Rank of the part holding an lti module (`kernels::spectral` → that of `kernels`).
+/// The modules of `lti` shared by all its parts.
+const LTI_SHARED: &[&str] = &["error", "interrupt"];
+
 fn lti_rank(module: &str) -> usize {
-    let part = module.split("::").next().unwrap();
-    match part {
-        "error" | "interrupt" => 0,
-        _ => LTI_PARTS
-            .iter()
-            .position(|p| *p == part)
-            .unwrap_or_else(|| panic!("src/lti/{module}: in no part of lti; add its folder to LTI_PARTS")),
-    }
+    part_rank("lti", LTI_PARTS, LTI_SHARED, module)
 }
 
 #[test]
 fn lti_parts_import_only_downwards() {
-    let g = graph("lti");
-    for part in &LTI_PARTS[2..] {
-        assert!(g.keys().any(|m| m.split("::").next() == Some(part)), "src/lti/{part}: not found");
-    }
-    for (m, edges) in &g {
-        for t in edges {
-            // The one exception: the H∞ norm's recording hook for `benches/lti.rs --record`,
-            // compiled only with the `test-support` feature.
-            if m == "norms::hinf" && t == "kernel_bench" {
-                continue;
-            }
-            assert!(
-                lti_rank(t) <= lti_rank(m) || m.split("::").next() == t.split("::").next(),
-                "src/lti/{m} imports lti::{t}, a part above its own (order: {LTI_PARTS:?})"
-            );
-        }
-    }
+    // The one exception: the H∞ norm's recording hook for `benches/lti.rs --record`, compiled
+    // only with the `test-support` feature.
+    assert_parts_import_only_downwards("lti", LTI_PARTS, LTI_SHARED, ("norms::hinf", "kernel_bench"));
 }
 
 #[test]
@@ -228,36 +243,16 @@ fn the_lti_part_order_is_checked() {
 /// import its own part and the parts below it, never one above.
 const CAMPAIGN_PARTS: &[&str] = &["leaves", "model", "records", "execution", "reduction"];
 
-/// Rank of the part holding a campaign module (`reduction::plot::render` → that of `reduction`).
 fn campaign_rank(module: &str) -> usize {
-    let part = module.split("::").next().unwrap();
-    CAMPAIGN_PARTS
-        .iter()
-        .position(|p| *p == part)
-        .unwrap_or_else(|| panic!("src/campaign/{module}: in no part of campaign; add its folder to CAMPAIGN_PARTS"))
+    part_rank("campaign", CAMPAIGN_PARTS, &[], module)
 }
 
 #[test]
 fn campaign_parts_import_only_downwards() {
-    let g = graph("campaign");
-    for part in CAMPAIGN_PARTS {
-        assert!(g.keys().any(|m| m.split("::").next() == Some(part)), "src/campaign/{part}: not found");
-    }
-    for (m, edges) in &g {
-        for t in edges {
-            // The one exception: order chaining (execution/chain.rs) judges a finished job's
-            // controller as the report verifies it (reduction/reduce.rs). Open debt: the one
-            // evaluation of the design layer moves verification below execution, and this
-            // exception goes.
-            if m == "execution::chain" && t == "reduction::reduce" {
-                continue;
-            }
-            assert!(
-                campaign_rank(t) <= campaign_rank(m),
-                "src/campaign/{m} imports campaign::{t}, a part above its own (order: {CAMPAIGN_PARTS:?})"
-            );
-        }
-    }
+    // The one exception: order chaining (execution/chain.rs) judges a finished job's controller
+    // as the report verifies it (reduction/reduce.rs). Open debt: the one evaluation of the
+    // design layer moves verification below execution, and this exception goes.
+    assert_parts_import_only_downwards("campaign", CAMPAIGN_PARTS, &[], ("execution::chain", "reduction::reduce"));
 }
 
 #[test]

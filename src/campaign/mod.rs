@@ -64,8 +64,8 @@ pub use reduction::compare::{
     FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 pub use reduction::export::{
-    BestCsv, CompareCsv, CompareTex, Exporter, HtmlPage, PlantsCsv, ReportData, StrongVsPlainCsv, TablesTex, HTML_PAGE,
-    TABLES,
+    BestCsv, CompareCsv, CompareTex, CsvFile, Exporter, HtmlPage, PlantsCsv, ReportData, StrongVsPlainCsv, TablesTex,
+    HTML_PAGE, TABLES,
 };
 pub use reduction::html::report_html;
 pub use reduction::latex::{campaign_table, compare_tex, cost_table, sig4, sig_figs, tables_tex, tables_tex_about};

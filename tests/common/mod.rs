@@ -328,3 +328,10 @@ pub fn plant_of(name: &str, [a, b1, b2, c1, c2, d11, d12, d21, d22]: [faer::Mat<
         d22,
     }
 }
+
+/// Writes the campaign file `dir/c.toml` with `text`; returns its path.
+pub fn campaign_file(dir: &Path, text: &str) -> std::path::PathBuf {
+    let file = dir.join("c.toml");
+    std::fs::write(&file, text).unwrap();
+    file
+}

@@ -66,6 +66,13 @@ fn table_start(caption: &str, label: &str, cols: &str, head: &str) -> String {
     )
 }
 
+/// `rows` by order, highest first (a stable sort: rows of one order keep their order).
+fn highest_order_first<'a, R>(rows: &[&'a R], order: impl Fn(&R) -> usize) -> Vec<&'a R> {
+    let mut sorted = rows.to_vec();
+    sorted.sort_by_key(|r| std::cmp::Reverse(order(*r)));
+    sorted
+}
+
 /// `tables.tex`, in the layout of the paper's tables: one `table` per plant with a caption and a
 /// `\label{tab:hinfix-<plant>}`; first the full-order bound (computed here, or the paper's value
 /// marked †, with whether the paper's full-order controller is stable), then per n_K from the
@@ -125,9 +132,7 @@ pub fn plants_table(p: &str, rows: &[&BestRow]) -> String {
     );
     let head = "$n_K$ & objective & plant & $g_j$ & $w_j$ & $b_j$ & value & stability";
     let mut s = table_start(&caption, &format!("{}-plants", label_key(p)), "rllllrrr", head);
-    let mut sorted = rows.to_vec();
-    sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
-    for r in sorted {
+    for r in highest_order_first(rows, |r| r.order) {
         for v in &r.plants {
             let bound = v.bound.map_or_else(|| "--".to_string(), sig4);
             let _ = writeln!(
@@ -334,15 +339,14 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
 /// objective and whether its controller is stable, γ of the strong one and their ratio (the
 /// comparison of the paper's tables).
 pub fn cost_table(p: &str, rows: &[&CostRow]) -> String {
+    let rows = highest_order_first(rows, |r| r.order);
     let caption = format!(
         "{}: the cost of strong stabilisation. Per order $n_K$, the best re-verified $\\gamma$ without a stability requirement on $K$ (plain) and whether that $K$ is stable, the best with a stable $K$ (strong), and their ratio.",
         escape(p)
     );
     let head = "$n_K$ & $\\gamma$ plain & $K$ & $\\gamma$ strong & strong/plain";
     let mut s = table_start(&caption, &format!("{}-strong-vs-plain", label_key(p)), "rrlrr", head);
-    let mut sorted = rows.to_vec();
-    sorted.sort_by_key(|r| std::cmp::Reverse(r.order));
-    for r in sorted {
+    for r in rows {
         let k = match r.plain_controller_stable {
             Some(true) => "stable",
             Some(false) => "unstable",

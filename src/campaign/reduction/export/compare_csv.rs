@@ -1,48 +1,52 @@
 //! `compare.csv`: ours against the paper, one row per (plant, order, objective), with the
 //! literature's values and the full-order bound.
 
-use super::{csv_bytes, csv_num, Exporter, ReportData};
+use super::{csv_num, CsvFile, ReportData};
 use crate::campaign::leaves::sanitise::for_csv;
+use crate::campaign::reduction::compare::CompareRow;
 
 /// `compare.csv`.
 pub struct CompareCsv;
 
+/// One row.
 #[derive(serde::Serialize)]
-struct Row {
+pub struct Row {
+    /// The plant (problem) name.
     plant: String,
+    /// The controller order.
     order: usize,
+    /// Our best verified γ.
     ours: String,
+    /// The paper's γ.
     paper: String,
+    /// Earlier literature's values, `source=γ` joined by `; `.
     literature: String,
+    /// The full-order bound.
     full_order: String,
+    /// ours/paper.
     ratio: String,
+    /// The design objective (`strong` or `plain`).
     objective: &'static str,
 }
 
-impl Exporter for CompareCsv {
-    fn file(&self) -> &'static str {
-        "compare.csv"
-    }
+impl CsvFile for CompareCsv {
+    const FILE: &'static str = "compare.csv";
+    type Row = Row;
 
-    fn export(&self, data: &ReportData) -> Result<Option<Vec<u8>>, csv::Error> {
-        let rows = data.compare.iter().map(|r| Row {
-            plant: for_csv(&r.plant),
-            order: r.order,
-            ours: csv_num(r.ours),
-            paper: csv_num(r.paper),
-            literature: for_csv(&r.literature.iter().map(|(s, g)| format!("{s}={g}")).collect::<Vec<_>>().join("; ")),
-            full_order: csv_num(r.full_order),
-            ratio: csv_num(r.ratio),
-            objective: r.objective.name(),
-        });
-        csv_bytes(rows).map(Some)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn snapshot() {
-        super::super::fixture::assert_snapshot(&super::CompareCsv);
+    fn rows(data: &ReportData) -> Vec<Row> {
+        let literature = |r: &CompareRow| r.literature.iter().map(|(s, g)| format!("{s}={g}")).collect::<Vec<_>>();
+        data.compare
+            .iter()
+            .map(|r| Row {
+                plant: for_csv(&r.plant),
+                order: r.order,
+                ours: csv_num(r.ours),
+                paper: csv_num(r.paper),
+                literature: for_csv(&literature(r).join("; ")),
+                full_order: csv_num(r.full_order),
+                ratio: csv_num(r.ratio),
+                objective: r.objective.name(),
+            })
+            .collect()
     }
 }

@@ -15,11 +15,3 @@ impl Exporter for CompareTex {
         Ok(Some(compare_tex(&data.compare).into_bytes()))
     }
 }
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn snapshot() {
-        super::super::fixture::assert_snapshot(&super::CompareTex);
-    }
-}

@@ -16,11 +16,3 @@ impl Exporter for HtmlPage {
         Ok(Some(report_html(data.dir, &data.best, &data.compare, data.records).into_bytes()))
     }
 }
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn snapshot() {
-        super::super::fixture::assert_snapshot(&super::HtmlPage);
-    }
-}

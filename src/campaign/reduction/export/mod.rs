@@ -5,8 +5,9 @@
 //! report ([`ReportData`]); `super::report` writes what they return, atomically.
 //!
 //! A new output format is one file here: a unit struct implementing [`Exporter`] (its file name
-//! and its bytes), listed in [`TABLES`], with a snapshot test against the fixture journal
-//! `tests/fixtures/report/runs.jsonl` (expected output in `tests/fixtures/report/expected/`).
+//! and its bytes; a CSV file implements [`CsvFile`], its rows), listed in [`TABLES`], and one line
+//! in the snapshot tests below: its output for the fixture journal
+//! `tests/fixtures/report/runs.jsonl` is committed as `tests/fixtures/report/expected/<file>.snap`.
 
 mod best_csv;
 mod compare_csv;
@@ -79,6 +80,38 @@ pub trait Exporter {
     fn export(&self, data: &ReportData) -> Result<Option<Vec<u8>>, csv::Error>;
 }
 
+/// A CSV report file: its rows under a header (no bytes at all for no rows). Every `CsvFile` is
+/// an [`Exporter`].
+pub trait CsvFile {
+    /// The file, relative to the campaign's results folder.
+    const FILE: &'static str;
+    /// Whether the file is written (empty) when it has no rows.
+    const WRITTEN_EMPTY: bool = true;
+    /// One row.
+    type Row: serde::Serialize;
+
+    /// The rows, in file order.
+    fn rows(data: &ReportData) -> Vec<Self::Row>;
+}
+
+impl<T: CsvFile> Exporter for T {
+    fn file(&self) -> &'static str {
+        T::FILE
+    }
+
+    fn export(&self, data: &ReportData) -> Result<Option<Vec<u8>>, csv::Error> {
+        let rows = T::rows(data);
+        if rows.is_empty() && !T::WRITTEN_EMPTY {
+            return Ok(None);
+        }
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for r in rows {
+            w.serialize(r)?;
+        }
+        w.into_inner().map(Some).map_err(|e| e.into_error().into())
+    }
+}
+
 /// The tables, in the order they are written.
 pub const TABLES: [&(dyn Exporter + Sync); 6] =
     [&BestCsv, &TablesTex, &StrongVsPlainCsv, &PlantsCsv, &CompareCsv, &CompareTex];
@@ -86,28 +119,19 @@ pub const TABLES: [&(dyn Exporter + Sync); 6] =
 /// The HTML page.
 pub const HTML_PAGE: &(dyn Exporter + Sync) = &HtmlPage;
 
-/// `rows` as CSV with a header (no bytes at all for no rows).
-fn csv_bytes<R: serde::Serialize>(rows: impl IntoIterator<Item = R>) -> Result<Vec<u8>, csv::Error> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for r in rows {
-        w.serialize(r)?;
-    }
-    w.into_inner().map_err(|e| e.into_error().into())
-}
-
 /// A number cell: non-finite values as "inf", "-inf", "nan", as in best.csv and every JSON file
 /// (builds before left the cell empty).
 fn csv_num(x: f64) -> String {
     crate::design::f64_text(x)
 }
 
-/// The report of the fixture campaign `tests/fixtures/report/report.toml` and the expected
-/// output of each exporter, for the snapshot tests.
+/// Each exporter against the fixture campaign `tests/fixtures/report/report.toml`: its output
+/// for the journal `runs.jsonl` is `expected/<file name>.snap` byte for byte.
 #[cfg(test)]
-mod fixture {
+mod snapshots {
     use std::path::{Path, PathBuf};
 
-    use super::{Exporter, ReportData};
+    use super::*;
     use crate::campaign::leaves::reference::load_default_reference;
     use crate::campaign::records::journal::read_journal;
     use crate::campaign::reduction::report::{plant_map, problem_map};
@@ -117,16 +141,37 @@ mod fixture {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report")
     }
 
-    /// Asserts that `exporter` turns the fixture journal into `expected/<its file name>`.
-    pub fn assert_snapshot(exporter: &dyn Exporter) {
+    fn assert_snapshot(exporter: &dyn Exporter) {
         let dir = dir();
         let campaign = Campaign::load(&dir.join("report.toml")).unwrap();
         let records = read_journal(&dir.join("runs.jsonl")).unwrap().records;
         let reference = load_default_reference().unwrap();
         let data = ReportData::reduce(&dir, &records, &plant_map(&campaign), &problem_map(&campaign), &reference);
-        let name = Path::new(exporter.file()).file_name().unwrap();
-        let want = std::fs::read_to_string(dir.join("expected").join(name)).unwrap();
+        let name = Path::new(exporter.file()).file_name().unwrap().to_string_lossy();
+        let want = std::fs::read_to_string(dir.join("expected").join(format!("{name}.snap"))).unwrap();
         let got = String::from_utf8(exporter.export(&data).unwrap().unwrap_or_default()).unwrap();
         assert_eq!(got, want, "{}", exporter.file());
     }
+
+    /// One test per exporter, named after its file.
+    macro_rules! snapshot_tests {
+        ($($test:ident: $exporter:expr),* $(,)?) => {
+            $(
+                #[test]
+                fn $test() {
+                    assert_snapshot(&$exporter);
+                }
+            )*
+        };
+    }
+
+    snapshot_tests!(
+        best_csv: BestCsv,
+        tables_tex: TablesTex,
+        strong_vs_plain_csv: StrongVsPlainCsv,
+        plants_csv: PlantsCsv,
+        compare_csv: CompareCsv,
+        compare_tex: CompareTex,
+        html_page: HtmlPage,
+    );
 }

@@ -1,7 +1,7 @@
 //! `plants.csv`: one row per plant of each best controller of a problem of several plants (or
 //! of another objective, weight or bound); written only when the campaign has such a problem.
 
-use super::{csv_bytes, csv_num, Exporter, ReportData};
+use super::{csv_num, CsvFile, ReportData};
 use crate::campaign::leaves::sanitise::for_csv;
 
 /// `plants.csv`.
@@ -10,17 +10,20 @@ pub struct PlantsCsv;
 /// One row: a plant of a problem, with its recomputed value for the best controller of the
 /// problem's (problem, order, objective) row of best.csv.
 #[derive(serde::Serialize)]
-struct Row {
+pub struct Row {
     /// The problem's name (best.csv's `plant`).
     problem: String,
+    /// The controller order.
     order: usize,
     /// The design objective (`strong` or `plain`), as best.csv's `objective`.
     objective: &'static str,
+    /// The job of the best controller.
     job_id: String,
     /// The plant's name.
     plant: String,
     /// Its objective: hinf, h2, abscissa or radius.
     plant_objective: &'static str,
+    /// Its weight w_j.
     weight: String,
     /// Its bound, or "none".
     bound: String,
@@ -34,14 +37,13 @@ struct Row {
     alpha_cl: String,
 }
 
-impl Exporter for PlantsCsv {
-    fn file(&self) -> &'static str {
-        "plants.csv"
-    }
+impl CsvFile for PlantsCsv {
+    const FILE: &'static str = "plants.csv";
+    const WRITTEN_EMPTY: bool = false;
+    type Row = Row;
 
-    fn export(&self, data: &ReportData) -> Result<Option<Vec<u8>>, csv::Error> {
-        let rows: Vec<Row> = data
-            .best
+    fn rows(data: &ReportData) -> Vec<Row> {
+        data.best
             .iter()
             .flat_map(|b| b.plants.iter().map(move |v| (b, v)))
             .map(|(b, v)| Row {
@@ -58,18 +60,6 @@ impl Exporter for PlantsCsv {
                 bound_met: v.bound_met(),
                 alpha_cl: csv_num(v.alpha_cl),
             })
-            .collect();
-        if rows.is_empty() {
-            return Ok(None);
-        }
-        csv_bytes(rows).map(Some)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn snapshot() {
-        super::super::fixture::assert_snapshot(&super::PlantsCsv);
+            .collect()
     }
 }

@@ -16,11 +16,3 @@ impl Exporter for TablesTex {
         Ok(Some(tables_tex_about(&data.best, &data.full, data.reference, &data.about).into_bytes()))
     }
 }
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn snapshot() {
-        super::super::fixture::assert_snapshot(&super::TablesTex);
-    }
-}
