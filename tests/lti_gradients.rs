@@ -367,9 +367,9 @@ fn ill_posed_loop_is_an_error() {
 
 #[test]
 fn shape_mismatch_is_an_error() {
+    // a plant of two controls against a controller of one output
     let mut rng = ChaCha8Rng::seed_from_u64(4);
-    let plant = random_plant(&mut rng, 3, 1, 2, 1, 1, false);
-    let k = random_controller(&mut rng, 1, 1, 1);
+    let (plant, k) = (random_plant(&mut rng, 3, 1, 2, 1, 1, false), random_controller(&mut rng, 1, 1, 1));
     assert!(matches!(closed_loop(&plant, &k), Err(LtiError::Shape { .. })));
 }
 
