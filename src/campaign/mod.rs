@@ -4,7 +4,7 @@
 //! The pieces are separate, nextest style (docs/ARCHITECTURE.md §2): [`execute`] runs jobs and
 //! emits [`CampaignEvent`]s without printing or writing anything; the journal ([`run_jobs`],
 //! [`JournalWriter`]), the trace writer ([`TraceWriter`]), the progress reporter and the report
-//! writers ([`write_reports`]) each consume what they need.
+//! files (one [`Exporter`] each, written by [`write_reports`]) each consume what they need.
 //!
 //! The modules are in five parts, one folder each, from the bottom up (a part imports only its
 //! own and those below it, `tests/module_graph.rs`; docs/ARCHITECTURE.md §1):
