@@ -13,8 +13,8 @@ use faer::Mat;
 use hinfix::design::{ComponentCache, MIN_ORDER_FOR_INTERRUPT};
 use hinfix::design::{ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase, SearchStop};
 use hinfix::lti::{
-    closed_loop, closed_loop_hinf_grad, hinf_norm, Controller, Dims, HinfParams, Interrupt, Interrupted, LtiError,
-    Plant, StateSpace, DEFAULT_HINF_TOL,
+    closed_loop, closed_loop_hinf_grad, hinf_norm, Controller, HinfParams, Interrupt, Interrupted, LtiError, Plant,
+    StateSpace, DEFAULT_HINF_TOL,
 };
 use hinfix::optim::{bfgs, BfgsOptions, NoObserver, Objective, OptimError, RunControl, Termination};
 use rand::{Rng, SeedableRng};

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 
 use faer::{c64, Mat};
 use hinfix::lti::{
-    full_order_gamma_discrete, full_order_gamma_with, hinf_norm_discrete, spectral_radius, Dims, FullOrderOptions,
+    full_order_gamma_discrete, full_order_gamma_with, hinf_norm_discrete, spectral_radius, FullOrderOptions,
     HinfParams, Plant, StateSpace, TimeDomain, DEFAULT_HINF_TOL,
 };
 use rand::{Rng, SeedableRng};

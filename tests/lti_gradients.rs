@@ -10,7 +10,7 @@ use hinfix::lti::{
     controller_abscissa_grad, controller_hinf_grad, controller_hinf_grad_discrete, controller_radius_grad,
     h2_feedthrough_parameterisation, h2_norm, h2_norm_discrete, h2_norm_grad, h2_norm_grad_discrete, hinf_norm,
     hinf_norm_discrete, hinf_norm_grad_discrete, inverse_stability_radius, spectral_abscissa, spectral_radius,
-    Controller, Dims, HinfParams, LtiError, Plant, StateSpace,
+    Controller, HinfParams, LtiError, Plant, StateSpace,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use faer::{c64, Mat};
 use hinfix::lti::{
     closed_loop, closed_loop_h2_grad, closed_loop_inverse_stability_radius_grad, h2_feedthrough_parameterisation,
-    h2_norm, h2_norm_discrete, h2_norm_grad, inverse_stability_radius, Controller, Dims, FeedthroughError, HinfParams,
+    h2_norm, h2_norm_discrete, h2_norm_grad, inverse_stability_radius, Controller, FeedthroughError, HinfParams,
     LtiError, Plant, StateSpace, H2_FEEDTHROUGH_RTOL,
 };
 use rand::{Rng, SeedableRng};
