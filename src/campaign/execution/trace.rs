@@ -371,7 +371,7 @@ impl JobObserver for TraceWriter {
 
 /// The observer factory for `scheduler::execute`: one [`TraceWriter`] per job in `traces_dir`,
 /// at the trace level of the job's problem (`levels`, indexed like the campaign's problems:
-/// [`super::Campaign::trace_levels`]; a problem beyond it gets the default); none at level
+/// [`crate::campaign::Campaign::trace_levels`]; a problem beyond it gets the default); none at level
 /// `off`.
 pub fn trace_observers(
     traces_dir: &Path,
