@@ -9,9 +9,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_discrete, hinf_norm_with_poles, is_stable,
-    is_stable_with_margin, stability_measure, stability_measure_of, verified_stability_measure, Controller, HinfParams,
-    Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
+    closed_loop, continuous_time_image, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_in, is_stable,
+    stability_measure, stability_measure_of, verified_stability, Controller, HinfParams, Interrupt, Plant, TimeDomain,
+    NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
 
@@ -357,41 +357,11 @@ fn fixed_design(
     outcome(problem, k, fig, plants, opts, ended, phases, cpu, search)
 }
 
-/// Whether `k` stabilises every plant of `problem` as `opts` asks, with the verification margin
-/// (`lti::is_stable_with_margin`, the test of `campaign check`, `design --out` and `campaign
-/// report`): every closed loop stable and, with the strong objective, the controller too. `Err`
-/// holds the largest of the closed-loop measures and ε·α(A_K) (strong), as
-/// [`DesignStatus::NotStabilised`] reports it.
-pub fn stabilises(problem: &Problem, opts: &DesignOptions, k: &Controller) -> Result<(), f64> {
-    let mut worst = f64::NEG_INFINITY;
-    let mut stable = true;
-    for t in &problem.terms {
-        match closed_loop(&t.plant, k) {
-            Ok(cl) => {
-                let s = verified_stability_measure(t.plant.domain, cl.a.as_ref());
-                worst = nan_max(worst, s);
-                stable &= is_stable_with_margin(s, cl.a.as_ref());
-            }
-            Err(_) => (worst, stable) = (f64::INFINITY, false),
-        }
-    }
-    if opts.objective == ObjectiveKind::Strong && k.order() > 0 {
-        let s = verified_stability_measure(k.domain, k.ak.as_ref());
-        worst = nan_max(worst, opts.eps * s);
-        stable &= is_stable_with_margin(s, k.ak.as_ref());
-    }
-    if stable {
-        Ok(())
-    } else {
-        Err(worst)
-    }
-}
-
 /// The status the returned controller itself supports. The search calls a point stable once
 /// its measure is below 0, so it can end on the boundary (the abscissa objective under strong
 /// stabilisation ended at α ≈ −4e-12 and was journaled "stopped" while `design` refused to write
 /// the controller): a controller that is not stable with the verification margin
-/// ([`stabilises`]) is [`DesignStatus::NotStabilised`] whatever the search said, and a
+/// ([`stabilises`](super::stabilises)) is [`DesignStatus::NotStabilised`] whatever the search said, and a
 /// stabilising one that violates a plant's bound is [`DesignStatus::BoundViolated`]. Interrupted
 /// and not-stabilised runs keep their status.
 fn verified_status(
@@ -404,7 +374,7 @@ fn verified_status(
     if matches!(status, DesignStatus::Interrupted | DesignStatus::NotStabilised { .. }) {
         return status;
     }
-    match stabilises(problem, opts, k) {
+    match super::evaluate::stabilises(problem, opts, k) {
         Err(best_alpha) => DesignStatus::NotStabilised { best_alpha },
         Ok(()) if plants.iter().any(|v| !v.bound_met()) => DesignStatus::BoundViolated,
         Ok(()) => status,
@@ -441,11 +411,11 @@ fn fixed_ak_stable(
     }
     let Some(ak) = s.entries()[..nk * nk].iter().copied().collect::<Option<Vec<f64>>>() else { return Ok(()) };
     let ak = faer::Mat::from_fn(nk, nk, |i, j| ak[i + j * nk]);
-    let measure = verified_stability_measure(domain, ak.as_ref());
-    if is_stable_with_margin(measure, ak.as_ref()) {
+    let verified = verified_stability(domain, ak.as_ref());
+    if verified.is_stable() {
         return Ok(());
     }
-    let (name, value) = domain.stability_quantity(measure);
+    let (name, value) = domain.stability_quantity(verified.measure);
     Err(opt_err(
         "structure",
         format!(
@@ -467,11 +437,7 @@ pub fn strongly_stabilisable(plant: &Plant, opts: &DesignOptions) -> Result<(), 
     // A discrete-time plant is strongly stabilisable iff its bilinear image is (stable
     // controllers and stabilising ones correspond, `lti::PlantImage`); the violation then names
     // the image's zeros and poles.
-    let image = match plant.domain {
-        TimeDomain::Continuous => None,
-        TimeDomain::Discrete { .. } => crate::lti::PlantImage::new(plant).ok().map(|i| i.plant),
-    };
-    match crate::lti::parity_interlacing(image.as_ref().unwrap_or(plant)).and_then(|p| p.violation) {
+    match crate::lti::parity_interlacing(&continuous_time_image(plant)).and_then(|p| p.violation) {
         Some(v) => Err(DesignError::NotStronglyStabilisable(v)),
         None => Ok(()),
     }
@@ -563,11 +529,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
                 let a = stability_measure_of(plant.domain, &poles);
                 let g = if is_stable(a) && cl.is_finite() {
                     let params = HinfParams::new(opts.hinf_tol).with_stop(stop);
-                    let norm = match plant.domain {
-                        TimeDomain::Continuous => hinf_norm_with_poles(&cl, &poles, &params),
-                        TimeDomain::Discrete { .. } => hinf_norm_discrete(&cl, &params),
-                    };
-                    norm.map_or(f64::NAN, |h| h.value)
+                    hinf_norm_with_poles_in(plant.domain, &cl, &poles, &params).map_or(f64::NAN, |h| h.value)
                 } else {
                     f64::INFINITY
                 };
