@@ -3,7 +3,7 @@
 //! journal, traces and progress display are consumers.
 //!
 //! * The job runner is injected ([`JobRunner`]): production passes [`design_job`]
-//!   (`design::run`), tests pass fast fakes.
+//!   (`design::Design`), tests pass fast fakes.
 //! * Per-job observers (the trace writer) are made by an injected [`ObserverFactory`] on the
 //!   worker that runs the job.
 //! * Warm-start chains: a job whose `warm_from` predecessor has not finished is not started; its
@@ -12,7 +12,7 @@
 //!   finished (here, in the journals or elsewhere); its chained start is the controller of the
 //!   best of them (`campaign::chain`), re-verified once per job on the calling thread.
 //! * Cancellation: when `cancel` becomes true (first Ctrl-C, or a failing callback), nothing new
-//!   is scheduled and every in-flight job's observer returns `Break`, so `design::run` stops with
+//!   is scheduled and every in-flight job's observer returns `Break`, so `design::Design::run` stops with
 //!   status `Interrupted`; such jobs produce [`CampaignEvent::JobInterrupted`] and no record, so a
 //!   resumed run reruns them.
 //! * Workers send events over one `std::sync::mpsc` channel; the calling thread owns the callback.
@@ -205,7 +205,7 @@ pub struct RunStats {
     pub already_done: usize,
     /// Finished in this run (journaled), failures included.
     pub finished: usize,
-    /// Of those, failed (`design::run` error or panic).
+    /// Of those, failed (`design::Design::run` error or panic).
     pub failed: usize,
     /// Finished meanwhile by other processes (found in their journals).
     pub done_elsewhere: usize,

@@ -15,7 +15,7 @@
 //! and a cancel flag ([`Design::cancel`], default the observer's
 //! [`DesignObserver::cancel_flag`]). [`Design::run`] makes the run's budget (`optim::RunControl`)
 //! from `opts.cpumax`, `opts.maxevals` and the cancel flag — the only place it is made — and runs
-//! the design (`design::run`, docs/ALGORITHMS.md §8).
+//! the design (`design/run.rs`, docs/ALGORITHMS.md §8).
 
 use std::borrow::Cow;
 use std::sync::atomic::AtomicBool;

@@ -129,7 +129,7 @@ pub(super) fn design(
     let cancelled = || ctl.cancelled();
     let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
     let (fig, plants) =
-        evaluate(plant, multi, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+        outcome_figures(plant, multi, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
     Ok(outcome(problem, k, fig, plants, opts, ended, res.phases, ctl.cpu_elapsed(), res.summary))
 }
 
@@ -236,9 +236,12 @@ fn how_it_ended(
     (final_x, (status, certificate))
 }
 
-/// The figures of `k` on the first plant ([`figures`]), or the problem's with each plant's value
-/// for a problem of several plants (`multi`).
-fn evaluate(
+/// The outcome's figures of `k` on the first plant ([`figures`]), or the problem's with each
+/// plant's value for a problem of several plants (`multi`). These are the optimiser's figures (its
+/// stability measure, the norms to the run's `hinf_tol`, abandoned on a cancel): what the
+/// controller is judged by after the run is [`design::evaluate`](super::evaluate)'s verification
+/// ([`verified_status`]).
+fn outcome_figures(
     plant: &Plant,
     multi: Option<&Problem>,
     opts: &DesignOptions,
@@ -332,7 +335,7 @@ fn fixed_design(
         None => k,
     };
     let multi = (!problem.is_single_hinf()).then_some(problem);
-    let (fig, plants) = evaluate(plant, multi, opts, &k, Interrupt::NEVER);
+    let (fig, plants) = outcome_figures(plant, multi, opts, &k, Interrupt::NEVER);
     let strong = opts.objective == ObjectiveKind::Strong;
     let alpha = match fig.alpha_k {
         Some(a) if strong => nan_max(fig.alpha_cl, opts.eps * a),
