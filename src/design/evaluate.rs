@@ -151,7 +151,7 @@ fn plant_prefix(plant: &Option<String>) -> String {
 /// (`lti::verified_stability`, the test of [`evaluate`], `design --out` and `campaign
 /// report`): every closed loop stable and, with the strong objective, the controller too. `Err`
 /// holds the largest of the closed-loop measures and ε·α(A_K) (strong), as
-/// [`DesignStatus::NotStabilised`] reports it.
+/// [`DesignStatus::NotStabilised`](super::DesignStatus::NotStabilised) reports it.
 pub fn stabilises(problem: &Problem, opts: &DesignOptions, k: &Controller) -> Result<(), f64> {
     let mut worst = f64::NEG_INFINITY;
     let mut stable = true;

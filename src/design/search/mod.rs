@@ -341,16 +341,16 @@ impl Search<'_, '_, '_> {
         {
             rounds.ran |= self.gs_incumbent(&mut st, full_ctl)?;
         }
-        Ok(self.result(st, &first[0], plan, stop, truncated, rounds.ran))
+        Ok(self.result(st, first, plan, stop, truncated, rounds.ran))
     }
 
     /// What the search produced, once it has ended with `stop` after `plan`'s local searches:
-    /// the best points (the f_s one defaults to the first start, `first`), the phases' counters
+    /// the best points (the f_s one defaults to the first of the first starts, `first`), the phases' counters
     /// (gradient sampling's if it ran, `gs_ran`, or refined near-misses) and the summary.
     fn result(
         &mut self,
         st: State<'_>,
-        first: &[f64],
+        first: &[Vec<f64>],
         plan: StartPlan,
         stop: SearchStop,
         truncated: bool,
@@ -366,12 +366,12 @@ impl Search<'_, '_, '_> {
             phases.push(s2);
         }
         let stab = st.stab.unwrap_or_else(|| Best {
-            x: first.to_vec(),
+            x: first[0].clone(),
             f: f64::INFINITY,
             dnorm: f64::NAN,
             evaldist: f64::NAN,
             start: 0,
-            from: first.to_vec(),
+            from: first[0].clone(),
             coords: Coords::Raw,
         });
         let best_start = st.perf.as_ref().map_or(stab.start, |b| b.start);
