@@ -20,7 +20,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
-use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver};
+use hinfix::design::{Design, DesignOptions, DesignOutcome, DesignStatus};
 use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, HinfParams, Plant};
 
 struct Args {
@@ -133,7 +133,7 @@ fn main() {
             'search: for &eps in &a.eps {
                 for seed in 0..a.seeds {
                     let opts = DesignOptions { order: r.order, eps, seed, cpumax: a.cpumax, ..Default::default() };
-                    let o = run(&p, &opts, None, &mut NoDesignObserver).expect("valid options");
+                    let o = Design::for_plant(&p, &opts).run().expect("valid options");
                     runs += 1;
                     cpu += o.design_cpu_s;
                     evals += o.evaluations;
@@ -215,7 +215,7 @@ fn main() {
                 .map(|r| r.gamma);
             for seed in 0..a.seeds.min(1) {
                 let opts = DesignOptions { order, eps: 1e-3, seed, cpumax: a.large_cpumax, ..Default::default() };
-                let o = run(&p, &opts, None, &mut NoDesignObserver).expect("valid options");
+                let o = Design::for_plant(&p, &opts).run().expect("valid options");
                 let status = match &o.status {
                     DesignStatus::NotStabilised { .. } => "not_stabilised".to_string(),
                     s => format!("{s:?}").to_lowercase(),

@@ -47,9 +47,7 @@ use std::rc::Rc;
 use faer::linalg::solvers::DenseSolveCore;
 use faer::Mat;
 use hinfix::design::ComponentCache;
-use hinfix::design::{
-    controller_to_x, run, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase,
-};
+use hinfix::design::{controller_to_x, ControllerShape, Design, DesignObjective, DesignOptions, ObjectivePhase};
 use hinfix::lti::kernel_bench;
 use hinfix::lti::step_stats::{self, Step};
 use hinfix::lti::{
@@ -219,7 +217,7 @@ fn design_ratio(name: &str, nk: usize, cpumax: f64, steps: bool, record: Option<
     if record.is_some() {
         kernel_bench::record_norms();
     }
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let o = Design::for_plant(&p, &opts).run().unwrap_or_else(|e| panic!("{name}: {e}"));
     step_stats::set_timing(false);
     if let Some(path) = record {
         let norms = kernel_bench::take_recorded_norms();

@@ -11,8 +11,8 @@ use std::path::PathBuf;
 use std::rc::Rc;
 
 use hinfix::design::{
-    controller_to_x, run, ComponentCache, ControllerShape, DesignObjective, DesignOptions, NoDesignObserver,
-    ObjectivePhase, PlantObjective, PlantTerm, Problem,
+    controller_to_x, ComponentCache, ControllerShape, Design, DesignObjective, DesignOptions, ObjectivePhase,
+    PlantObjective, PlantTerm, Problem,
 };
 use hinfix::lti::{resolve_plant, Plant};
 use hinfix::optim::{thread_cpu_time, Objective};
@@ -62,7 +62,7 @@ fn main() {
     for (name, order, evals) in [("HE1", 2, 2000), ("AC8", 2, 300), ("REA2", 2, 2000)] {
         let p = shipped(name);
         let opts = DesignOptions { order, seed: 1, maxevals: Some(2000), ..Default::default() };
-        let k = run(&p, &opts, None, &mut NoDesignObserver).unwrap().controller;
+        let k = Design::for_plant(&p, &opts).run().unwrap().controller;
         let x = controller_to_x(&k);
         let shape = ControllerShape::for_plant(&p, order);
         let mk = |plant: &Plant, objective: PlantObjective| PlantTerm {
@@ -93,16 +93,7 @@ fn main() {
             .map(|p| PlantTerm { plant: p.clone(), objective: PlantObjective::Hinf, weight: 1.0, bound: None })
             .collect(),
     };
-    let k = hinfix::design::run_problem(
-        &three,
-        &opts,
-        None,
-        None,
-        &hinfix::optim::RunControl::new(f64::INFINITY),
-        &mut NoDesignObserver,
-    )
-    .unwrap()
-    .controller;
+    let k = Design::new(&three, &opts).run().unwrap().controller;
     let x = controller_to_x(&k);
     let shape = ControllerShape::for_plant(&ops[0], 1);
     let cache = || Rc::new(RefCell::new(ComponentCache::default()));

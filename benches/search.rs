@@ -44,7 +44,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use hinfix::campaign::{load_reference, RefMethod, REFERENCE_CSV};
-use hinfix::design::{run, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, VariableScaling};
+use hinfix::design::{Design, DesignOptions, DesignOutcome, DesignStatus, VariableScaling};
 use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, HinfParams, Plant};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -138,7 +138,7 @@ fn run_all(jobs: Vec<Job>, threads: usize) -> Vec<(Job, DesignOutcome)> {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(job) = jobs.get(i) else { break };
-                let o = run(&job.plant, &job.opts, None, &mut NoDesignObserver).expect("valid options");
+                let o = Design::for_plant(&job.plant, &job.opts).run().expect("valid options");
                 eprintln!(
                     "  [{:>3}/{n}] {:<28} γ {:>10.5}  {:>4} starts  best #{:<4} to best {:>6.1} s of {:>6.1} s  stop {}",
                     i + 1,

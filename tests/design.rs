@@ -4,9 +4,8 @@
 use std::ops::ControlFlow;
 
 use hinfix::design::{
-    controller_to_x, run, variable_scaling, ControllerShape, DesignError, DesignIterRecord, DesignObserver,
-    DesignOptions, DesignStatus, InitError, NoDesignObserver, ObjectiveKind, Phase, SearchStop, StartKind,
-    VariableScaling,
+    controller_to_x, variable_scaling, ControllerShape, Design, DesignError, DesignIterRecord, DesignObserver,
+    DesignOptions, DesignStatus, InitError, ObjectiveKind, Phase, SearchStop, StartKind, VariableScaling,
 };
 use hinfix::lti::{closed_loop, hinf_norm, spectral_abscissa, Controller, HinfParams, Plant};
 
@@ -35,7 +34,7 @@ fn check_recomputed(p: &Plant, o: &hinfix::design::DesignOutcome) {
 fn rea2_order1_reaches_the_published_gamma() {
     let p = plant("REA2");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, cpumax: 30.0, stall_starts: 0, ..Default::default() };
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts).run().unwrap();
     assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
     assert!(o.gamma <= 1.134 * 1.01, "γ = {}", o.gamma);
     check_recomputed(&p, &o);
@@ -46,7 +45,7 @@ fn rea2_order1_reaches_the_published_gamma() {
 fn he1_order1_reaches_the_published_gamma() {
     let p = plant("HE1");
     let opts = DesignOptions { order: 1, eps: 1e-4, seed: 1, cpumax: 30.0, stall_starts: 0, ..Default::default() };
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts).run().unwrap();
     assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
     assert!(o.gamma <= 0.1235 * 1.01, "γ = {}", o.gamma);
     check_recomputed(&p, &o);
@@ -84,7 +83,7 @@ fn non_stabilisable_plant_is_an_outcome_not_an_error() {
             max_starts: Some(9),
             ..Default::default()
         };
-        let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+        let o = Design::for_plant(&p, &opts).run().unwrap();
         assert_eq!((o.search.starts, o.search.stop), (9, SearchStop::Starts), "{:?}", o.search);
         match o.status {
             DesignStatus::NotStabilised { best_alpha } => {
@@ -103,17 +102,17 @@ fn non_stabilisable_plant_is_an_outcome_not_an_error() {
 fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
     let p = plant("HE1");
     let base = DesignOptions { order: 1, eps: 1e-3, seed: 2, cpumax: 30.0, stall_starts: 0, ..Default::default() };
-    let o1 = run(&p, &base, None, &mut NoDesignObserver).unwrap();
+    let o1 = Design::for_plant(&p, &base).run().unwrap();
     let k1 = controller(&o1);
     let opts2 = DesignOptions { order: 2, cpumax: 10.0, nrand: 2, ..base.clone() };
-    let o2 = run(&p, &opts2, Some(&k1), &mut NoDesignObserver).unwrap();
+    let o2 = Design::for_plant(&p, &opts2).init(Some(&k1)).run().unwrap();
     assert_eq!(controller(&o2).order(), 2);
     assert!(o2.objective <= o1.objective * (1.0 + 1e-9), "{} > {}", o2.objective, o1.objective);
     check_recomputed(&p, &o2);
     // With no budget at all beyond the first evaluation the padded start itself comes back
     // unchanged in value: padding keeps ‖Tzw‖∞ and ‖K‖∞.
     let opts_same = DesignOptions { order: 1, cpumax: 10.0, ..base };
-    let o_same = run(&p, &opts_same, Some(&k1), &mut NoDesignObserver).unwrap();
+    let o_same = Design::for_plant(&p, &opts_same).init(Some(&k1)).run().unwrap();
     assert!(o_same.objective <= o1.objective * (1.0 + 1e-9));
 }
 
@@ -131,14 +130,14 @@ fn same_seed_gives_the_same_controller_bits() {
         central_gammas: Vec::new(),
         ..Default::default()
     };
-    let a = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
-    let b = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let a = Design::for_plant(&p, &opts).run().unwrap();
+    let b = Design::for_plant(&p, &opts).run().unwrap();
     let bits = |o: &hinfix::design::DesignOutcome| {
         controller_to_x(&controller(o)).iter().map(|v| v.to_bits()).collect::<Vec<_>>()
     };
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.evaluations, b.evaluations);
-    let c = run(&p, &DesignOptions { seed: 3, ..opts }, None, &mut NoDesignObserver).unwrap();
+    let c = Design::for_plant(&p, &DesignOptions { seed: 3, ..opts }).run().unwrap();
     assert_ne!(bits(&a), bits(&c));
 }
 
@@ -162,7 +161,7 @@ fn observer_sees_components_and_break_interrupts() {
     let p = plant("REA2");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 0, cpumax: 30.0, stall_starts: 0, ..Default::default() };
     let mut obs = StopAfter { n: 40, seen: Vec::new() };
-    let o = run(&p, &opts, None, &mut obs).unwrap();
+    let o = Design::for_plant(&p, &opts).observe(&mut obs).run().unwrap();
     assert_eq!(o.status, DesignStatus::Interrupted);
     assert_eq!(obs.seen.len(), 40, "no records after Break");
     let opt: Vec<_> = obs.seen.iter().filter(|r| r.phase == Phase::Optimisation).collect();
@@ -200,21 +199,21 @@ fn bad_options_and_init_are_errors() {
         (DesignOptions { continued_maxit: hinfix::design::MAX_ITERATIONS + 1, ..ok.clone() }, "continued_maxit"),
     ];
     for (opts, field) in cases {
-        match run(&p, &opts, None, &mut NoDesignObserver) {
+        match Design::for_plant(&p, &opts).run() {
             Err(DesignError::Options { field: f, .. }) => assert_eq!(f, field),
             other => panic!("{field}: expected an options error, got {other:?}"),
         }
     }
     let wrong_shape = Controller::zeros(1, 1, 1); // HE1 has m2 = 2
-    let e = run(&p, &ok, Some(&wrong_shape), &mut NoDesignObserver).unwrap_err();
+    let e = Design::for_plant(&p, &ok).init(Some(&wrong_shape)).run().unwrap_err();
     assert!(matches!(e, DesignError::Init(InitError::Shape(_))), "{e:?}");
     assert_eq!(e.to_string(), "initial controller: does not fit plant HE1: DK is 1×1, the plant needs m2×p2 = 2×1");
     let too_big = Controller::zeros(2, 2, 1);
-    let e = run(&p, &ok, Some(&too_big), &mut NoDesignObserver).unwrap_err();
+    let e = Design::for_plant(&p, &ok).init(Some(&too_big)).run().unwrap_err();
     assert!(matches!(e, DesignError::Init(InitError::OrderTooHigh { order: 2, target: 1 })), "{e:?}");
     let mut nan = Controller::zeros(1, 2, 1);
     nan.dk[(0, 0)] = f64::NAN;
-    let e = run(&p, &ok, Some(&nan), &mut NoDesignObserver).unwrap_err();
+    let e = Design::for_plant(&p, &ok).init(Some(&nan)).run().unwrap_err();
     assert!(matches!(e, DesignError::Init(InitError::NonFinite)), "{e:?}");
     assert_eq!(e.to_string(), "initial controller: has a non-finite entry");
 }
@@ -223,7 +222,7 @@ fn bad_options_and_init_are_errors() {
 fn tiny_budget_is_honoured() {
     let p = plant("HE1");
     let opts = DesignOptions { order: 2, eps: 1e-3, seed: 0, cpumax: 0.05, ..Default::default() };
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts).run().unwrap();
     // one evaluation of HE1 takes well under 10 ms
     assert!(o.design_cpu_s < 0.05 + 0.1, "cpu {}", o.design_cpu_s);
     assert!(matches!(o.status, DesignStatus::BudgetExhausted | DesignStatus::NotStabilised { .. }), "{:?}", o.status);
@@ -240,7 +239,7 @@ fn bits(o: &hinfix::design::DesignOutcome) -> Vec<u64> {
 fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
     let p = plant("HE1");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 5, cpumax: 1e6, maxevals: Some(4000), ..Default::default() };
-    let alone = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let alone = Design::for_plant(&p, &opts).run().unwrap();
     assert_eq!(alone.search.stop, SearchStop::Maxevals, "{:?}", alone.search);
     assert!(alone.evaluations <= 4000 + 2, "{} evaluations", alone.evaluations);
     assert!(alone.search.starts > opts.nrand, "{:?}", alone.search);
@@ -258,7 +257,7 @@ fn maxevals_gives_the_same_controller_bits_at_one_and_two_threads_under_load() {
         })
         .collect();
     let both: Vec<_> = std::thread::scope(|s| {
-        let h: Vec<_> = (0..2).map(|_| s.spawn(|| run(&p, &opts, None, &mut NoDesignObserver).unwrap())).collect();
+        let h: Vec<_> = (0..2).map(|_| s.spawn(|| Design::for_plant(&p, &opts).run().unwrap())).collect();
         h.into_iter().map(|h| h.join().unwrap()).collect()
     });
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
@@ -283,9 +282,8 @@ fn unused_gradient_sampling_reserve_goes_back_to_the_search() {
     let p = plant("HE1");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 5, cpumax: 1e6, maxevals: Some(4000), ..Default::default() };
     assert!(opts.return_gs_reserve, "the default");
-    let kept =
-        run(&p, &DesignOptions { return_gs_reserve: false, ..opts.clone() }, None, &mut NoDesignObserver).unwrap();
-    let returned = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let kept = Design::for_plant(&p, &DesignOptions { return_gs_reserve: false, ..opts.clone() }).run().unwrap();
+    let returned = Design::for_plant(&p, &opts).run().unwrap();
     let gs_evals = |o: &hinfix::design::DesignOutcome| {
         o.phases.iter().filter(|s| s.phase == Phase::GradientSampling).map(|s| s.evals).sum::<usize>()
     };
@@ -325,8 +323,8 @@ fn default_search_is_never_worse_than_hifoos_search() {
             DesignOptions { order, eps: 1e-3, seed: 1, cpumax: 1e6, maxevals: Some(12_000), ..Default::default() };
         let hifoo_opts =
             DesignOptions { stall_starts: 0, central_gammas: Vec::new(), open_loop_start: false, ..base.clone() };
-        let hifoo = run(&p, &hifoo_opts, None, &mut NoDesignObserver).unwrap();
-        let default = run(&p, &base, None, &mut NoDesignObserver).unwrap();
+        let hifoo = Design::for_plant(&p, &hifoo_opts).run().unwrap();
+        let default = Design::for_plant(&p, &base).run().unwrap();
         assert_eq!(hifoo.search.stop, SearchStop::Starts, "{name} {order}: {:?}", hifoo.search);
         assert!(
             default.objective <= hifoo.objective,
@@ -349,9 +347,9 @@ fn continued_search_is_never_worse_than_the_first_starts_and_is_recorded() {
         DesignOptions { order: 2, eps: 1e-3, seed: 4, cpumax: 1e6, gradient_sampling: false, ..Default::default() };
     let hifoo_opts =
         DesignOptions { stall_starts: 0, central_gammas: Vec::new(), open_loop_start: false, ..base.clone() };
-    let hifoo = run(&p, &hifoo_opts, None, &mut NoDesignObserver).unwrap();
+    let hifoo = Design::for_plant(&p, &hifoo_opts).run().unwrap();
     assert_eq!((hifoo.search.starts, hifoo.search.stop), (3, SearchStop::Starts));
-    let more = run(&p, &DesignOptions { max_starts: Some(15), ..base }, None, &mut NoDesignObserver).unwrap();
+    let more = Design::for_plant(&p, &DesignOptions { max_starts: Some(15), ..base }).run().unwrap();
     assert_eq!((more.search.starts, more.search.stop), (15, SearchStop::Starts));
     assert!(more.objective <= hifoo.objective, "{} > {}", more.objective, hifoo.objective);
     check_recomputed(&p, &more);
@@ -371,7 +369,7 @@ fn continued_search_is_never_worse_than_the_first_starts_and_is_recorded() {
 fn ac10_order1_is_stabilised_from_a_cold_start() {
     let p = plant("AC10");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, cpumax: 1e6, maxevals: Some(3000), ..Default::default() };
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts).run().unwrap();
     assert!(!matches!(o.status, DesignStatus::NotStabilised { .. }), "{:?}", o.status);
     assert_eq!(o.search.stop, SearchStop::Maxevals, "{:?}", o.search);
     check_recomputed(&p, &o);
@@ -407,8 +405,7 @@ fn ac10_order1_default_search_with_scaled_cycles_gets_far_below_the_unscaled_one
     let base = DesignOptions { central_gammas: Vec::new(), ..ac10_order1_one_random_start(1500) };
     assert_eq!(base.variable_scaling, VariableScaling::Alternate, "the default");
     let gamma = |mode| {
-        let o =
-            run(&p, &DesignOptions { variable_scaling: mode, ..base.clone() }, None, &mut NoDesignObserver).unwrap();
+        let o = Design::for_plant(&p, &DesignOptions { variable_scaling: mode, ..base.clone() }).run().unwrap();
         assert_eq!(o.search.stop, SearchStop::Maxevals, "{mode:?}: {:?}", o.search);
         check_recomputed(&p, &o);
         (o.gamma, o.search.best_start_scaled)
@@ -429,7 +426,7 @@ fn variable_scaling_modes_are_bit_identical_on_a_plant_with_alike_channels() {
     assert!(variable_scaling(&p, ControllerShape::for_plant(&p, 1)).is_none());
     let base = DesignOptions { order: 1, eps: 1e-3, seed: 3, cpumax: 1e6, maxevals: Some(2000), ..Default::default() };
     let runs: Vec<_> = [VariableScaling::Off, VariableScaling::Alternate, VariableScaling::Always]
-        .map(|mode| run(&p, &DesignOptions { variable_scaling: mode, ..base.clone() }, None, &mut NoDesignObserver))
+        .map(|mode| Design::for_plant(&p, &DesignOptions { variable_scaling: mode, ..base.clone() }).run())
         .into_iter()
         .map(Result::unwrap)
         .collect();
@@ -462,14 +459,14 @@ fn bounded_run_spends_its_budget_and_the_stall_rule_ends_unbounded_runs() {
         ..Default::default()
     };
     let bounded = DesignOptions { max_starts: Some(20), ..base.clone() };
-    let spent = run(&p, &bounded, None, &mut NoDesignObserver).unwrap();
+    let spent = Design::for_plant(&p, &bounded).run().unwrap();
     assert_eq!((spent.search.starts, spent.search.stop), (20, SearchStop::Starts), "{:?}", spent.search);
-    let stalled = run(&p, &DesignOptions { spend_budget: false, ..bounded }, None, &mut NoDesignObserver).unwrap();
+    let stalled = Design::for_plant(&p, &DesignOptions { spend_budget: false, ..bounded }).run().unwrap();
     assert_eq!(stalled.search.stop, SearchStop::Stall, "{:?}", stalled.search);
     assert!(stalled.search.starts < 20, "{:?}", stalled.search);
     assert!(spent.objective <= stalled.objective, "{} > {}", spent.objective, stalled.objective);
     check_recomputed(&p, &spent);
-    let unbounded = run(&p, &base, None, &mut NoDesignObserver).unwrap();
+    let unbounded = Design::for_plant(&p, &base).run().unwrap();
     assert_eq!(unbounded.search.stop, SearchStop::Stall, "{:?}", unbounded.search);
     assert_eq!(bits(&unbounded), bits(&stalled), "the same path, ended by the same stall");
 }
@@ -486,7 +483,7 @@ fn ac10_central_start_in_scaled_variables_is_the_best_start() {
     let p = plant("AC10");
     let opts =
         DesignOptions { open_loop_start: false, central_gammas: vec![2.0], ..ac10_order1_one_random_start(5000) };
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts).run().unwrap();
     check_recomputed(&p, &o);
     let s = &o.search;
     assert_eq!((s.best_start, s.best_start_kind, s.best_start_scaled), (2, Some(StartKind::Central), true), "{s:?}");

@@ -7,14 +7,11 @@
 //! Runs in a few seconds in release (`cargo test --release --test design_property`).
 
 use faer::Mat;
-use hinfix::design::{
-    run_problem, DesignOptions, DesignStatus, NoDesignObserver, ObjectiveKind, PlantObjective, PlantTerm, Problem,
-};
+use hinfix::design::{Design, DesignOptions, DesignStatus, ObjectiveKind, PlantObjective, PlantTerm, Problem};
 use hinfix::lti::{
     h2_norm, h2_norm_discrete, hinf_norm_in, stability_margin, stability_measure, Controller, HinfParams, Plant,
     StateSpace, TimeDomain,
 };
-use hinfix::optim::RunControl;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
@@ -111,8 +108,7 @@ fn reported_values_and_stability_hold_on_the_explicit_closed_loop() {
             let problem =
                 Problem { terms: vec![PlantTerm { plant: plant.clone(), objective, weight: 1.0, bound: None }] };
             let what = format!("{objective:?}, discrete {discrete}, seed {seed}, strong {strong}");
-            let o = match run_problem(&problem, &opts, None, None, &RunControl::new(opts.cpumax), &mut NoDesignObserver)
-            {
+            let o = match Design::new(&problem, &opts).run() {
                 Ok(o) => o,
                 Err(e) => {
                     // refusals (an H2 objective the plant cannot have, a plant no stable

@@ -12,8 +12,8 @@ use std::path::PathBuf;
 use std::rc::Rc;
 
 use hinfix::design::{
-    central_starts, controller_to_x, run, ComponentCache, ControllerShape, DesignObjective, DesignOptions,
-    NoDesignObserver, ObjectivePhase,
+    central_starts, controller_to_x, ComponentCache, ControllerShape, Design, DesignObjective, DesignOptions,
+    ObjectivePhase,
 };
 use hinfix::lti::{
     closed_loop, controller_to_mat, full_order_gamma, hinf_norm, hinf_norm_discrete, plant_to_mat, resolve_plant,
@@ -96,7 +96,7 @@ fn discrete_design_objectives_have_exact_gradients() {
     let shape = ControllerShape::for_plant(&p, 2);
     // a stabilising, strongly stable controller early in a search (not at a nonsmooth optimum)
     let opts = DesignOptions { order: 2, seed: 4, maxevals: Some(300), ..Default::default() };
-    let k = run(&p, &opts, None, &mut NoDesignObserver).unwrap().controller;
+    let k = Design::for_plant(&p, &opts).run().unwrap().controller;
     let x0: Vec<f64> =
         controller_to_x(&k).iter().enumerate().map(|(i, v)| v * (1.0 + 1e-3 * (i as f64).sin())).collect();
     for (phase, strong, eps) in [
@@ -163,7 +163,7 @@ fn central_starts_of_a_discrete_plant_are_its_images_taken_back() {
 fn a_sampled_plant_is_designed_and_verified_in_discrete_time() {
     let p = example("HE1_Ts0.1.json");
     let opts = DesignOptions { order: 1, eps: 1e-3, seed: 1, maxevals: Some(20_000), ..Default::default() };
-    let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts).run().unwrap();
     let k = &o.controller;
     assert_eq!(k.domain, TimeDomain::Discrete { ts: 0.1 });
     let cl = closed_loop(&p, k).unwrap();

@@ -10,8 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use faer::Mat;
-use hinfix::design::{ComponentCache, MIN_ORDER_FOR_INTERRUPT};
-use hinfix::design::{ControllerShape, DesignObjective, DesignOptions, NoDesignObserver, ObjectivePhase, SearchStop};
+use hinfix::design::{ComponentCache, Design, MIN_ORDER_FOR_INTERRUPT};
+use hinfix::design::{ControllerShape, DesignObjective, DesignOptions, ObjectivePhase, SearchStop};
 use hinfix::lti::{
     closed_loop, closed_loop_hinf_grad, hinf_norm, Controller, HinfParams, Interrupt, Interrupted, LtiError, Plant,
     StateSpace, DEFAULT_HINF_TOL,
@@ -195,8 +195,7 @@ fn cancelled_design_reports_recomputed_figures_or_none() {
         let plant = random_plant(n, 6);
         let opts = DesignOptions { order: 0, nrand: 1, seed: 1, ..DesignOptions::default() };
         let flag = Arc::new(AtomicBool::new(true));
-        let ctl = RunControl::new(f64::INFINITY).with_cancel(flag);
-        let out = hinfix::design::run_with_control(&plant, &opts, None, &ctl, &mut NoDesignObserver).unwrap();
+        let out = Design::for_plant(&plant, &opts).cancel(flag).run().unwrap();
         assert_eq!(out.search.stop, SearchStop::Interrupted);
         let k = &out.controller;
         let cl = closed_loop(&plant, k).unwrap();

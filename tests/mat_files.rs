@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use hinfix::design::{run, DesignOptions, NoDesignObserver};
+use hinfix::design::{Design, DesignOptions};
 use hinfix::lti::{controller_to_mat, plant_to_mat, read_mat_vars};
 use hinfix::lti::{Controller, Plant};
 
@@ -59,8 +59,8 @@ fn same_plant_as_mat_and_json_gives_bit_identical_designs() {
         gradient_sampling: false,
         ..Default::default()
     };
-    let a = run(&json, &opts, None, &mut NoDesignObserver).unwrap();
-    let b = run(&mat, &opts, None, &mut NoDesignObserver).unwrap();
+    let a = Design::for_plant(&json, &opts).run().unwrap();
+    let b = Design::for_plant(&mat, &opts).run().unwrap();
     assert_eq!(a.controller, b.controller);
     assert_eq!(a.gamma.to_bits(), b.gamma.to_bits());
     assert_eq!((a.iterations, a.evaluations), (b.iterations, b.evaluations));

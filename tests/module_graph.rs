@@ -254,11 +254,7 @@ fn campaign_rank(module: &str) -> usize {
 
 #[test]
 fn campaign_parts_import_only_downwards() {
-    // The one exception: order chaining (execution/chain.rs) judges a finished job's controller
-    // as the report verifies it (reduction/reduce.rs). Open debt: the one evaluation of the
-    // design layer moves verification below execution, and this exception goes.
-    let exceptions = [("execution::chain", "reduction::reduce")];
-    assert_parts_import_only_downwards("campaign", CAMPAIGN_PARTS, &[], &exceptions);
+    assert_parts_import_only_downwards("campaign", CAMPAIGN_PARTS, &[], &[]);
 }
 
 #[test]

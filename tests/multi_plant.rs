@@ -13,12 +13,11 @@ use std::process::Command;
 use std::rc::Rc;
 
 use hinfix::design::{
-    controller_to_x, plant_values, run, run_problem, ComponentCache, ControllerShape, DesignError, DesignObjective,
-    DesignOptions, DesignOutcome, NoDesignObserver, ObjectiveKind, ObjectivePhase, PlantObjective, PlantTerm, Problem,
-    ProblemError, Structure,
+    controller_to_x, plant_values, ComponentCache, ControllerShape, Design, DesignError, DesignObjective,
+    DesignOptions, DesignOutcome, ObjectiveKind, ObjectivePhase, PlantObjective, PlantTerm, Problem, ProblemError,
+    Structure,
 };
 use hinfix::lti::{closed_loop, resolve_plant, Plant};
-use hinfix::optim::RunControl;
 use serde_json::Value;
 
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
@@ -40,7 +39,7 @@ fn opts(order: usize, seed: u64, maxevals: usize) -> DesignOptions {
 }
 
 fn design(problem: &Problem, o: &DesignOptions, s: Option<&Structure>) -> Result<DesignOutcome, DesignError> {
-    run_problem(problem, o, None, s, &RunControl::new(o.cpumax), &mut NoDesignObserver)
+    Design::new(problem, o).structure(s).run()
 }
 
 /// Central differences of both phases of a problem's objective, for every objective kind, with
@@ -220,7 +219,7 @@ fn a_structure_is_kept_on_several_plants() {
 fn the_single_plant_problem_is_the_single_plant_design() {
     let p = Plant::load(resolve_plant("HE1").unwrap()).unwrap();
     let o = opts(2, 5, 800);
-    let a = run(&p, &o, None, &mut NoDesignObserver).unwrap();
+    let a = Design::for_plant(&p, &o).run().unwrap();
     let b = design(&Problem::single(p), &o, None).unwrap();
     let bits = |o: &DesignOutcome| controller_to_x(&o.controller).iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&a), bits(&b));

@@ -7,11 +7,9 @@
 use std::time::Instant;
 
 use hinfix::design::{
-    run, run_problem, ControllerShape, DesignOptions, DesignStatus, NoDesignObserver, PlantObjective, PlantTerm,
-    Problem, SearchStop, Structure,
+    ControllerShape, Design, DesignOptions, DesignStatus, PlantObjective, PlantTerm, Problem, SearchStop, Structure,
 };
 use hinfix::lti::{closed_loop, h2_norm, hinf_norm, resolve_plant, HinfParams, Plant};
-use hinfix::optim::RunControl;
 
 mod common;
 
@@ -23,7 +21,7 @@ fn h2_at_order_zero_with_a_forced_feedthrough_is_answered_at_once() {
     };
     let opts = DesignOptions { order: 0, cpumax: 60.0, ..Default::default() };
     let t0 = Instant::now();
-    let o = run_problem(&problem, &opts, None, None, &RunControl::new(opts.cpumax), &mut NoDesignObserver).unwrap();
+    let o = Design::new(&problem, &opts).run().unwrap();
     let secs = t0.elapsed().as_secs_f64();
     assert!(secs < 1.0, "{secs} s");
     assert_eq!(o.search.stop, SearchStop::NoFreeVariable);
@@ -47,16 +45,14 @@ fn a_structure_that_fixes_every_entry_is_evaluated_once() {
     let p = Plant::load(resolve_plant("HE1").unwrap()).unwrap();
     // a stabilising controller of order 1 to fix: a short design's
     let base = DesignOptions { order: 1, maxevals: Some(2000), ..Default::default() };
-    let k = run(&p, &base, None, &mut NoDesignObserver).unwrap().controller;
+    let k = Design::for_plant(&p, &base).run().unwrap().controller;
     let shape = ControllerShape::for_plant(&p, 1);
     let entries = hinfix::design::controller_to_x(&k).into_iter().map(Some).collect();
     let s = Structure::from_entries(shape, entries).unwrap();
     assert_eq!(s.nfree(), 0);
     let opts = DesignOptions { order: 1, cpumax: 60.0, ..Default::default() };
     let t0 = Instant::now();
-    let o =
-        run_problem(&Problem::single(p.clone()), &opts, None, Some(&s), &RunControl::new(60.0), &mut NoDesignObserver)
-            .unwrap();
+    let o = Design::new(&Problem::single(p.clone()), &opts).structure(Some(&s)).run().unwrap();
     let secs = t0.elapsed().as_secs_f64();
     assert!(secs < 1.0, "{secs} s");
     assert_eq!(o.search.stop, SearchStop::NoFreeVariable);

@@ -10,9 +10,7 @@ use hinfix::campaign::FAKE_RUNNER_ENV;
 use hinfix::campaign::{best_per_order, expand, Campaign, PlantMap, RunnerTag};
 use hinfix::campaign::{parse_journal, read_journal, JournalError};
 use hinfix::campaign::{JobFailure, JobRecord, JobStatus};
-use hinfix::design::{
-    run, Certificate, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver, Phase, PhaseStats,
-};
+use hinfix::design::{Certificate, Design, DesignOptions, DesignOutcome, DesignStatus, Phase, PhaseStats};
 use hinfix::lti::Plant;
 use serde_json::Value;
 
@@ -547,7 +545,7 @@ fn converged_and_stopped_are_told_apart_and_old_optimised_reads() {
             gradient_sampling: false,
             ..Default::default()
         };
-        let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+        let o = Design::for_plant(&p, &opts).run().unwrap();
         match o.status {
             DesignStatus::Converged => assert!(o.certificate.as_ref().unwrap().dnorm <= opts.normtol, "{o:?}"),
             DesignStatus::Stopped => assert!(o.certificate.as_ref().unwrap().dnorm > opts.normtol, "{o:?}"),
@@ -566,7 +564,7 @@ fn controller_norm_term_is_flagged() {
     for (eps, active) in [(1e3, true), (1e-6, false)] {
         let opts =
             DesignOptions { order: 0, eps, seed: 0, cpumax: 5.0, nrand: 1, spend_budget: false, ..Default::default() };
-        let o = run(&p, &opts, None, &mut NoDesignObserver).unwrap();
+        let o = Design::for_plant(&p, &opts).run().unwrap();
         assert!(o.gamma.is_finite(), "{o:?}");
         assert_eq!(o.controller_norm_active, active, "ε = {eps}: γ = {}, ε‖K‖∞ = {}", o.gamma, eps * o.k_hinf);
         // Within the norms' tolerance: on the ridge ‖Tzw‖∞ = ε‖K‖∞ the larger one is rounding.

@@ -10,11 +10,11 @@ use std::path::PathBuf;
 use std::rc::Rc;
 
 use hinfix::design::{
-    controller_to_x, run, run_with_structure, ComponentCache, ControllerShape, DesignObjective, DesignOptions,
-    DesignOutcome, NoDesignObserver, ObjectivePhase, Structure,
+    controller_to_x, ComponentCache, ControllerShape, Design, DesignObjective, DesignOptions, DesignOutcome,
+    ObjectivePhase, Structure,
 };
 use hinfix::lti::{resolve_plant, Controller, Plant};
-use hinfix::optim::{Objective, RunControl};
+use hinfix::optim::Objective;
 
 fn plant(name: &str) -> Plant {
     Plant::load(resolve_plant(name).unwrap()).unwrap()
@@ -25,7 +25,7 @@ fn opts(order: usize, seed: u64) -> DesignOptions {
 }
 
 fn design(p: &Plant, o: &DesignOptions, s: Option<&Structure>) -> DesignOutcome {
-    run_with_structure(p, o, None, s, &RunControl::new(o.cpumax), &mut NoDesignObserver).unwrap()
+    Design::for_plant(p, o).structure(s).run().unwrap()
 }
 
 /// Every fixed entry of `k` is bit for bit the structure's value.
@@ -141,7 +141,7 @@ fn the_structured_gradient_matches_finite_differences() {
     entries[last] = Some(0.0); // the last Dk entry fixed at 0
     let s = Rc::new(Structure::from_entries(shape, entries).unwrap());
     // a stabilising strongly stable point: the HE1 order-1 design projected onto the structure
-    let o = run(&p, &opts(1, 1), None, &mut NoDesignObserver).unwrap();
+    let o = Design::for_plant(&p, &opts(1, 1)).run().unwrap();
     let x_full = controller_to_x(&s.project(&o.controller));
     let x0 = s.restrict(&x_full);
     for (phase, strong, eps) in [
@@ -183,7 +183,7 @@ fn bad_structure_files_are_named_errors() {
     // a structure of another order is refused by the run, not silently used
     let p = plant("HE1");
     let s2 = Structure::all_free(ControllerShape::for_plant(&p, 2));
-    let err = run_with_structure(&p, &opts(1, 1), None, Some(&s2), &RunControl::new(1.0), &mut NoDesignObserver);
+    let err = Design::for_plant(&p, &opts(1, 1)).structure(Some(&s2)).run();
     assert!(err.unwrap_err().to_string().contains("structure"));
 }
 
@@ -194,7 +194,7 @@ fn no_structure_and_all_free_are_the_unstructured_design() {
     for (name, order) in [("HE1", 1), ("REA2", 2), ("AC8", 0)] {
         let p = plant(name);
         let o = opts(order, 3);
-        let reference = run(&p, &o, None, &mut NoDesignObserver).unwrap();
+        let reference = Design::for_plant(&p, &o).run().unwrap();
         let none = design(&p, &o, None);
         let free = design(&p, &o, Some(&Structure::all_free(ControllerShape::for_plant(&p, order))));
         for (label, out) in [("no structure", &none), ("all free", &free)] {

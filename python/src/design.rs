@@ -15,11 +15,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use hinfix::design::{
-    run_problem, ControllerShape, DesignIterRecord, DesignObserver, DesignOptions, PlantObjective, PlantTerm, Problem,
+    ControllerShape, Design, DesignIterRecord, DesignObserver, DesignOptions, PlantObjective, PlantTerm, Problem,
     Structure,
 };
 use hinfix::lti::{Controller, TimeDomain};
-use hinfix::optim::RunControl;
 
 use crate::arrays::{to_mat, to_numpy, In};
 use crate::errors::{bad_input, failure};
@@ -107,8 +106,12 @@ pub fn design<'py>(
         cancel,
         move |_| {
             // The clock starts here, in the thread that spends the CPU time.
-            let ctl = RunControl::new(opts.cpumax).with_cancel(flag);
-            run_problem(&problem, &opts, init.as_ref(), structure.as_ref(), &ctl, &mut watcher)
+            Design::new(&problem, &opts)
+                .init(init.as_ref())
+                .structure(structure.as_ref())
+                .observe(&mut watcher)
+                .cancel(flag)
+                .run()
         },
         on_poll,
     )?

@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 
-use hinfix::lti::{hinf_norm, hinf_norm_discrete, HinfParams, Interrupt, StateSpace, TimeDomain, DEFAULT_HINF_TOL};
+use hinfix::lti::{hinf_norm_in, HinfParams, Interrupt, StateSpace, TimeDomain, DEFAULT_HINF_TOL};
 
 use crate::arrays::{to_mat, In};
 use crate::errors::{bad_input, failure};
@@ -32,10 +32,7 @@ pub fn hinfnorm(py: Python<'_>, a: In<'_>, b: In<'_>, c: In<'_>, d: In<'_>, tol:
     let norm = run_interruptible(py, cancel, move |flag| {
         let stop = || flag.load(Ordering::Relaxed);
         let params = HinfParams::new(tol).with_stop(Interrupt::new(&stop));
-        match domain {
-            TimeDomain::Continuous => hinf_norm(&sys, &params),
-            TimeDomain::Discrete { .. } => hinf_norm_discrete(&sys, &params),
-        }
+        hinf_norm_in(domain, &sys, &params)
     })?
     .map_err(|e| failure("hinfnorm", e))?;
     Ok((norm.value, domain.to_rad_per_s(norm.peak_freq)))

@@ -22,11 +22,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::design::{plant_value, PlantObjective};
-use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm_in, stability_margin, verified_stability_measure, Controller,
-    HinfNorm, HinfParams, Plant, TimeDomain, DEFAULT_HINF_TOL, NORM_TIE_RTOL,
-};
+use crate::design::{evaluate_plant, loop_details};
+use crate::lti::{Controller, Plant, TimeDomain, NORM_TIE_RTOL};
 use anyhow::Context;
 use serde_json::{json, Value};
 
@@ -67,7 +64,8 @@ struct CheckReport {
     /// 1/r_C(A_cl), the reciprocal of the complex stability radius (continuous time; None in
     /// discrete time).
     inverse_radius: Option<f64>,
-    /// Stability margins (`lti::stability_margin`) of A_cl and Ak: stable means α below minus it.
+    /// Stability margins (`lti::verified_stability`) of A_cl and Ak: stable means α below minus it
+    /// (NaN for Ak of order 0).
     margin_cl: f64,
     margin_k: f64,
 }
@@ -153,32 +151,21 @@ fn report_one(a: &CheckArgs, plant: &Plant, k: &Controller, r: &CheckReport) -> 
 }
 
 fn evaluate(plant: &Plant, k: &Controller) -> anyhow::Result<CheckReport> {
-    let cl = closed_loop(plant, k).context("forming the closed loop")?;
-    let domain = plant.domain;
-    let alpha_cl = verified_stability_measure(domain, cl.a.as_ref());
-    let h = hinf_norm_in(domain, &cl, &HinfParams::default()).expect("no stop hook is set");
-    // in rad/s (a discrete norm's θ is in rad/sample)
-    let h = HinfNorm { value: h.value, peak_freq: domain.to_rad_per_s(h.peak_freq) };
-    let alpha_k = (k.order() > 0).then(|| verified_stability_measure(domain, k.ak.as_ref()));
-    let (hk, _) = controller_hinf_grad(k, DEFAULT_HINF_TOL);
-    let (margin_cl, margin_k) = (stability_margin(cl.a.as_ref()), stability_margin(k.ak.as_ref()));
-    let peak_freqs = crate::lti::near_peak_frequencies(domain, &cl, &h, NORM_TIE_RTOL);
-    let params = HinfParams::default();
-    let value = |o: PlantObjective| plant_value(plant, o, k, &params).map_or(f64::INFINITY, |(v, _)| v);
-    let h2 = value(PlantObjective::H2);
-    let inverse_radius = (!domain.is_discrete()).then(|| value(PlantObjective::Radius));
+    let e = evaluate_plant(plant, k);
+    let l = e.plants[0].closed_loop.as_ref().map_err(Clone::clone).context("forming the closed loop")?;
+    let details = loop_details(plant, k, &l.hinf).context("forming the closed loop")?;
     let r = CheckReport {
-        h2,
-        inverse_radius,
-        domain,
-        alpha_cl,
-        alpha_k,
-        gamma: h.value,
-        peak_freq: h.peak_freq,
-        peak_freqs,
-        k_hinf: hk.value,
-        margin_cl,
-        margin_k,
+        h2: details.h2,
+        inverse_radius: details.inverse_radius,
+        domain: plant.domain,
+        alpha_cl: l.stability.measure,
+        alpha_k: e.controller.stability.map(|s| s.measure),
+        gamma: l.hinf.value,
+        peak_freq: l.hinf.peak_freq,
+        peak_freqs: details.peak_freqs,
+        k_hinf: e.controller.hinf,
+        margin_cl: l.stability.margin,
+        margin_k: e.controller.stability.map_or(f64::NAN, |s| s.margin),
     };
     // A stable system has a finite norm: NaN or ∞ here is a computation out of f64's range (a
     // controller with huge entries; plants are bounded on load), never a result to print.

@@ -31,12 +31,11 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::design::{
-    run_problem, stabilises, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, NoDesignObserver,
-    ObjectiveKind, PlantObjective, PlantTerm, PlantValue, Problem, SearchStop, Structure, VariableScaling,
+    stabilises, ControllerShape, Design, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, PlantObjective,
+    PlantTerm, PlantValue, Problem, SearchStop, Structure, VariableScaling,
 };
 use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
-use crate::optim::RunControl;
 use anyhow::Context;
 
 use super::{fmt_num, signals, EXIT_BOUND_VIOLATED, EXIT_NOT_STABILISED};
@@ -289,8 +288,11 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         check_writable(out).with_context(|| format!("--out {}", out.display()))?;
     }
     let cancel = signals::install();
-    let ctl = RunControl::new(opts.cpumax).with_cancel(Arc::clone(&cancel));
-    let outcome = run_problem(&problem, &opts, init.as_ref(), structure.as_ref(), &ctl, &mut NoDesignObserver)
+    let outcome = Design::new(&problem, &opts)
+        .init(init.as_ref())
+        .structure(structure.as_ref())
+        .cancel(Arc::clone(&cancel))
+        .run()
         .with_context(|| format!("designing an order-{} controller for {names}", a.order))?;
     let good = stabilising(&problem, &opts, &outcome);
     // A stabilising result has a finite γ; NaN or ∞ would be a failed computation called success.
@@ -481,7 +483,7 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     );
     s += &format!("status:   {}\n", status_text(&o.status, o.search.stop));
     s += &plant_lines(&o.plants);
-    // A problem's γ is its plants' largest weighted value (`design::run_problem`).
+    // A problem's γ is its plants' largest weighted value (`design::Design`).
     let gamma_name = if o.plants.is_empty() { "‖Tzw‖∞" } else { "max w·g" };
     s += &format!(
         "{gamma_name} = {}   ‖K‖∞ = {}   objective = {}\n",

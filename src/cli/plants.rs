@@ -30,17 +30,20 @@ struct Summary {
     /// The library folder it comes from (`compleib`), `None` for the top folder or a path.
     collection: Option<String>,
     plant: Plant,
+    /// α, or ρ − 1 in discrete time.
     alpha: f64,
+    /// Whether the plant is stable with the verification margin.
+    stable: bool,
 }
 
 impl Summary {
     fn new(plant: Plant) -> Self {
-        // α, or ρ − 1 in discrete time
-        let alpha = lti::verified_stability_measure(plant.domain, plant.a.as_ref());
-        Summary { name: plant.name.clone(), collection: None, plant, alpha }
+        let verified = lti::verified_stability(plant.domain, plant.a.as_ref());
+        let (alpha, stable) = (verified.measure, verified.is_stable());
+        Summary { name: plant.name.clone(), collection: None, plant, alpha, stable }
     }
     fn stable(&self) -> bool {
-        lti::is_stable_with_margin(self.alpha, self.plant.a.as_ref())
+        self.stable
     }
     fn json(&self) -> Value {
         let d = self.plant.dims;

@@ -11,11 +11,18 @@
 //! * `scaling`: plant-scaled controller variables x = d ∘ x̃ for the search;
 //! * `search`: the multi-start search (local searches until a budget or the stall rule, basin
 //!   hopping, gradient sampling on the best point);
-//! * [`run`]: the entry point.
+//! * `builder`: [`Design`], the one entry point (a builder: problem, options, initial and chained
+//!   controllers, structure, observer, cancel flag), which makes the run's budget;
+//! * `evaluate`: [`evaluate`], one controller on a problem's plants as verification sees it
+//!   (stability with the margin, norms, each plant's value, the verdict);
+//! * `run`: one design as [`Design::run`] starts it (checks, starting points, the search, the
+//!   outcome's figures recomputed from the returned controller).
 //!
 //! The modules are crate-private; what is API is re-exported here.
+mod builder;
 pub(crate) mod central_start;
 mod components;
+mod evaluate;
 mod float_serde;
 mod multi_objective;
 pub(crate) mod objective;
@@ -30,7 +37,12 @@ mod search;
 pub(crate) mod starts;
 mod structure;
 
+pub use builder::Design;
 pub use central_start::{central_starts, reduce as reduce_controller, CENTRAL_MAX_STATES, CENTRAL_REGULARISATIONS};
+pub use evaluate::{
+    evaluate, evaluate_job, evaluate_plant, loop_details, stabilises, ControllerEvaluation, Evaluation, LoopDetails,
+    LoopEvaluation, PlantEvaluation, Rejection,
+};
 pub use float_serde::{f64_from_json, f64_text, f64_to_json, serde_f64_or_string, serde_opt_f64_or_string};
 pub use objective::{
     ComponentCache, Components, DesignObjective, ObjectivePhase, ObserverAdapter, COMPONENT_CACHE_LEN,
@@ -51,10 +63,7 @@ pub use problem::{
     plant_part, plant_value, plant_values, problem_gamma, H2Feedthrough, PlantObjective, PlantTerm, PlantValue,
     Problem, ProblemError, UnknownObjective, BOUND_RTOL, MAX_BOUND, MAX_WEIGHT, MIN_WEIGHT, PENALTY_WEIGHT,
 };
-pub use run::{
-    run, run_problem, run_problem_chained, run_with_control, run_with_structure, stabilises, strongly_stabilisable,
-    validate,
-};
+pub use run::{strongly_stabilisable, validate};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};
 pub use structure::{Structure, StructureError};

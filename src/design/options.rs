@@ -590,7 +590,7 @@ macro_rules! define_design_options {
             check $check:expr,
             doc $doc:literal;
     )*) => {
-        /// Options of [`crate::design::run`]. Defaults follow HIFOO 3.5 (docs/ALGORITHMS.md §8),
+        /// Options of a design ([`crate::design::Design`]). Defaults follow HIFOO 3.5 (docs/ALGORITHMS.md §8),
         /// except that the search goes on after HIFOO's starts (`stall_starts`, `hop_scales`).
         /// Defined by the option table (`design_option_table!`, [`DesignOptions::table`]).
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -145,7 +145,7 @@ pub enum StartKind {
     /// The initial controller or one of its perturbations.
     Init,
     /// The padded controller of the order below (a campaign's order chaining,
-    /// [`crate::design::run_problem_chained`]).
+    /// [`crate::design::Design::chained`]).
     Chained,
     /// A reduced-order full-order-central-controller start (`central_gammas`).
     Central,
@@ -237,7 +237,7 @@ pub struct Certificate {
     pub evaldist: f64,
 }
 
-/// The result of [`crate::design::run`]. Every figure is recomputed from `controller`.
+/// The result of [`crate::design::Design::run`]. Every figure is recomputed from `controller`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct DesignOutcome {
     /// How the run ended.
@@ -284,7 +284,7 @@ pub struct DesignOutcome {
     #[serde(default = "SearchSummary::not_recorded")]
     pub search: SearchSummary,
     /// Each plant's recomputed value, of a design for several plants or another objective than
-    /// one plant's H∞ norm (`design::run_problem`); empty for the single-plant H∞ design.
+    /// one plant's H∞ norm (`design::Design::new`); empty for the single-plant H∞ design.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plants: Vec<super::problem::PlantValue>,
 }
@@ -332,7 +332,7 @@ pub trait DesignObserver {
         ControlFlow::Continue(())
     }
 
-    /// A cancel flag that [`run`](super::run) attaches to its `RunControl`, so that setting it
+    /// A cancel flag that [`Design::run`](super::Design::run) attaches to its `RunControl`, so that setting it
     /// stops the run inside a long evaluation, not only at the next iteration (`on_iter`
     /// returning `Break` takes effect only there). Default: none.
     fn cancel_flag(&self) -> Option<Arc<AtomicBool>> {

@@ -26,9 +26,9 @@ use faer::Mat;
 use serde::{Deserialize, Serialize};
 
 use crate::lti::{
-    closed_loop, closed_loop_h2_grad, closed_loop_h2_grad_discrete, closed_loop_hinf_grad,
-    closed_loop_inverse_stability_radius_grad, closed_loop_stability_grad, h2_feedthrough_parameterisation,
-    stability_measure, Controller, ControllerGradient, DkAffine, FeedthroughError, HinfParams, LtiError, Plant,
+    closed_loop, closed_loop_h2_grad_in, closed_loop_hinf_grad, closed_loop_inverse_stability_radius_grad,
+    closed_loop_stability_grad, h2_feedthrough_parameterisation, stability_measure, Controller, ControllerGradient,
+    DkAffine, FeedthroughError, HinfParams, LtiError, Plant,
 };
 
 /// Weight μ of the exact ℓ1 penalty on violated bounds (module docs). It is exact once μ exceeds
@@ -336,8 +336,7 @@ pub fn plant_value(
 ) -> Result<(f64, ControllerGradient), LtiError> {
     match objective {
         PlantObjective::Hinf => closed_loop_hinf_grad(plant, k, params).map(|(n, g)| (n.value, g)),
-        PlantObjective::H2 if plant.domain.is_discrete() => closed_loop_h2_grad_discrete(plant, k),
-        PlantObjective::H2 => closed_loop_h2_grad(plant, k),
+        PlantObjective::H2 => closed_loop_h2_grad_in(plant, k),
         PlantObjective::Abscissa => closed_loop_stability_grad(plant, k),
         PlantObjective::Radius => {
             closed_loop_inverse_stability_radius_grad(plant, k, params).map(|(n, g)| (n.value, g))

@@ -1,5 +1,6 @@
-//! [`run`]: one HIFOO design (docs/ALGORITHMS.md §8): validate, build the starting points, stabilise,
-//! optimise, and report figures recomputed from the returned controller.
+//! One HIFOO design (docs/ALGORITHMS.md §8), as [`Design::run`](super::Design::run) starts it:
+//! validate, build the starting points, stabilise, optimise, and report figures recomputed from
+//! the returned controller.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -8,9 +9,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, eigenvalues_of, hinf_norm_discrete, hinf_norm_with_poles, is_stable,
-    is_stable_with_margin, stability_measure, stability_measure_of, verified_stability_measure, Controller, HinfParams,
-    Interrupt, Plant, TimeDomain, NORM_TIE_RTOL,
+    closed_loop, continuous_time_image, controller_hinf_grad, eigenvalues_of, hinf_norm_with_poles_in, is_stable,
+    stability_measure, stability_measure_of, verified_stability, Controller, HinfParams, Interrupt, Plant, TimeDomain,
+    NORM_TIE_RTOL,
 };
 use crate::optim::RunControl;
 
@@ -28,150 +29,44 @@ use super::problem::{
     nan_max, plant_part, plant_values, problem_gamma, H2Feedthrough, PlantValue, Problem, PENALTY_WEIGHT,
 };
 use super::scaling::variable_scaling;
-use super::search::{ScaledObjectives, Search};
+use super::search::{ScaledObjectives, Search, SearchResult};
 use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
 use super::structure::Structure;
 
-/// Designs a controller of order `opts.order` for `plant` (HIFOO, strong stabilisation unless
-/// `opts.objective` is [`ObjectiveKind::Plain`]), within `opts.cpumax` CPU seconds and
-/// `opts.maxevals` evaluations.
-///
-/// `init` (optional) is a starting controller of order ≤ `opts.order`; a lower order is padded
-/// with decoupled stable modes (docs/ALGORITHMS.md §8.2), and it is used together with `opts.nrand`
-/// relative perturbations of itself. Without `init`, `opts.nrand` standard-normal starts are drawn
-/// from a ChaCha8 generator seeded with `opts.seed`. After these starts the search goes on
-/// (basin hopping and fresh random starts) until a budget or the stall rule ends it
-/// (`design::search`).
-///
-/// Failing to stabilise is an outcome ([`DesignStatus::NotStabilised`]), not an error; `Err` is
-/// for invalid options or an initial controller that does not fit. γ, ‖K‖∞ and the abscissas of
-/// the outcome are recomputed from the returned controller.
-pub fn run(
-    plant: &Plant,
-    opts: &DesignOptions,
-    init: Option<&Controller>,
-    obs: &mut dyn DesignObserver,
-) -> Result<DesignOutcome, DesignError> {
-    let mut ctl = RunControl::new(opts.cpumax);
-    if let Some(flag) = obs.cancel_flag() {
-        ctl = ctl.with_cancel(flag);
-    }
-    run_with_control(plant, opts, init, &ctl, obs)
+/// The given starting controllers of a run: `init` (with its perturbations, in place of the
+/// random starts) and `chained` (the first local search), each of order ≤ `opts.order`
+/// ([`Design::init`](super::Design::init), [`Design::chained`](super::Design::chained)).
+#[derive(Clone, Copy, Default)]
+pub(super) struct Starts<'a> {
+    pub init: Option<&'a Controller>,
+    pub chained: Option<&'a Controller>,
 }
 
-/// As [`run`], with a caller-made [`RunControl`] (e.g. with a cancel flag:
-/// `RunControl::new(opts.cpumax).with_cancel(flag)`); its budget replaces `opts.cpumax`, and a
-/// cancel gives [`DesignStatus::Interrupted`].
-pub fn run_with_control(
-    plant: &Plant,
-    opts: &DesignOptions,
-    init: Option<&Controller>,
-    ctl: &RunControl,
-    obs: &mut dyn DesignObserver,
-) -> Result<DesignOutcome, DesignError> {
-    run_with_structure(plant, opts, init, None, ctl, obs)
-}
-
-/// As [`run_with_control`], for controllers of `structure` (`design::structure`,
-/// docs/ALGORITHMS.md §1.1): the optimiser's variables are the free entries, and every fixed
-/// entry of the returned controller is bit for bit its value. `None` is exactly
-/// [`run_with_control`].
-///
-/// Starting points with a structure: the first random starts draw `opts.nrand` standard-normal
-/// vectors of the free entries only; the initial controller (padded to the order if lower), the
-/// open-loop start and the central starts are *projected* onto the structure (their fixed
-/// entries overwritten by the structure's values); variable scaling applies to the free entries.
-/// A structure of other sizes than `opts.order` on this plant is an `Options` error (field
-/// `structure`); one with no free entry (and no free Dk entry left by the H2 objective) is
-/// evaluated once and answered at once (search stop `no_free_variable`).
-pub fn run_with_structure(
-    plant: &Plant,
-    opts: &DesignOptions,
-    init: Option<&Controller>,
-    structure: Option<&Structure>,
-    ctl: &RunControl,
-    obs: &mut dyn DesignObserver,
-) -> Result<DesignOutcome, DesignError> {
-    run_problem(&Problem::single(plant.clone()), opts, init, structure, ctl, obs)
-}
-
-/// As [`run_with_structure`], for a [`Problem`]: several plants, each with its objective, weight
-/// and bound (`design::problem`, docs/ALGORITHMS.md §14). The single-plant H∞ problem
-/// ([`Problem::is_single_hinf`]) is exactly [`run_with_structure`]; any other is evaluated by
+/// The design of `problem` ([`Design::run`](super::Design::run), whose docs say what each
+/// argument does) under the run control `ctl` (`opts.cpumax`, `opts.maxevals`, the cancel flag;
+/// a cancel gives [`DesignStatus::Interrupted`]). The single-plant H∞ problem
+/// ([`Problem::is_single_hinf`]) is evaluated by `design::objective` alone; any other by
 /// `design::multi_objective`, every plant stabilised in the first phase. The first plant gives
-/// the starting points (random, `init`, open loop, its central starts) and the variable scaling;
-/// every plant is checked by [`validate`] and, strong objective, for strong stabilisability. The
-/// outcome's [`DesignOutcome::plants`] gives each plant's recomputed value; its `gamma` is then the
-/// largest weighted value w_j·g_j of the plants without a bound (of all plants if each has one),
+/// the starting points and the variable scaling; every plant is checked by [`validate`] and,
+/// strong objective, for strong stabilisability. The outcome's [`DesignOutcome::plants`] gives
+/// each plant's recomputed value of a problem of several plants; its `gamma` is then the largest
+/// weighted value w_j·g_j of the plants without a bound (of all plants if each has one),
 /// `alpha_cl` the largest closed-loop stability measure.
-pub fn run_problem(
+pub(super) fn design(
     problem: &Problem,
     opts: &DesignOptions,
-    init: Option<&Controller>,
+    starts: Starts<'_>,
     structure: Option<&Structure>,
     ctl: &RunControl,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
-    run_problem_chained(problem, opts, init, None, structure, ctl, obs)
-}
-
-/// As [`run_problem`], with `chained`: one more initial controller of order ≤ `opts.order` (a
-/// campaign's order chaining passes the best controller of the order below, `campaign::jobs`),
-/// padded exactly as `init` is (docs/ALGORITHMS.md §8.2) and projected onto the structure. It is
-/// the **first** local search of the run (kind [`StartKind::Chained`], no perturbations of it),
-/// so that no budget can end the run before it: the search then never returns a controller whose
-/// objective is above the padded controller's, which (same ε) is the objective of `chained`
-/// itself. The other starts (from `init` or random, open loop, central) follow as in
-/// [`run_problem`]; `chained = None` is exactly [`run_problem`].
-pub fn run_problem_chained(
-    problem: &Problem,
-    opts: &DesignOptions,
-    init: Option<&Controller>,
-    chained: Option<&Controller>,
-    structure: Option<&Structure>,
-    ctl: &RunControl,
-    obs: &mut dyn DesignObserver,
-) -> Result<DesignOutcome, DesignError> {
-    let h2 = problem.validate().map_err(DesignError::Problem)?;
+    let h2 = check(problem, opts, starts, structure)?;
     let plant = problem.first();
-    for t in &problem.terms {
-        validate(&t.plant, opts, init)?;
-        if chained.is_some() {
-            validate(&t.plant, opts, chained)?;
-        }
-    }
-    let multi = (!problem.is_single_hinf()).then_some(problem);
-    if let (Some(s), Some(_)) = (structure, &h2) {
-        let shape = ControllerShape::for_plant(plant, opts.order);
-        let dk = &s.entries()[shape.nvar() - shape.m * shape.p..];
-        if dk.iter().any(Option::is_some) {
-            return Err(opt_err(
-                "structure",
-                "fixes entries of DK, which the h2 objective constrains to D11 + D12·DK·D21 = 0: leave DK free",
-            ));
-        }
+    let shape = ControllerShape::for_plant(plant, opts.order);
+    if free_variables(shape, structure, h2.as_ref()) == 0 {
+        return Ok(fixed_design(problem, opts, shape, structure, h2.as_ref()));
     }
     let h2 = h2.map(Rc::new);
-    let shape = ControllerShape::for_plant(plant, opts.order);
-    if let Some(s) = structure {
-        if !s.fits(shape) {
-            let (nk, m, p) = s.sizes();
-            return Err(opt_err(
-                "structure",
-                format!(
-                    "made for order {nk} with {m} controls and {p} measurements, not order {} with {} and {}",
-                    shape.nk, shape.m, shape.p
-                ),
-            ));
-        }
-        fixed_ak_stable(s, shape, opts, plant.domain)?;
-    }
-    for t in &problem.terms {
-        strongly_stabilisable(&t.plant, opts)?;
-    }
-    if free_variables(shape, structure, h2.as_deref()) == 0 {
-        return Ok(fixed_design(problem, opts, shape, structure, h2.as_deref()));
-    }
     let structure: Option<Rc<Structure>> = structure.map(|s| Rc::new(s.clone()));
     // The optimiser's variables of a controller (all of x, or its free entries: the fixed ones
     // are overwritten, i.e. the controller is projected onto the structure).
@@ -180,29 +75,16 @@ pub fn run_problem_chained(
         Some(s) => s.restrict(&x),
     };
     let nvar = structure.as_ref().map_or(shape.nvar(), |s| s.nfree());
-    let strong = opts.objective == ObjectiveKind::Strong;
-    let ctl = ctl.clone().with_maxevals(opts.maxevals.or(ctl.maxevals()));
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let mut first = starting_points(plant, opts, init, shape, nvar, &vars, &mut rng);
-    let mut kinds = vec![if init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
-    if let Some(k) = chained {
-        first.insert(0, vars(controller_to_x(&padded_to(plant, k, shape.nk))));
-        kinds.insert(0, StartKind::Chained);
-    }
-    if opts.open_loop_start {
-        first.push(vars(controller_to_x(&open_loop_controller(plant, shape.nk))));
-        kinds.push(StartKind::OpenLoop);
-    }
-    for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
-        first.push(vars(controller_to_x(&k)));
-        kinds.push(StartKind::Central);
-    }
+    let (first, kinds) = first_starts(plant, opts, starts, shape, nvar, &vars, &mut rng);
     // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
     // asks for them and the plant is scaled at all.
     let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
         VariableScaling::Off => None,
         VariableScaling::Alternate | VariableScaling::Always => variable_scaling(plant, shape).map(|d| vars(d).into()),
     };
+    let multi = (!problem.is_single_hinf()).then_some(problem);
+    let strong = opts.objective == ObjectiveKind::Strong;
     // Inside an evaluation the full budget and the cancel flag are polled (objective.rs); a
     // sub-budget of the search is checked between evaluations.
     let stop_ctl = ctl.clone();
@@ -238,17 +120,102 @@ pub fn run_problem_chained(
         (Some((s, p)), Some(d)) => Some(ScaledObjectives { stab_obj: s, perf_obj: p, d: Rc::clone(d) }),
         _ => None,
     };
-    let res = Search {
-        stab_obj: &mut stab_obj,
-        perf_obj: &mut perf_obj,
-        adapter: &mut adapter,
-        rng: &mut rng,
-        ctl: &ctl,
-        scaled,
-    }
-    .run(opts, &first, &kinds, nvar)?;
+    let res =
+        Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl, scaled }
+            .run(opts, &first, &kinds, nvar)?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
+    let (final_x, ended) = how_it_ended(&res, opts, interrupted);
+    let k = perf_obj.controller_at(&final_x);
+    let cancelled = || ctl.cancelled();
+    let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
+    let (fig, plants) =
+        outcome_figures(plant, multi, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
+    Ok(outcome(problem, k, fig, plants, opts, ended, res.phases, ctl.cpu_elapsed(), res.summary))
+}
 
+/// The checks before a design: the problem, the options and the given controllers against every
+/// plant ([`validate`]), the structure against the problem (sizes; Dk free under the h2
+/// objective; a fixed A_K stable under the strong objective), and strong stabilisability. `Ok`
+/// holds the h2 objective's feedthrough set, if the problem has one.
+fn check(
+    problem: &Problem,
+    opts: &DesignOptions,
+    starts: Starts<'_>,
+    structure: Option<&Structure>,
+) -> Result<Option<H2Feedthrough>, DesignError> {
+    let h2 = problem.validate().map_err(DesignError::Problem)?;
+    let plant = problem.first();
+    for t in &problem.terms {
+        validate(&t.plant, opts, starts.init)?;
+        if starts.chained.is_some() {
+            validate(&t.plant, opts, starts.chained)?;
+        }
+    }
+    let shape = ControllerShape::for_plant(plant, opts.order);
+    if let (Some(s), Some(_)) = (structure, &h2) {
+        let dk = &s.entries()[shape.nvar() - shape.m * shape.p..];
+        if dk.iter().any(Option::is_some) {
+            return Err(opt_err(
+                "structure",
+                "fixes entries of DK, which the h2 objective constrains to D11 + D12·DK·D21 = 0: leave DK free",
+            ));
+        }
+    }
+    if let Some(s) = structure {
+        if !s.fits(shape) {
+            let (nk, m, p) = s.sizes();
+            return Err(opt_err(
+                "structure",
+                format!(
+                    "made for order {nk} with {m} controls and {p} measurements, not order {} with {} and {}",
+                    shape.nk, shape.m, shape.p
+                ),
+            ));
+        }
+        fixed_ak_stable(s, shape, opts, plant.domain)?;
+    }
+    for t in &problem.terms {
+        strongly_stabilisable(&t.plant, opts)?;
+    }
+    Ok(h2)
+}
+
+/// The first starting points and their kinds, in the search's order: the chained start (if
+/// any), perturbations of the (padded) initial controller or random starts, the open-loop start
+/// (if asked for), the central starts. `vars` maps a controller's x to the optimiser's variables.
+fn first_starts(
+    plant: &Plant,
+    opts: &DesignOptions,
+    starts: Starts<'_>,
+    shape: ControllerShape,
+    nvar: usize,
+    vars: &dyn Fn(Vec<f64>) -> Vec<f64>,
+    rng: &mut ChaCha8Rng,
+) -> (Vec<Vec<f64>>, Vec<StartKind>) {
+    let mut first = starting_points(plant, opts, starts.init, shape, nvar, vars, rng);
+    let mut kinds = vec![if starts.init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
+    if let Some(k) = starts.chained {
+        first.insert(0, vars(controller_to_x(&padded_to(plant, k, shape.nk))));
+        kinds.insert(0, StartKind::Chained);
+    }
+    if opts.open_loop_start {
+        first.push(vars(controller_to_x(&open_loop_controller(plant, shape.nk))));
+        kinds.push(StartKind::OpenLoop);
+    }
+    for (_, k) in central_starts(plant, shape.nk, &opts.central_gammas) {
+        first.push(vars(controller_to_x(&k)));
+        kinds.push(StartKind::Central);
+    }
+    (first, kinds)
+}
+
+/// The point a search returns (the best of the performance phase, else of the stabilisation
+/// phase) and how the search ended: its status and certificate.
+fn how_it_ended(
+    res: &SearchResult,
+    opts: &DesignOptions,
+    interrupted: bool,
+) -> (Vec<f64>, (DesignStatus, Option<Certificate>)) {
     let (final_x, certificate) = match &res.perf {
         Some(b) => (b.x.clone(), Some(Certificate { dnorm: b.dnorm, evaldist: b.evaldist })),
         None => (res.stab.x.clone(), None),
@@ -266,18 +233,15 @@ pub fn run_problem_chained(
     } else {
         DesignStatus::Stopped
     };
-
-    let k = perf_obj.controller_at(&final_x);
-    let cancelled = || ctl.cancelled();
-    let large = plant.dims.n + shape.nk >= MIN_ORDER_FOR_INTERRUPT;
-    let (fig, plants) =
-        evaluate(plant, multi, opts, &k, if large { Interrupt::new(&cancelled) } else { Interrupt::NEVER });
-    Ok(outcome(problem, k, fig, plants, opts, (status, certificate), res.phases, ctl.cpu_elapsed(), res.summary))
+    (final_x, (status, certificate))
 }
 
-/// The figures of `k` on the first plant ([`figures`]), or the problem's with each plant's value
-/// for a problem of several plants (`multi`).
-fn evaluate(
+/// The outcome's figures of `k` on the first plant ([`figures`]), or the problem's with each
+/// plant's value for a problem of several plants (`multi`). These are the optimiser's figures (its
+/// stability measure, the norms to the run's `hinf_tol`, abandoned on a cancel): what the
+/// controller is judged by after the run is [`design::evaluate`](super::evaluate)'s verification
+/// ([`verified_status`]).
+fn outcome_figures(
     plant: &Plant,
     multi: Option<&Problem>,
     opts: &DesignOptions,
@@ -333,7 +297,7 @@ fn outcome(
 
 /// The design's free variables: the structure's free entries (every entry without one), Dk's
 /// counted as the dimension of the H2 feedthrough set when the h2 objective constrains Dk (a
-/// structure then leaves Dk free, checked by [`run_problem_chained`]).
+/// structure then leaves Dk free, checked by [`check`]).
 fn free_variables(shape: ControllerShape, structure: Option<&Structure>, h2: Option<&H2Feedthrough>) -> usize {
     let ndk = shape.m * shape.p;
     let split = shape.nvar() - ndk;
@@ -371,7 +335,7 @@ fn fixed_design(
         None => k,
     };
     let multi = (!problem.is_single_hinf()).then_some(problem);
-    let (fig, plants) = evaluate(plant, multi, opts, &k, Interrupt::NEVER);
+    let (fig, plants) = outcome_figures(plant, multi, opts, &k, Interrupt::NEVER);
     let strong = opts.objective == ObjectiveKind::Strong;
     let alpha = match fig.alpha_k {
         Some(a) if strong => nan_max(fig.alpha_cl, opts.eps * a),
@@ -396,41 +360,11 @@ fn fixed_design(
     outcome(problem, k, fig, plants, opts, ended, phases, cpu, search)
 }
 
-/// Whether `k` stabilises every plant of `problem` as `opts` asks, with the verification margin
-/// (`lti::is_stable_with_margin`, the test of `campaign check`, `design --out` and `campaign
-/// report`): every closed loop stable and, with the strong objective, the controller too. `Err`
-/// holds the largest of the closed-loop measures and ε·α(A_K) (strong), as
-/// [`DesignStatus::NotStabilised`] reports it.
-pub fn stabilises(problem: &Problem, opts: &DesignOptions, k: &Controller) -> Result<(), f64> {
-    let mut worst = f64::NEG_INFINITY;
-    let mut stable = true;
-    for t in &problem.terms {
-        match closed_loop(&t.plant, k) {
-            Ok(cl) => {
-                let s = verified_stability_measure(t.plant.domain, cl.a.as_ref());
-                worst = nan_max(worst, s);
-                stable &= is_stable_with_margin(s, cl.a.as_ref());
-            }
-            Err(_) => (worst, stable) = (f64::INFINITY, false),
-        }
-    }
-    if opts.objective == ObjectiveKind::Strong && k.order() > 0 {
-        let s = verified_stability_measure(k.domain, k.ak.as_ref());
-        worst = nan_max(worst, opts.eps * s);
-        stable &= is_stable_with_margin(s, k.ak.as_ref());
-    }
-    if stable {
-        Ok(())
-    } else {
-        Err(worst)
-    }
-}
-
 /// The status the returned controller itself supports. The search calls a point stable once
 /// its measure is below 0, so it can end on the boundary (the abscissa objective under strong
 /// stabilisation ended at α ≈ −4e-12 and was journaled "stopped" while `design` refused to write
 /// the controller): a controller that is not stable with the verification margin
-/// ([`stabilises`]) is [`DesignStatus::NotStabilised`] whatever the search said, and a
+/// ([`stabilises`](super::stabilises)) is [`DesignStatus::NotStabilised`] whatever the search said, and a
 /// stabilising one that violates a plant's bound is [`DesignStatus::BoundViolated`]. Interrupted
 /// and not-stabilised runs keep their status.
 fn verified_status(
@@ -443,14 +377,14 @@ fn verified_status(
     if matches!(status, DesignStatus::Interrupted | DesignStatus::NotStabilised { .. }) {
         return status;
     }
-    match stabilises(problem, opts, k) {
+    match super::evaluate::stabilises(problem, opts, k) {
         Err(best_alpha) => DesignStatus::NotStabilised { best_alpha },
         Ok(()) if plants.iter().any(|v| !v.bound_met()) => DesignStatus::BoundViolated,
         Ok(()) => status,
     }
 }
 
-/// A problem's figures in place of the first plant's (`run_problem`): γ the largest weighted value
+/// A problem's figures in place of the first plant's ([`design`]): γ the largest weighted value
 /// of the unbounded plants (of all if each has a bound), α(A_cl) the largest, the objective
 /// max(γ, ε‖K‖∞) plus the penalty of violated bounds.
 fn problem_figures(fig: &mut Figures, values: &[PlantValue], opts: &DesignOptions) {
@@ -480,11 +414,11 @@ fn fixed_ak_stable(
     }
     let Some(ak) = s.entries()[..nk * nk].iter().copied().collect::<Option<Vec<f64>>>() else { return Ok(()) };
     let ak = faer::Mat::from_fn(nk, nk, |i, j| ak[i + j * nk]);
-    let measure = verified_stability_measure(domain, ak.as_ref());
-    if is_stable_with_margin(measure, ak.as_ref()) {
+    let verified = verified_stability(domain, ak.as_ref());
+    if verified.is_stable() {
         return Ok(());
     }
-    let (name, value) = domain.stability_quantity(measure);
+    let (name, value) = domain.stability_quantity(verified.measure);
     Err(opt_err(
         "structure",
         format!(
@@ -506,11 +440,7 @@ pub fn strongly_stabilisable(plant: &Plant, opts: &DesignOptions) -> Result<(), 
     // A discrete-time plant is strongly stabilisable iff its bilinear image is (stable
     // controllers and stabilising ones correspond, `lti::PlantImage`); the violation then names
     // the image's zeros and poles.
-    let image = match plant.domain {
-        TimeDomain::Continuous => None,
-        TimeDomain::Discrete { .. } => crate::lti::PlantImage::new(plant).ok().map(|i| i.plant),
-    };
-    match crate::lti::parity_interlacing(image.as_ref().unwrap_or(plant)).and_then(|p| p.violation) {
+    match crate::lti::parity_interlacing(&continuous_time_image(plant)).and_then(|p| p.violation) {
         Some(v) => Err(DesignError::NotStronglyStabilisable(v)),
         None => Ok(()),
     }
@@ -521,7 +451,7 @@ fn opt_err(field: &'static str, problem: impl Into<String>) -> DesignError {
 }
 
 /// Checks the options and the initial controller against the plant. This is the one validation
-/// of design options: `campaign design` calls it through [`run`], and a campaign file calls it
+/// of design options: `campaign design` calls it through [`Design::run`](super::Design::run), and a campaign file calls it
 /// for every problem before any job starts.
 pub fn validate(plant: &Plant, opts: &DesignOptions, init: Option<&Controller>) -> Result<(), DesignError> {
     // each option on its own: the option table's checks (design/options.rs)
@@ -602,11 +532,7 @@ fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<
                 let a = stability_measure_of(plant.domain, &poles);
                 let g = if is_stable(a) && cl.is_finite() {
                     let params = HinfParams::new(opts.hinf_tol).with_stop(stop);
-                    let norm = match plant.domain {
-                        TimeDomain::Continuous => hinf_norm_with_poles(&cl, &poles, &params),
-                        TimeDomain::Discrete { .. } => hinf_norm_discrete(&cl, &params),
-                    };
-                    norm.map_or(f64::NAN, |h| h.value)
+                    hinf_norm_with_poles_in(plant.domain, &cl, &poles, &params).map_or(f64::NAN, |h| h.value)
                 } else {
                     f64::INFINITY
                 };

@@ -52,11 +52,12 @@ pub use kernels::spectral::{
 pub use norms::discrete::{
     closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete, hinf_norm_grad_discrete,
 };
-pub(crate) use norms::domain::stability_measure_of;
 pub use norms::domain::{
-    closed_loop_hinf_grad, closed_loop_stability_grad, controller_hinf_grad, controller_stability_grad, hinf_norm_in,
-    stability_measure, verified_stability_measure,
+    closed_loop_h2_grad_in, closed_loop_hinf_grad, closed_loop_stability_grad, controller_hinf_grad,
+    controller_stability_grad, hinf_norm_in, stability_measure, verified_stability, verified_stability_measure,
+    VerifiedStability,
 };
+pub(crate) use norms::domain::{hinf_norm_with_poles_in, stability_measure_of};
 pub use norms::gradient::{
     closed_loop_abscissa_grad, closed_loop_radius_grad, controller_abscissa_grad, controller_radius_grad,
     ControllerGradient,
@@ -65,7 +66,6 @@ pub use norms::h2::{
     closed_loop_h2_grad, closed_loop_h2_grad_discrete, h2_feedthrough_parameterisation, h2_norm, h2_norm_discrete,
     h2_norm_grad, h2_norm_grad_discrete, DkAffine, FeedthroughError, H2_FEEDTHROUGH_RTOL,
 };
-pub(crate) use norms::hinf::hinf_norm_with_poles;
 pub use norms::hinf::{
     hinf_lower_bound, hinf_lower_bound_sharing, hinf_norm, HinfNorm, HinfParams, DEFAULT_HINF_TOL,
     MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
@@ -84,7 +84,7 @@ pub use synthesis::full_order::{
     full_order_gamma, full_order_gamma_discrete, full_order_gamma_with, Binding, FullOrderError, FullOrderGamma,
     FullOrderOptions, Regularisation, FLAT_RTOL, GAMMA_MAX, GAMMA_RTOL, REGULARISATION_DELTAS,
 };
-pub use synthesis::plant_image::{ImageError, PlantImage};
+pub use synthesis::plant_image::{continuous_time_image, ImageError, PlantImage};
 pub use synthesis::strong_stabilisability::{parity_interlacing, ParityInterlacing, PipViolation, PIP_MAX_N, PIP_RTOL};
 pub use system::closed_loop::{closed_loop, MAX_LOOP_CONDITION};
 pub use system::controller::{controller_to_mat, Controller, ControllerError, ControllerErrorKind};

@@ -1,26 +1,19 @@
 //! Order chaining's choice of a start (`order_chaining`, module docs of `campaign::jobs`): of the
 //! finished jobs a job chains from (every job of the order below at its ε), the one whose
-//! controller re-verifies (as the report verifies it, [`crate::campaign::reduction::reduce::verify_controller`]) with
+//! controller re-verifies (as the report verifies it: `design::evaluate_job` and its verdict) with
 //! the least γ, ties broken by the smaller job id. The rule depends only on those jobs' records,
 //! never on when or where they finished, so one sitting, a resumed run and a sharded one start a
 //! job from the same controller.
 
 use crate::campaign::model::jobs::{Job, JobId};
-use crate::campaign::reduction::reduce::{verify_controller, verify_problem_controller, Verdict};
+use crate::design::evaluate_job;
 use crate::lti::Controller;
 
 /// The γ of `k`, the controller of finished job `job`, as the report re-verifies it; `None` if it
 /// does not verify.
 pub fn verified_gamma(job: &Job, k: &Controller) -> Option<f64> {
-    let (order, objective) = (job.options.order, job.options.objective);
-    let verdict = match &job.multi {
-        Some(problem) => verify_problem_controller(k, order, objective, problem),
-        None => verify_controller(k, order, objective, &job.plant),
-    };
-    match verdict {
-        Verdict::Verified { gamma, .. } => Some(gamma),
-        Verdict::Rejected(_) => None,
-    }
+    let evaluation = evaluate_job(job.multi.as_deref(), &job.plant, k, job.options.order).ok()?;
+    evaluation.verdict(job.options.objective).ok()
 }
 
 /// The best of `candidates` (job id, verified γ if any): the least γ, ties by job id; `None` if

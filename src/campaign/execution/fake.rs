@@ -1,4 +1,4 @@
-//! A deterministic stand-in for `design::run`, for testing the campaign machinery (scheduling,
+//! A deterministic stand-in for `design::Design::run`, for testing the campaign machinery (scheduling,
 //! journal, resume after kill -9) quickly. Only the test-only binary examples/fake_campaign.rs
 //! uses it (through [`crate::cli::main_with`]); the `campaign` binary has no way to select it, so
 //! a production binary cannot be switched to fake results. Jobs made for it carry

@@ -3,7 +3,7 @@
 //! journal, traces and progress display are consumers.
 //!
 //! * The job runner is injected ([`JobRunner`]): production passes [`design_job`]
-//!   (`design::run`), tests pass fast fakes.
+//!   (`design::Design`), tests pass fast fakes.
 //! * Per-job observers (the trace writer) are made by an injected [`ObserverFactory`] on the
 //!   worker that runs the job.
 //! * Warm-start chains: a job whose `warm_from` predecessor has not finished is not started; its
@@ -12,7 +12,7 @@
 //!   finished (here, in the journals or elsewhere); its chained start is the controller of the
 //!   best of them (`campaign::chain`), re-verified once per job on the calling thread.
 //! * Cancellation: when `cancel` becomes true (first Ctrl-C, or a failing callback), nothing new
-//!   is scheduled and every in-flight job's observer returns `Break`, so `design::run` stops with
+//!   is scheduled and every in-flight job's observer returns `Break`, so `design::Design::run` stops with
 //!   status `Interrupted`; such jobs produce [`CampaignEvent::JobInterrupted`] and no record, so a
 //!   resumed run reruns them.
 //! * Workers send events over one `std::sync::mpsc` channel; the calling thread owns the callback.
@@ -76,33 +76,20 @@ where
     }
 }
 
-/// The production runner (a [`JobRunner`] as every such function is): [`crate::design::run`]
-/// with the job's plant and options; a job of several plants (or another objective, or a
-/// structure), or with a chained start, is [`crate::design::run_problem_chained`] of its problem
-/// and structure, with the run control `design::run` makes (the job's `cpumax` and the
-/// observer's cancel flag).
+/// The production runner (a [`JobRunner`] as every such function is): [`crate::design::Design`]
+/// of the job's problem (its plant, or its plants with their objectives, weights and bounds) and
+/// options, with its warm start, chained start and structure, observed by `obs` (whose cancel
+/// flag stops the run).
 pub fn design_job(
     job: &Job,
     starts: JobStarts<'_>,
     obs: &mut dyn DesignObserver,
 ) -> Result<DesignOutcome, DesignError> {
-    let init = starts.warm;
-    if job.multi.is_none() && job.structure.is_none() && starts.chained.is_none() {
-        return crate::design::run(&job.plant, &job.options, init, obs);
-    }
-    let single;
-    let problem = match &job.multi {
-        Some(p) => p.as_ref(),
-        None => {
-            single = crate::design::Problem::single((*job.plant).clone());
-            &single
-        }
+    let design = match &job.multi {
+        Some(p) => crate::design::Design::new(p, &job.options),
+        None => crate::design::Design::for_plant(&job.plant, &job.options),
     };
-    let mut ctl = crate::optim::RunControl::new(job.options.cpumax);
-    if let Some(flag) = obs.cancel_flag() {
-        ctl = ctl.with_cancel(flag);
-    }
-    crate::design::run_problem_chained(problem, &job.options, init, starts.chained, job.structure.as_deref(), &ctl, obs)
+    design.init(starts.warm).chained(starts.chained).structure(job.structure.as_deref()).observe(obs).run()
 }
 
 /// What [`Coordinator::claim`] found.
@@ -218,7 +205,7 @@ pub struct RunStats {
     pub already_done: usize,
     /// Finished in this run (journaled), failures included.
     pub finished: usize,
-    /// Of those, failed (`design::run` error or panic).
+    /// Of those, failed (`design::Design::run` error or panic).
     pub failed: usize,
     /// Finished meanwhile by other processes (found in their journals).
     pub done_elsewhere: usize,

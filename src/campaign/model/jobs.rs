@@ -66,7 +66,7 @@ impl fmt::Display for JobId {
 /// results can never be mistaken for real ones.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RunnerTag {
-    /// `design::run` (production).
+    /// `design::Design` (production).
     Design,
     /// The deterministic fake runner of the machinery tests (`campaign::fake`; only the test-only
     /// binary examples/fake_campaign.rs runs it).

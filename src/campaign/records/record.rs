@@ -23,7 +23,7 @@ pub enum JobFailure {
     /// The runner panicked (the scheduler caught it); the panic's message.
     #[error("panic: {0}")]
     Panicked(String),
-    /// The runner returned an error (for `design::run`, a `DesignError`); its message.
+    /// The runner returned an error (for `design::Design::run`, a `DesignError`); its message.
     #[error("{0}")]
     RunnerError(String),
     /// The runner's result failed the check before journaling.
@@ -104,7 +104,7 @@ impl JobFailure {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", try_from = "StatusLine")]
 pub enum JobStatus {
-    /// `design::run` returned an error (or panicked), or its result failed the check before
+    /// `design::Design::run` returned an error (or panicked), or its result failed the check before
     /// journaling: no trustworthy result.
     Failed {
         /// The failure's message ([`JobFailure`]'s `Display`).
@@ -233,10 +233,10 @@ fn write_current_schema<S: serde::Serializer>(_: &u32, s: S) -> Result<S::Ok, S:
 /// The result of a journaled job.
 #[derive(Debug, Clone)]
 pub enum JobResult {
-    /// `design::run` finished (never with [`DesignStatus::Interrupted`]: interrupted runs are not
+    /// `design::Design::run` finished (never with [`DesignStatus::Interrupted`]: interrupted runs are not
     /// journaled) and returned this.
     Designed(Box<DesignOutcome>),
-    /// `design::run` returned an error (or panicked), or its result failed the check before
+    /// `design::Design::run` returned an error (or panicked), or its result failed the check before
     /// journaling: no trustworthy result.
     Failed(JobFailure),
 }

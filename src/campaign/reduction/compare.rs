@@ -13,9 +13,7 @@ use std::collections::BTreeMap;
 use super::reduce::{BestRow, PlantMap};
 use crate::campaign::leaves::reference::{RefMethod, ReferenceRow};
 use crate::design::ObjectiveKind;
-use crate::lti::{
-    full_order_gamma, is_stable_with_margin, verified_spectral_abscissa, CentralProblem, Plant, PlantImage,
-};
+use crate::lti::{continuous_time_image, full_order_gamma, verified_stability, CentralProblem, Plant};
 
 /// Largest plant order for which the full-order bound is computed here.
 pub const FULL_ORDER_MAX_N: usize = 60;
@@ -45,11 +43,9 @@ pub const FULL_ORDER_CENTRAL_LEVEL: f64 = 1.01;
 /// A discrete-time plant's is that of its bilinear image (`lti::PlantImage`: the map keeps the
 /// controller's stability).
 pub fn full_order_controller_stable(plant: &Plant) -> Option<bool> {
-    let image = plant.domain.is_discrete().then(|| PlantImage::new(plant).ok()).flatten();
-    let continuous = image.as_ref().map_or(plant, |i| &i.plant);
-    let c = CentralProblem::new(continuous).ok()?;
+    let c = CentralProblem::new(&continuous_time_image(plant)).ok()?;
     let k = c.controller(FULL_ORDER_CENTRAL_LEVEL * c.gamma_opt).ok()?;
-    Some(k.order() == 0 || is_stable_with_margin(verified_spectral_abscissa(k.ak.as_ref()), k.ak.as_ref()))
+    Some(k.order() == 0 || verified_stability(k.domain, k.ak.as_ref()).is_stable())
 }
 
 /// What a table's caption says of the campaign behind it: its name(s), ε values, number of

@@ -2,8 +2,8 @@
 //! are re-verified by recomputation: the controller's shape is checked against the job's order
 //! and the plant's channels (the journal's `order` and `options.order` must agree too), the
 //! closed loop is formed again (`lti::closed_loop`), both α(A_cl) and α(Ak) (in discrete time
-//! ρ − 1, `lti::verified_stability_measure`, on the balanced matrix where that pays) are checked to be below minus the stability margin (`lti::is_stable_with_margin`: 1e-12 · max(1, ‖A‖_F) — ‖·‖_F of the balanced A where balancing lowers it more than 100-fold, docs/ALGORITHMS.md §5), and
-//! γ = ‖Tzw‖∞ is recomputed. The reported γ is always the recomputed one, never the journal's.
+//! ρ − 1, `lti::verified_stability`, on the balanced matrix where that pays) are checked to be below minus the stability margin (1e-12 · max(1, ‖A‖_F) — ‖·‖_F of the balanced A where balancing lowers it more than 100-fold, docs/ALGORITHMS.md §5), and
+//! γ = ‖Tzw‖∞ is recomputed — all of it `design::evaluate` and its verdict. The reported γ is always the recomputed one, never the journal's.
 //! A job of the plain objective (no stability asked of K) counts with an unstable controller
 //! too: its row says whether the controller is stable (`controller_stable`), which is what the
 //! comparison of the two objectives needs. Rows are per (plant, order, objective).
@@ -26,11 +26,8 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use crate::campaign::records::record::JobRecord;
-use crate::design::{plant_values, problem_gamma, ObjectiveKind, PlantValue, Problem};
-use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm_in, is_stable_with_margin, stability_margin,
-    verified_stability_measure, Controller, HinfParams, Plant, DEFAULT_HINF_TOL,
-};
+use crate::design::{evaluate_job, Evaluation, ObjectiveKind, PlantValue, Problem, Rejection};
+use crate::lti::{Controller, Plant};
 
 /// Plants by content fingerprint (the journal's `plant_fingerprint`), as `Job::plant` holds
 /// them.
@@ -102,33 +99,28 @@ fn recorded_controller(record: &JobRecord) -> Result<&Controller, String> {
 }
 
 /// Re-verifies controller `k` of a job of `order` and `objective` against `plant` ([`verify`]
-/// without the record: the campaign's order chaining judges controllers this way too).
+/// without the record): `design::evaluate_job` and its verdict.
 pub fn verify_controller(k: &Controller, order: usize, objective: ObjectiveKind, plant: &Plant) -> Verdict {
-    if let Err(e) = k.check_fits_order(plant, order) {
-        return Verdict::Rejected(format!("controller does not fit the job: {e}"));
-    }
-    let cl = match closed_loop(plant, k) {
-        Ok(cl) => cl,
-        Err(e) => return Verdict::Rejected(format!("closed loop: {e}")),
+    verdict(evaluate_job(None, plant, k, order), objective)
+}
+
+/// The [`Verdict`] of an evaluation (`design::Evaluation::verdict`).
+fn verdict(evaluation: Result<Evaluation, Rejection>, objective: ObjectiveKind) -> Verdict {
+    let e = match evaluation {
+        Ok(e) => e,
+        Err(why) => return Verdict::Rejected(why.to_string()),
     };
-    let (domain, s) = (plant.domain, plant.domain.stability_symbol());
-    let alpha_cl = verified_stability_measure(domain, cl.a.as_ref());
-    if !is_stable_with_margin(alpha_cl, cl.a.as_ref()) {
-        let margin = stability_margin(cl.a.as_ref());
-        return Verdict::Rejected(format!("closed loop not stable ({s} = {alpha_cl}, must be below −{margin:.1e})"));
+    match e.verdict(objective) {
+        Ok(gamma) => Verdict::Verified {
+            gamma,
+            alpha_cl: e.worst_loop_measure(),
+            alpha_k: e.controller.stability.map(|s| s.measure),
+            k_hinf: e.controller.hinf,
+            controller_stable: e.controller.is_stable(),
+            plants: e.values,
+        },
+        Err(why) => Verdict::Rejected(why.to_string()),
     }
-    let alpha_k = (k.order() > 0).then(|| verified_stability_measure(domain, k.ak.as_ref()));
-    let controller_stable = alpha_k.is_none_or(|a| is_stable_with_margin(a, k.ak.as_ref()));
-    if !controller_stable && objective == ObjectiveKind::Strong {
-        let (a, margin) = (alpha_k.unwrap_or(f64::NAN), stability_margin(k.ak.as_ref()));
-        return Verdict::Rejected(format!("controller not stable ({s} of A_K = {a}, must be below −{margin:.1e})"));
-    }
-    let gamma = hinf_norm_in(domain, &cl, &HinfParams::default()).expect("no stop hook is set").value;
-    if !gamma.is_finite() {
-        return Verdict::Rejected(format!("γ not finite ({gamma})"));
-    }
-    let k_hinf = controller_hinf_grad(k, DEFAULT_HINF_TOL).0.value;
-    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf, controller_stable, plants: Vec::new() }
 }
 
 /// Re-verifies one record's controller against every plant of `problem` ([`verify`] on each, a
@@ -145,34 +137,10 @@ pub fn verify_problem(record: &JobRecord, problem: &Problem) -> Verdict {
 
 /// [`verify_problem`] of controller `k` of a job of `order` and `objective` (without the record).
 pub fn verify_problem_controller(k: &Controller, order: usize, objective: ObjectiveKind, problem: &Problem) -> Verdict {
-    let mut alpha_cl = f64::NEG_INFINITY;
-    let mut first = None;
-    for t in &problem.terms {
-        match verify_controller(k, order, objective, &t.plant) {
-            Verdict::Rejected(why) => return Verdict::Rejected(format!("plant {}: {why}", t.plant.name)),
-            Verdict::Verified { alpha_cl: a, alpha_k, k_hinf, controller_stable, .. } => {
-                alpha_cl = alpha_cl.max(a);
-                first.get_or_insert((alpha_k, k_hinf, controller_stable));
-            }
-        }
+    match problem.terms.first() {
+        Some(t) => verdict(evaluate_job(Some(problem), &t.plant, k, order), objective),
+        None => Verdict::Rejected("no plant".into()),
     }
-    let Some((alpha_k, k_hinf, controller_stable)) = first else {
-        return Verdict::Rejected("no plant".into());
-    };
-    let plants = plant_values(problem, k, DEFAULT_HINF_TOL);
-    if let Some(v) = plants.iter().find(|v| !v.bound_met()) {
-        return Verdict::Rejected(format!(
-            "plant {}: bound violated (w·g = {} > {})",
-            v.plant,
-            crate::numeric::readable(v.weighted()),
-            crate::numeric::readable(v.bound.unwrap_or(f64::NAN))
-        ));
-    }
-    let gamma = problem_gamma(&plants);
-    if !gamma.is_finite() {
-        return Verdict::Rejected(format!("γ not finite ({gamma})"));
-    }
-    Verdict::Verified { gamma, alpha_cl, alpha_k, k_hinf, controller_stable, plants }
 }
 
 /// A record verified against its plant (`plants`) or its problem of several plants (`problems`);

@@ -39,7 +39,7 @@ use super::options::DesignOptions;
 use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
 use super::scaling::{from_scaled, to_scaled};
 use budget::{ctl_stop, improves, stop_of, GsRounds};
-use plan::NextStart;
+use plan::{NextStart, StartPlan};
 
 pub use budget::{GS_RESERVE, GS_RESERVE_FACTOR};
 pub use plan::ALTERNATE_PERIOD;
@@ -123,7 +123,24 @@ struct State<'s> {
     refinements: usize,
 }
 
-impl State<'_> {
+impl<'s> State<'s> {
+    /// The state before the first start.
+    fn new(opts: &'s DesignOptions) -> Self {
+        let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
+        State {
+            opts,
+            stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
+            perf: None,
+            stab: None,
+            stabilised: false,
+            stall: 0,
+            improved_cpu: 0.0,
+            perf_cut: false,
+            continued: false,
+            refinements: 0,
+        }
+    }
+
     fn evals(&self) -> usize {
         self.stats.iter().map(|s| s.evals).sum()
     }
@@ -247,19 +264,7 @@ impl Search<'_, '_, '_> {
     ) -> Result<SearchResult, DesignError> {
         let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
         let mut search_ctl = self.ctl.sub_budget(reserve, reserve);
-        let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
-        let mut st = State {
-            opts,
-            stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
-            perf: None,
-            stab: None,
-            stabilised: false,
-            stall: 0,
-            improved_cpu: 0.0,
-            perf_cut: false,
-            continued: false,
-            refinements: 0,
-        };
+        let mut st = State::new(opts);
         let mut stop = None;
         let full_ctl = self.ctl;
         let returning = opts.return_gs_reserve && opts.gradient_sampling;
@@ -326,8 +331,7 @@ impl Search<'_, '_, '_> {
             stop = s.filter(|_| !(returning && st.stabilised && share_only && !rounds.done));
         }
         let stop = stop.unwrap_or(SearchStop::Starts);
-        let (k, kinds, coords) = (plan.made(), plan.kinds, plan.coords);
-        let truncated = k < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
+        let truncated = plan.made() < hifoo_starts && matches!(stop, SearchStop::Budget | SearchStop::Maxevals);
 
         // Gradient sampling from the best stable point, under the whole budget (unless it already
         // ran from it).
@@ -337,12 +341,28 @@ impl Search<'_, '_, '_> {
         {
             rounds.ran |= self.gs_incumbent(&mut st, full_ctl)?;
         }
+        Ok(self.result(st, first, plan, stop, truncated, rounds.ran))
+    }
+
+    /// What the search produced, once it has ended with `stop` after `plan`'s local searches:
+    /// the best points (the f_s one defaults to the first of the first starts, `first`), the phases' counters
+    /// (gradient sampling's if it ran, `gs_ran`, or refined near-misses) and the summary.
+    fn result(
+        &mut self,
+        st: State<'_>,
+        first: &[Vec<f64>],
+        plan: StartPlan,
+        stop: SearchStop,
+        truncated: bool,
+        gs_ran: bool,
+    ) -> SearchResult {
+        let (k, kinds, coords) = (plan.made(), plan.kinds, plan.coords);
         let [s0, s1, s2] = st.stats;
         let mut phases = vec![s0];
         if st.stabilised {
             phases.push(s1);
         }
-        if rounds.ran || st.refinements > 0 {
+        if gs_ran || st.refinements > 0 {
             phases.push(s2);
         }
         let stab = st.stab.unwrap_or_else(|| Best {
@@ -369,7 +389,7 @@ impl Search<'_, '_, '_> {
             evals_to_best: reached.map_or(0, |r| r.evals),
             stop,
         };
-        Ok(SearchResult { perf: st.perf, stab, stabilised: st.stabilised, phases, summary, truncated })
+        SearchResult { perf: st.perf, stab, stabilised: st.stabilised, phases, summary, truncated }
     }
 }
 

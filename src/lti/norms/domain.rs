@@ -19,11 +19,14 @@ use super::gradient::{
     closed_loop_abscissa_grad, closed_loop_hinf_grad_continuous, closed_loop_radius_grad, controller_abscissa_grad,
     controller_hinf_grad_continuous, controller_radius_grad, ControllerGradient,
 };
-use super::hinf::{hinf_norm, HinfNorm, HinfParams};
+use super::h2::{closed_loop_h2_grad, closed_loop_h2_grad_discrete};
+use super::hinf::{hinf_norm, hinf_norm_with_poles, HinfNorm, HinfParams};
 use crate::lti::error::LtiError;
 use crate::lti::interrupt::Interrupted;
+use crate::lti::kernels::balance::balanced_for_eigenvalues;
 use crate::lti::kernels::spectral::{
     abscissa_of, radius_of, spectral_abscissa, spectral_radius, verified_spectral_abscissa, verified_spectral_radius,
+    STABILITY_MARGIN_RTOL,
 };
 use crate::lti::system::controller::Controller;
 use crate::lti::system::plant::Plant;
@@ -48,6 +51,39 @@ pub fn verified_stability_measure(domain: TimeDomain, a: MatRef<'_, f64>) -> f64
     match domain {
         TimeDomain::Continuous => verified_spectral_abscissa(a),
         TimeDomain::Discrete { .. } => verified_spectral_radius(a) - 1.0,
+    }
+}
+
+/// The stability measure of a state matrix A as verification computes it, with its margin: the
+/// one verification of stability (of a closed loop or of a controller), so that A is balanced
+/// once for both numbers.
+///
+/// With B the balanced A where balancing pays (`kernels::balance::balanced_for_eigenvalues`),
+/// else A itself: `measure` is s(B) (α, or ρ − 1 in discrete time: bit for bit
+/// [`verified_stability_measure`]), `margin` is
+/// [`STABILITY_MARGIN_RTOL`](crate::lti::STABILITY_MARGIN_RTOL) · max(1, ‖B‖_F) (bit for bit
+/// [`stability_margin`](crate::lti::stability_margin)), and A is stable with the verification
+/// margin when s < −margin ([`VerifiedStability::is_stable`], as
+/// [`is_stable_with_margin`](crate::lti::is_stable_with_margin)).
+pub fn verified_stability(domain: TimeDomain, a: MatRef<'_, f64>) -> VerifiedStability {
+    let balanced = balanced_for_eigenvalues(a);
+    let b = balanced.as_ref().map_or(a, |b| b.as_ref());
+    VerifiedStability { measure: stability_measure(domain, b), margin: STABILITY_MARGIN_RTOL * b.norm_l2().max(1.0) }
+}
+
+/// A stability measure and its verification margin ([`verified_stability`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerifiedStability {
+    /// s(A): α(A), or ρ(A) − 1 in discrete time (of the balanced A where balancing pays).
+    pub measure: f64,
+    /// The verification margin of A (> 0).
+    pub margin: f64,
+}
+
+impl VerifiedStability {
+    /// Stable with the margin: s < −margin (NaN is not stable; −∞, an empty matrix, is).
+    pub fn is_stable(&self) -> bool {
+        self.measure < -self.margin
     }
 }
 
@@ -87,6 +123,32 @@ pub fn hinf_norm_in(domain: TimeDomain, sys: &StateSpace, params: &HinfParams<'_
     match domain {
         TimeDomain::Continuous => hinf_norm(sys, params),
         TimeDomain::Discrete { .. } => hinf_norm_discrete(sys, params),
+    }
+}
+
+/// [`hinf_norm_in`] when the poles (eigenvalues of `sys.a`) are already known, shared with the
+/// stability test: in continuous time they serve the norm (`hinf_norm_with_poles`; the data must
+/// be finite, and `params.stop` is first polled after the stability test), the discrete-time norm
+/// computes its own.
+pub(crate) fn hinf_norm_with_poles_in(
+    domain: TimeDomain,
+    sys: &StateSpace,
+    poles: &[c64],
+    params: &HinfParams<'_>,
+) -> Result<HinfNorm, Interrupted> {
+    match domain {
+        TimeDomain::Continuous => hinf_norm_with_poles(sys, poles, params),
+        TimeDomain::Discrete { .. } => hinf_norm_discrete(sys, params),
+    }
+}
+
+/// ‖Tzw‖₂ of the closed loop in the plant's domain and its gradient with respect to the
+/// controller ([`closed_loop_h2_grad`](crate::lti::closed_loop_h2_grad), or
+/// [`closed_loop_h2_grad_discrete`](crate::lti::closed_loop_h2_grad_discrete)).
+pub fn closed_loop_h2_grad_in(plant: &Plant, k: &Controller) -> Result<(f64, ControllerGradient), LtiError> {
+    match plant.domain {
+        TimeDomain::Continuous => closed_loop_h2_grad(plant, k),
+        TimeDomain::Discrete { .. } => closed_loop_h2_grad_discrete(plant, k),
     }
 }
 

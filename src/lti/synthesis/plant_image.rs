@@ -8,6 +8,8 @@
 //! values are kept. So continuous-time synthesis on the image (γ_opt, the central controller,
 //! balanced truncation) is discrete-time synthesis on the plant.
 
+use std::borrow::Cow;
+
 use faer::Mat;
 
 use super::full_order::linalg::{concat_cols, concat_rows};
@@ -16,6 +18,17 @@ use crate::lti::system::controller::Controller;
 use crate::lti::system::plant::Plant;
 use crate::lti::system::state_space::StateSpace;
 use crate::lti::system::time_domain::TimeDomain;
+
+/// The continuous-time plant on which `plant`'s questions about stable controllers are asked:
+/// `plant` itself in continuous time, its bilinear image ([`PlantImage`]: stable controllers and
+/// stabilising ones correspond) in discrete time. A discrete-time plant without an image
+/// ([`ImageError`]) is taken as it is.
+pub fn continuous_time_image(plant: &Plant) -> Cow<'_, Plant> {
+    match plant.domain {
+        TimeDomain::Continuous => Cow::Borrowed(plant),
+        TimeDomain::Discrete { .. } => PlantImage::new(plant).map_or(Cow::Borrowed(plant), |i| Cow::Owned(i.plant)),
+    }
+}
 
 /// A discrete-time plant's continuous-time image.
 #[derive(Debug, Clone)]
