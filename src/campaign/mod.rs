@@ -85,4 +85,4 @@ pub use trace::{
     iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,
     TraceIteration, TraceSummary, TraceWriter, ITER_TOPIC, RESULT_TOPIC,
 };
-pub use trace_filter::{Keep, SparseFilter, TraceLevel, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO};
+pub use trace_filter::TraceLevel;

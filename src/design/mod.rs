@@ -5,7 +5,9 @@
 //! * `starts`: seeded random starts, perturbations of an initial controller, warm-start padding;
 //! * `central_start`: reduced-order full-order-central-controller starts;
 //! * `objective`: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
-//!   observer adapter;
+//!   observer adapter (the optimiser's iteration record extended with the design's);
+//! * `observe`: the iteration record, the observer trait, the best value so far and the observer
+//!   modes (every iteration, every k-th, on improvement, throttled, sparse);
 //! * `phases`: the optimiser options of the two phases;
 //! * `structure`: structured controllers (entries of Ak, Bk, Ck, Dk fixed at values);
 //! * `scaling`: plant-scaled controller variables x = d ∘ x̃ for the search;
@@ -19,6 +21,7 @@ mod components;
 mod float_serde;
 mod multi_objective;
 pub(crate) mod objective;
+mod observe;
 mod options;
 mod outcome;
 pub(crate) mod params;
@@ -42,9 +45,13 @@ pub use options::{
     DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES, DEFAULT_REFINE_RTOL,
     DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
+pub use observe::{
+    BestSoFar, DesignIterRecord, DesignObserver, Improvement, Keep, ModeFilter, NoDesignObserver, ObserverMode,
+    Observed, SparseFilter, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO,
+};
 pub use outcome::{
-    Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError,
-    NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary, StartKind,
+    Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,
+    StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use problem::{

@@ -19,9 +19,10 @@ use super::objective::{
     ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
 };
 use super::options::{DesignOptions, ObjectiveKind, VariableScaling};
+use super::observe::DesignObserver;
 use super::outcome::{
-    Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop,
-    SearchSummary, StartKind,
+    Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,
+    StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
 use super::problem::{
