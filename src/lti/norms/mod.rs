@@ -13,5 +13,6 @@ pub(crate) mod domain;
 pub(crate) mod gradient;
 pub(crate) mod h2;
 pub(crate) mod hinf;
+mod hinf_hooks;
 pub(crate) mod sigma;
 pub(crate) mod stability_radius;
