@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use hinfix::campaign::{iter_message, summarise, ITER_TOPIC, RESULT_TOPIC};
 use hinfix::campaign::{read_journal, JobRecord, JobStatus, JournalWriter, SCHEMA_VERSION};
 use hinfix::design::{f64_from_json, DesignIterRecord, Phase, SearchStop};
-use hinfix::optim::{Iteration, SolverKind};
 use hinfix::lti::Controller;
+use hinfix::optim::{Iteration, SolverKind};
 use serde_json::Value;
 
 fn fixture(name: &str) -> PathBuf {
@@ -287,7 +287,8 @@ fn trace_messages_of_2980e60_summarise() {
     assert_eq!(s.final_gamma, Some(final_gamma));
     assert_eq!(s.final_status.as_deref(), Some("converged"));
 
-    let it = Iteration { solver: SolverKind::Bfgs, start: 0, iter: 1, f: 2.0, dnorm: 0.1, step: 1.0, evals: 1, cpu_s: 0.0 };
+    let it =
+        Iteration { solver: SolverKind::Bfgs, start: 0, iter: 1, f: 2.0, dnorm: 0.1, step: 1.0, evals: 1, cpu_s: 0.0 };
     let rec = DesignIterRecord {
         phase: Phase::Optimisation,
         it,

@@ -108,8 +108,15 @@ impl JobRunner for FakeRunner {
                 cpu_s,
             };
             let improved = best.offer(Phase::Optimisation, Improvement { f, cpu_s, evals });
-            let rec =
-                DesignIterRecord { phase: Phase::Optimisation, it, gamma: f, k_hinf: 1.0, alpha_cl: -1.0, alpha_k: -1.0, improved };
+            let rec = DesignIterRecord {
+                phase: Phase::Optimisation,
+                it,
+                gamma: f,
+                k_hinf: 1.0,
+                alpha_cl: -1.0,
+                alpha_k: -1.0,
+                improved,
+            };
             if obs.on_iter(&rec) == ControlFlow::Break(()) {
                 status = DesignStatus::Interrupted;
                 break;

@@ -41,7 +41,7 @@ use std::time::{Duration, Instant};
 use super::jobs::{Job, JobId};
 use super::provenance::Provenance;
 use super::record::{JobFailure, JobRecord};
-use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, ObserverMode, Observed, Phase};
+use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, Observed, ObserverMode, Phase};
 use crate::lti::Controller;
 use crate::optim::thread_cpu_time;
 

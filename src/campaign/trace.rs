@@ -50,9 +50,9 @@ use super::jobs::Job;
 use super::record::JobRecord;
 use super::scheduler::{no_observers, JobObserver, ObserverError};
 use super::trace_filter::TraceLevel;
-use crate::design::{DesignIterRecord, DesignObserver, ModeFilter, ObserverMode};
 #[cfg(doc)]
 use crate::design::SparseFilter;
+use crate::design::{DesignIterRecord, DesignObserver, ModeFilter, ObserverMode};
 
 /// Topic of the per-iteration channel.
 pub const ITER_TOPIC: &str = "/hinfix/iterations";

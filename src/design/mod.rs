@@ -39,15 +39,15 @@ pub use objective::{
     ComponentCache, Components, DesignObjective, ObjectivePhase, ObserverAdapter, COMPONENT_CACHE_LEN,
     MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
 };
+pub use observe::{
+    BestSoFar, DesignIterRecord, DesignObserver, Improvement, Keep, ModeFilter, NoDesignObserver, Observed,
+    ObserverMode, SparseFilter, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO,
+};
 pub(crate) use options::design_option_table;
 pub use options::{
     options_markdown, DesignOptions, ObjectiveKind, OptionRow, OptionValue, UnknownVariableScaling, VariableScaling,
     DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES, DEFAULT_REFINE_RTOL,
     DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
-};
-pub use observe::{
-    BestSoFar, DesignIterRecord, DesignObserver, Improvement, Keep, ModeFilter, NoDesignObserver, ObserverMode,
-    Observed, SparseFilter, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO,
 };
 pub use outcome::{
     Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,

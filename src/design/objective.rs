@@ -553,7 +553,14 @@ impl<'a, 'p> ObserverAdapter<'a, 'p> {
     /// An adapter for `inner`, reading components from `objective`'s cache.
     pub fn new(inner: &'a mut dyn DesignObserver, objective: &DesignObjective<'p>, phase: Phase) -> Self {
         let objective_for_misses = objective.sibling();
-        ObserverAdapter { inner, objective_for_misses, phase, evals_base: 0, interrupted: false, best: BestSoFar::new() }
+        ObserverAdapter {
+            inner,
+            objective_for_misses,
+            phase,
+            evals_base: 0,
+            interrupted: false,
+            best: BestSoFar::new(),
+        }
     }
 
     /// Reports the iterations of `objective` as `phase` from now on (one adapter serves a whole

@@ -18,8 +18,8 @@ use super::central_start::central_starts;
 use super::objective::{
     ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
 };
-use super::options::{DesignOptions, ObjectiveKind, VariableScaling};
 use super::observe::DesignObserver;
+use super::options::{DesignOptions, ObjectiveKind, VariableScaling};
 use super::outcome::{
     Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,
     StartKind,

@@ -24,7 +24,7 @@ use super::outcome::Phase;
 use crate::optim::Iteration;
 
 pub use best::{BestSoFar, Improvement};
-pub use mode::{ModeFilter, ObserverMode, Observed};
+pub use mode::{ModeFilter, Observed, ObserverMode};
 pub use sparse::{Keep, SparseFilter, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO};
 
 /// One iteration as a design observer sees it: the optimiser's [`Iteration`] (its evaluation

@@ -78,13 +78,13 @@
 
 use faer::{c64, Mat};
 
+use super::hinf_hooks::{measured, note, timed, NormEvent, Step};
 use crate::lti::interrupt::{Interrupt, Interrupted};
 use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
 use crate::lti::kernels::level_set_pencil::pencil_crossings;
 use crate::lti::kernels::spectral::eigenvalues;
 use crate::lti::kernels::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
-use super::hinf_hooks::{measured, note, timed, NormEvent, Step};
 use crate::lti::system::state_space::StateSpace;
 
 /// Default relative tolerance of [`hinf_norm`].

@@ -4,8 +4,8 @@
 //! the `test-support` feature, into the recorded norms of `benches/lti.rs --record`
 //! (`lti::kernel_bench`). No computed value depends on it.
 
-pub(crate) use crate::lti::kernels::step_stats::{timed, Step};
 use crate::lti::kernels::step_stats::{count, for_order};
+pub(crate) use crate::lti::kernels::step_stats::{timed, Step};
 use crate::lti::system::state_space::StateSpace;
 
 /// What happened in a norm computation, as far as the benchmarks care.
