@@ -22,7 +22,7 @@ use std::sync::OnceLock;
 use hinfix::campaign::parse_journal;
 use hinfix::campaign::JobRecord;
 use hinfix::campaign::{expand, Campaign, RunnerTag};
-use hinfix::campaign::{summarise_bytes, TraceError, TraceLevel, TraceWriter};
+use hinfix::campaign::{summarise_bytes, TraceError, TraceWriter};
 use hinfix::design::{
     validate, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats, Structure,
 };
