@@ -18,8 +18,8 @@ use sha2::{Digest, Sha256};
 use super::jobs::{Job, RunnerTag};
 use super::scheduler::{JobRunner, JobStarts};
 use crate::design::{
-    BestSoFar, Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Improvement,
-    Phase, PhaseStats, SearchStop, SearchSummary,
+    BestSoFar, Certificate, Components, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus,
+    Improvement, Phase, PhaseStats, SearchStop, SearchSummary,
 };
 use crate::lti::Controller;
 use crate::optim::{Iteration, SolverKind};
@@ -108,15 +108,8 @@ impl JobRunner for FakeRunner {
                 cpu_s,
             };
             let improved = best.offer(Phase::Optimisation, Improvement { f, cpu_s, evals });
-            let rec = DesignIterRecord {
-                phase: Phase::Optimisation,
-                it,
-                gamma: f,
-                k_hinf: 1.0,
-                alpha_cl: -1.0,
-                alpha_k: -1.0,
-                improved,
-            };
+            let c = Components { f, gamma: f, k_hinf: 1.0, alpha_cl: -1.0, alpha_k: -1.0 };
+            let rec = DesignIterRecord::new(Phase::Optimisation, it, &c, improved);
             if obs.on_iter(&rec) == ControlFlow::Break(()) {
                 status = DesignStatus::Interrupted;
                 break;

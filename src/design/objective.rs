@@ -620,15 +620,7 @@ impl Observer for ObserverAdapter<'_, '_> {
             (Phase::Optimisation, SolverKind::GradientSampling) => Phase::GradientSampling,
             (p, _) => p,
         };
-        let out = DesignIterRecord {
-            phase,
-            it: Iteration { evals, ..rec.it },
-            gamma: c.gamma,
-            k_hinf: c.k_hinf,
-            alpha_cl: c.alpha_cl,
-            alpha_k: c.alpha_k,
-            improved,
-        };
+        let out = DesignIterRecord::new(phase, Iteration { evals, ..rec.it }, &c, improved);
         let flow = self.inner.on_iter(&out);
         if flow.is_break() {
             self.interrupted = true;

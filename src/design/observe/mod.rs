@@ -20,6 +20,7 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
+use super::components::Components;
 use super::outcome::Phase;
 use crate::optim::Iteration;
 
@@ -49,6 +50,15 @@ pub struct DesignIterRecord {
     /// Whether f lowered the best value so far of its objective (stabilisation, or performance
     /// in the other phases) in this run ([`BestSoFar`]).
     pub improved: bool,
+}
+
+impl DesignIterRecord {
+    /// The optimiser's iteration `it` extended: its `phase`, the components `c` at the iterate
+    /// (f is `it`'s) and whether f is a new best of its objective.
+    pub fn new(phase: Phase, it: Iteration, c: &Components, improved: bool) -> Self {
+        let Components { gamma, k_hinf, alpha_cl, alpha_k, f: _ } = *c;
+        DesignIterRecord { phase, it, gamma, k_hinf, alpha_cl, alpha_k, improved }
+    }
 }
 
 impl std::ops::Deref for DesignIterRecord {

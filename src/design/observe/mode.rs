@@ -138,21 +138,14 @@ impl<O: DesignObserver> DesignObserver for Observed<O> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::design::Phase;
+    use crate::design::{Components, Phase};
     use crate::optim::{Iteration, SolverKind};
 
     fn rec(iter: usize, f: f64, improved: bool) -> DesignIterRecord {
         let it =
             Iteration { solver: SolverKind::Bfgs, start: 0, iter, f, dnorm: 1.0, step: 1.0, evals: iter, cpu_s: 0.0 };
-        DesignIterRecord {
-            phase: Phase::Optimisation,
-            it,
-            gamma: f,
-            k_hinf: 1.0,
-            alpha_cl: -1.0,
-            alpha_k: -1.0,
-            improved,
-        }
+        let c = Components { f, gamma: f, k_hinf: 1.0, alpha_cl: -1.0, alpha_k: -1.0 };
+        DesignIterRecord::new(Phase::Optimisation, it, &c, improved)
     }
 
     fn passed(mode: ObserverMode, recs: &[DesignIterRecord]) -> Vec<usize> {
