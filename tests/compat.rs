@@ -10,6 +10,7 @@ use hinfix::campaign::{iter_message, summarise, ITER_TOPIC, RESULT_TOPIC};
 use hinfix::campaign::{read_journal, JobRecord, JobStatus, JournalWriter, SCHEMA_VERSION};
 use hinfix::design::{f64_from_json, DesignIterRecord, Phase, SearchStop};
 use hinfix::lti::Controller;
+use hinfix::optim::{Iteration, SolverKind};
 use serde_json::Value;
 
 fn fixture(name: &str) -> PathBuf {
@@ -286,19 +287,16 @@ fn trace_messages_of_2980e60_summarise() {
     assert_eq!(s.final_gamma, Some(final_gamma));
     assert_eq!(s.final_status.as_deref(), Some("converged"));
 
+    let it =
+        Iteration { solver: SolverKind::Bfgs, start: 0, iter: 1, f: 2.0, dnorm: 0.1, step: 1.0, evals: 1, cpu_s: 0.0 };
     let rec = DesignIterRecord {
         phase: Phase::Optimisation,
-        start: 0,
-        iter: 1,
-        f: 2.0,
+        it,
         gamma: 2.0,
         k_hinf: 3.0,
         alpha_cl: -1.0,
         alpha_k: -1.0,
-        dnorm: 0.1,
-        step: 1.0,
-        evals: 1,
-        cpu_s: 0.0,
+        improved: true,
     };
     let m = iter_message(&rec);
     assert_eq!((m["gamma"].as_f64(), m["k_hinf"].as_f64()), (Some(2.0), Some(3.0)));

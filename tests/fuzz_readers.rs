@@ -22,7 +22,7 @@ use std::sync::OnceLock;
 use hinfix::campaign::parse_journal;
 use hinfix::campaign::JobRecord;
 use hinfix::campaign::{expand, Campaign, RunnerTag};
-use hinfix::campaign::{summarise_bytes, TraceError, TraceLevel, TraceWriter};
+use hinfix::campaign::{summarise_bytes, TraceError, TraceWriter};
 use hinfix::design::{
     validate, ControllerShape, DesignOptions, DesignOutcome, DesignStatus, ObjectiveKind, Phase, PhaseStats, Structure,
 };
@@ -395,22 +395,27 @@ fn trace_bytes() -> &'static [u8] {
     static T: OnceLock<Vec<u8>> = OnceLock::new();
     T.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let mut w = TraceWriter::create(dir.path(), "job", TraceLevel::Full).unwrap();
+        let mut w = TraceWriter::create(dir.path(), "job", hinfix::design::ObserverMode::Always).unwrap();
         for i in 0..30 {
             let x = i as f64;
-            w.record_iter(&hinfix::design::DesignIterRecord {
-                phase: if i < 10 { Phase::Stabilisation } else { Phase::Optimisation },
+            let it = hinfix::optim::Iteration {
+                solver: hinfix::optim::SolverKind::Bfgs,
                 start: i / 20,
                 iter: i % 20,
                 f: 1.0 / (1.0 + x),
-                gamma: if i < 10 { f64::INFINITY } else { 2.0 - x / 100.0 },
-                k_hinf: f64::NAN,
-                alpha_cl: -x,
-                alpha_k: f64::NAN,
                 dnorm: 1e-3,
                 step: 1.0,
                 evals: 2 * i,
                 cpu_s: x / 10.0,
+            };
+            w.record_iter(&hinfix::design::DesignIterRecord {
+                phase: if i < 10 { Phase::Stabilisation } else { Phase::Optimisation },
+                it,
+                gamma: if i < 10 { f64::INFINITY } else { 2.0 - x / 100.0 },
+                k_hinf: f64::NAN,
+                alpha_cl: -x,
+                alpha_k: f64::NAN,
+                improved: true,
             })
             .unwrap();
         }

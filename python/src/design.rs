@@ -147,7 +147,7 @@ impl DesignObserver for Watcher {
     }
 
     fn on_iter(&mut self, r: &DesignIterRecord) -> std::ops::ControlFlow<()> {
-        if r.phase != hinfix::design::Phase::Stabilisation && r.f < self.best {
+        if r.phase != hinfix::design::Phase::Stabilisation && r.improved {
             self.best = r.f;
         }
         let p = Progress {

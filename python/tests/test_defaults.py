@@ -78,3 +78,27 @@ def test_the_commands_help_shows_the_same_defaults():
                 assert want == value, (name, want, value)
             compared += 1
     assert compared >= 10, (compared, sorted(shown))
+
+
+# The problem arguments of design(); every other keyword is a design option.
+_NOT_OPTIONS = {"P", "nmeas", "ncon", "objective", "weight", "bound", "structure", "strong", "init", "progress",
+                "search_options"}
+
+
+def test_every_keyword_of_design_is_an_option_of_the_table():
+    """Options declared once: the keywords design() names are options of the crate's table (the
+    others reach it through **search_options), and every option of the table is accepted as a
+    keyword at its default, which it keeps."""
+    import inspect
+    import json
+
+    from hinfix._design import options_json
+    names = hinfix.option_names()
+    named = set(inspect.signature(hinfix.design).parameters) - _NOT_OPTIONS
+    assert named <= set(names), sorted(named - set(names))
+    d = hinfix.default_options()
+    for name in names:
+        if name in ("order", "objective"):  # the positional order and strong=
+            continue
+        given = json.loads(options_json(1, None, {name: d[name]}))
+        assert name in given or d[name] is None, name

@@ -43,7 +43,7 @@ pub use leaves::reference::{
     PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV,
 };
 pub use leaves::sanitise::for_terminal;
-pub use leaves::trace_filter::{Keep, SparseFilter, TraceLevel, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO};
+pub use leaves::trace_filter::TraceLevel;
 pub use model::jobs::{
     chained_job_id, expand, job_id, problem_fingerprint, problem_job_id, Job, JobId, ProblemKey, RunnerTag,
     JOB_ID_VERSION,

@@ -5,7 +5,9 @@
 //! * `starts`: seeded random starts, perturbations of an initial controller, warm-start padding;
 //! * `central_start`: reduced-order full-order-central-controller starts;
 //! * `objective`: max(α(Acl), ε·α(Ak)) and max(‖Tzw‖∞, ε‖K‖∞) as optimiser objectives, and the
-//!   observer adapter;
+//!   observer adapter (the optimiser's iteration record extended with the design's);
+//! * `observe`: the iteration record, the observer trait, the best value so far and the observer
+//!   modes (every iteration, every k-th, on improvement, throttled, sparse);
 //! * `phases`: the optimiser options of the two phases;
 //! * `structure`: structured controllers (entries of Ak, Bk, Ck, Dk fixed at values);
 //! * `scaling`: plant-scaled controller variables x = d ∘ x̃ for the search;
@@ -26,6 +28,7 @@ mod evaluate;
 mod float_serde;
 mod multi_objective;
 pub(crate) mod objective;
+mod observe;
 mod options;
 mod outcome;
 pub(crate) mod params;
@@ -48,6 +51,10 @@ pub use objective::{
     ComponentCache, Components, DesignObjective, ObjectivePhase, ObserverAdapter, COMPONENT_CACHE_LEN,
     MIN_ORDER_FOR_INTERRUPT, MIN_ORDER_FOR_REJECTION,
 };
+pub use observe::{
+    BestSoFar, DesignIterRecord, DesignObserver, Improvement, Keep, ModeFilter, NoDesignObserver, Observed,
+    ObserverMode, SparseFilter, IMPROVE_RTOL, SAMPLE_CPU_S, SAMPLE_RATIO,
+};
 pub(crate) use options::design_option_table;
 pub use options::{
     options_markdown, DesignOptions, ObjectiveKind, OptionRow, OptionValue, UnknownVariableScaling, VariableScaling,
@@ -55,8 +62,8 @@ pub use options::{
     DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
-    Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, InitError,
-    NoDesignObserver, Phase, PhaseStats, SearchStop, SearchSummary, StartKind,
+    Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,
+    StartKind,
 };
 pub use params::{controller_to_x, x_to_controller, ControllerShape};
 pub use problem::{

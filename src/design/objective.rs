@@ -44,11 +44,12 @@ use crate::lti::{
     hinf_lower_bound_sharing, stability_measure, Controller, ControllerGradient, HinfParams, Interrupt, LtiError,
     Plant, ResponseSlot,
 };
-use crate::optim::{thread_cpu_time, IterRecord, Objective, Observer, SolverKind};
+use crate::optim::{thread_cpu_time, IterRecord, Iteration, Objective, Observer, SolverKind};
 
 pub use super::components::Components;
 use super::multi_objective;
-use super::outcome::{DesignIterRecord, DesignObserver, Phase};
+use super::observe::{BestSoFar, DesignIterRecord, DesignObserver, Improvement};
+use super::outcome::Phase;
 use super::params::ControllerShape;
 use super::problem::{H2Feedthrough, Problem};
 use super::structure::Structure;
@@ -522,8 +523,10 @@ impl Objective for DesignObjective<'_> {
     }
 }
 
-/// Translates the optimiser's [`IterRecord`]s into [`DesignIterRecord`]s for a
-/// [`DesignObserver`], with the objective's components taken from the [`ComponentCache`].
+/// Extends the optimiser's [`IterRecord`]s into [`DesignIterRecord`]s for a
+/// [`DesignObserver`]: the design's phase, the run-wide evaluation count, the objective's
+/// components taken from the [`ComponentCache`], and whether f is a new best of its objective
+/// (the run's one [`BestSoFar`], which the search also asks for its time to best).
 ///
 /// Missing components: if x is no longer cached (e.g. after many gradient-sampling samples) it is
 /// evaluated again without gradient; in the performance phase α(Acl) (one eigenvalue computation
@@ -535,24 +538,14 @@ pub struct ObserverAdapter<'a, 'p> {
     phase: Phase,
     evals_base: usize,
     interrupted: bool,
-    improvements: [Vec<Improvement>; 2],
+    best: BestSoFar,
 }
 
-/// An iterate that lowered the best objective value seen so far (per objective).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Improvement {
-    /// The objective value.
-    pub f: f64,
-    /// CPU seconds since the run started.
-    pub cpu_s: f64,
-    /// Evaluations made in the run so far.
-    pub evals: usize,
-}
-
-fn slot(p: ObjectivePhase) -> usize {
+/// The phase whose objective `p` is, as [`BestSoFar`] files it.
+fn objective_phase(p: ObjectivePhase) -> Phase {
     match p {
-        ObjectivePhase::Stabilisation => 0,
-        ObjectivePhase::Performance => 1,
+        ObjectivePhase::Stabilisation => Phase::Stabilisation,
+        ObjectivePhase::Performance => Phase::Optimisation,
     }
 }
 
@@ -566,7 +559,7 @@ impl<'a, 'p> ObserverAdapter<'a, 'p> {
             phase,
             evals_base: 0,
             interrupted: false,
-            improvements: [Vec::new(), Vec::new()],
+            best: BestSoFar::new(),
         }
     }
 
@@ -580,8 +573,7 @@ impl<'a, 'p> ObserverAdapter<'a, 'p> {
     /// The first iterate of objective `phase` whose value was within a relative `rtol` of `f`
     /// (|f_i − f| ≤ rtol·|f|, or below f): when the value f was first reached.
     pub fn first_reached(&self, phase: ObjectivePhase, f: f64, rtol: f64) -> Option<Improvement> {
-        let tol = rtol * f.abs();
-        self.improvements[slot(phase)].iter().find(|i| i.f <= f + tol).copied()
+        self.best.first_reached(objective_phase(phase), f, rtol)
     }
 
     /// Sets the number of evaluations made in the run before the next optimiser call.
@@ -605,10 +597,9 @@ impl Observer for ObserverAdapter<'_, '_> {
         if self.interrupted {
             return ControlFlow::Break(());
         }
-        let hist = &mut self.improvements[slot(self.objective_for_misses.phase)];
-        if rec.f.is_finite() && hist.last().is_none_or(|last| rec.f < last.f) {
-            hist.push(Improvement { f: rec.f, cpu_s: rec.cpu_s, evals: self.evals_base + rec.evals });
-        }
+        let evals = self.evals_base + rec.evals;
+        let reached = Improvement { f: rec.f, cpu_s: rec.cpu_s, evals };
+        let improved = self.best.offer(objective_phase(self.objective_for_misses.phase), reached);
         let wants = self.inner.wants_components();
         let obj = &self.objective_for_misses;
         let cached = obj.cache.borrow().lookup(rec.x);
@@ -629,20 +620,7 @@ impl Observer for ObserverAdapter<'_, '_> {
             (Phase::Optimisation, SolverKind::GradientSampling) => Phase::GradientSampling,
             (p, _) => p,
         };
-        let out = DesignIterRecord {
-            phase,
-            start: rec.start,
-            iter: rec.iter,
-            f: rec.f,
-            gamma: c.gamma,
-            k_hinf: c.k_hinf,
-            alpha_cl: c.alpha_cl,
-            alpha_k: c.alpha_k,
-            dnorm: rec.dnorm,
-            step: rec.step,
-            evals: self.evals_base + rec.evals,
-            cpu_s: rec.cpu_s,
-        };
+        let out = DesignIterRecord::new(phase, Iteration { evals, ..rec.it }, &c, improved);
         let flow = self.inner.on_iter(&out);
         if flow.is_break() {
             self.interrupted = true;

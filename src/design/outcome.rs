@@ -1,8 +1,4 @@
-//! What a design run returns and what its observers see.
-
-use std::ops::ControlFlow;
-use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
+//! What a design run returns.
 
 use serde::{Deserialize, Serialize};
 
@@ -287,65 +283,6 @@ pub struct DesignOutcome {
     /// one plant's H∞ norm (`design::Design::new`); empty for the single-plant H∞ design.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plants: Vec<super::problem::PlantValue>,
-}
-
-/// One iteration as seen by a design observer (the campaign's trace writer).
-#[derive(Debug, Clone, Serialize)]
-pub struct DesignIterRecord {
-    /// Phase.
-    pub phase: Phase,
-    /// Index of the starting point.
-    pub start: usize,
-    /// Iteration within this start and phase.
-    pub iter: usize,
-    /// Objective value.
-    pub f: f64,
-    /// ‖Tzw‖∞ at the iterate (+∞ if unstable; NaN if not computed in this phase).
-    pub gamma: f64,
-    /// ‖K‖∞ at the iterate (NaN if not computed).
-    pub k_hinf: f64,
-    /// α(A_cl).
-    pub alpha_cl: f64,
-    /// α(Ak) (NaN for order 0).
-    pub alpha_k: f64,
-    /// Certificate norm.
-    pub dnorm: f64,
-    /// Line-search step.
-    pub step: f64,
-    /// Evaluations so far in the run.
-    pub evals: usize,
-    /// CPU seconds since the run started.
-    pub cpu_s: f64,
-}
-
-/// Watches a design run; `Break` stops it (status `Interrupted`).
-pub trait DesignObserver {
-    /// Whether the records should carry ‖Tzw‖∞, ‖K‖∞, α(Acl), α(Ak) even where that costs an
-    /// extra computation (α(Acl) in the optimisation phase: one eigenvalue computation per
-    /// iteration). Default true; [`NoDesignObserver`] says false.
-    fn wants_components(&self) -> bool {
-        true
-    }
-
-    /// Called once per optimiser iteration.
-    fn on_iter(&mut self, _rec: &DesignIterRecord) -> ControlFlow<()> {
-        ControlFlow::Continue(())
-    }
-
-    /// A cancel flag that [`Design::run`](super::Design::run) attaches to its `RunControl`, so that setting it
-    /// stops the run inside a long evaluation, not only at the next iteration (`on_iter`
-    /// returning `Break` takes effect only there). Default: none.
-    fn cancel_flag(&self) -> Option<Arc<AtomicBool>> {
-        None
-    }
-}
-
-/// An observer that watches nothing.
-pub struct NoDesignObserver;
-impl DesignObserver for NoDesignObserver {
-    fn wants_components(&self) -> bool {
-        false
-    }
 }
 
 /// A design run that could not produce a trustworthy result.

@@ -19,10 +19,11 @@ use super::central_start::central_starts;
 use super::objective::{
     ComponentCache, DesignObjective, ObjectivePhase, ObserverAdapter, StopHook, MIN_ORDER_FOR_INTERRUPT,
 };
+use super::observe::DesignObserver;
 use super::options::{DesignOptions, ObjectiveKind, VariableScaling};
 use super::outcome::{
-    Certificate, DesignError, DesignObserver, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop,
-    SearchSummary, StartKind,
+    Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,
+    StartKind,
 };
 use super::params::{controller_to_x, ControllerShape};
 use super::problem::{

@@ -19,14 +19,14 @@ use super::control::RunControl;
 use super::error::OptimError;
 use super::gradsamp::gradient_sampling;
 use super::objective::Objective;
-use super::observer::{IterRecord, Observer};
+use super::observer::{IterRecord, Iteration, Observer};
 use super::options::HansoOptions;
 use super::solver::{check_dims, OptimResult};
 use super::termination::Termination;
 use rand::RngCore;
 
 /// Passes each record on with the evaluations of the call's earlier runs added, so that
-/// [`IterRecord::evals`] counts the whole `hanso` call.
+/// [`Iteration::evals`] counts the whole `hanso` call.
 struct EvalsBefore<'o> {
     inner: &'o mut dyn Observer,
     evals: usize,
@@ -34,7 +34,7 @@ struct EvalsBefore<'o> {
 
 impl Observer for EvalsBefore<'_> {
     fn on_iter(&mut self, rec: &IterRecord<'_>) -> std::ops::ControlFlow<()> {
-        self.inner.on_iter(&IterRecord { evals: self.evals + rec.evals, ..*rec })
+        self.inner.on_iter(&IterRecord { it: Iteration { evals: self.evals + rec.evals, ..rec.it }, ..*rec })
     }
 }
 

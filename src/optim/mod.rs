@@ -46,7 +46,7 @@ pub use gradsamp::{gradient_sampling, GradSampState, GS_MAX_CONTRACT, GS_MIN_STE
 #[cfg(any(test, feature = "test-support"))]
 pub use hanso::{hanso, HansoResult};
 pub use objective::{FnObjective, Objective};
-pub use observer::{FnObserver, IterRecord, NoObserver, Observer, SolverKind};
+pub use observer::{FnObserver, IterRecord, Iteration, NoObserver, Observer, SolverKind};
 pub use options::{BfgsOptions, GradSampOptions, HansoOptions, NGRAD_CAP};
 pub use qp::{min_norm_clarabel, min_norm_dense, min_norm_in_hull, MinNormResult, QpMethod};
 pub use solver::OptimResult;

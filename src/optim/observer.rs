@@ -1,6 +1,8 @@
 //! Watching a run: one [`IterRecord`] per iteration to an [`Observer`], which may stop the run
-//! (`ControlFlow::Break` ⇒ `Termination::Interrupted`) but never change it. Trace writers and
-//! progress bars live outside `optim` and implement this trait; `optim` does no I/O.
+//! (`ControlFlow::Break` ⇒ `Termination::Interrupted`) but never change it. The record's scalar
+//! part, [`Iteration`], is the iteration record every layer above passes on (`design` extends it
+//! with its phase and the objective's components; `design::DesignIterRecord`). Trace writers and
+//! progress bars live outside `optim` and implement `design`'s observer trait; `optim` does no I/O.
 
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
@@ -15,17 +17,16 @@ pub enum SolverKind {
     GradientSampling,
 }
 
-/// What an observer sees after every iteration (borrowed from the solver state).
-#[derive(Debug, Clone, Copy)]
-pub struct IterRecord<'a> {
+/// One iteration, as every observer sees it (owned, so that the layers above can keep it and
+/// pass it on).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Iteration {
     /// Which solver.
     pub solver: SolverKind,
     /// Index of the starting point (0 for a single run and for gradient sampling).
     pub start: usize,
     /// Iteration number, 1-based (0 is the starting point, reported once before the first step).
     pub iter: usize,
-    /// Current point.
-    pub x: &'a [f64],
     /// f(x).
     pub f: f64,
     /// Norm of the smallest vector in the convex hull of the current gradient bundle.
@@ -36,6 +37,23 @@ pub struct IterRecord<'a> {
     pub evals: usize,
     /// CPU seconds since the `RunControl` was created.
     pub cpu_s: f64,
+}
+
+/// What an observer sees after every iteration: the [`Iteration`] and the current point
+/// (borrowed from the solver state). Derefs to the [`Iteration`].
+#[derive(Debug, Clone, Copy)]
+pub struct IterRecord<'a> {
+    /// Current point.
+    pub x: &'a [f64],
+    /// The iteration's numbers.
+    pub it: Iteration,
+}
+
+impl std::ops::Deref for IterRecord<'_> {
+    type Target = Iteration;
+    fn deref(&self) -> &Iteration {
+        &self.it
+    }
 }
 
 /// Receives every iteration; return `Break` to stop the run (`Termination::Interrupted`).

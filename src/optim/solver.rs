@@ -5,7 +5,7 @@
 use super::control::RunControl;
 use super::error::OptimError;
 use super::objective::{Evaluator, Objective};
-use super::observer::{IterRecord, Observer, SolverKind};
+use super::observer::{IterRecord, Iteration, Observer, SolverKind};
 use super::termination::Termination;
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
@@ -88,15 +88,17 @@ fn norm(x: &[f64]) -> f64 {
 /// What the observer sees of state `s` at iteration `iter` (`step`: this iteration's step length).
 fn record<'s, S: Solver>(s: &'s S::State, start: usize, iter: usize, step: f64, ev: &Evaluator<'_>) -> IterRecord<'s> {
     IterRecord {
-        solver: S::KIND,
-        start,
-        iter,
         x: s.x(),
-        f: s.f(),
-        dnorm: s.dnorm(),
-        step,
-        evals: ev.evals,
-        cpu_s: ev.ctl.cpu_elapsed(),
+        it: Iteration {
+            solver: S::KIND,
+            start,
+            iter,
+            f: s.f(),
+            dnorm: s.dnorm(),
+            step,
+            evals: ev.evals,
+            cpu_s: ev.ctl.cpu_elapsed(),
+        },
     }
 }
 

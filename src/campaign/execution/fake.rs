@@ -18,10 +18,11 @@ use sha2::{Digest, Sha256};
 use super::scheduler::{JobRunner, JobStarts};
 use crate::campaign::model::jobs::{Job, RunnerTag};
 use crate::design::{
-    Certificate, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus, Phase, PhaseStats,
-    SearchStop, SearchSummary,
+    BestSoFar, Certificate, Components, DesignError, DesignIterRecord, DesignObserver, DesignOutcome, DesignStatus,
+    Improvement, Phase, PhaseStats, SearchStop, SearchSummary,
 };
 use crate::lti::Controller;
+use crate::optim::{Iteration, SolverKind};
 
 /// The environment variable the fake binary reads its pause between fake iterations from, in
 /// milliseconds (unset, empty or unparsable: [`DEFAULT_PAUSE_MS`]).
@@ -90,24 +91,25 @@ impl JobRunner for FakeRunner {
         }
         let mut status = DesignStatus::Converged;
         let mut iters = 0;
+        let mut best = BestSoFar::new();
         for iter in 0..FAKE_ITERS {
             std::thread::sleep(self.pause);
             iters += 1;
             let f = gamma * (1.0 + (FAKE_ITERS - 1 - iter) as f64 / FAKE_ITERS as f64);
-            let rec = DesignIterRecord {
-                phase: Phase::Optimisation,
+            let (evals, cpu_s) = (iter + 1, 0.0);
+            let it = Iteration {
+                solver: SolverKind::Bfgs,
                 start: 0,
                 iter: iter + 1,
                 f,
-                gamma: f,
-                k_hinf: 1.0,
-                alpha_cl: -1.0,
-                alpha_k: -1.0,
                 dnorm: 1.0 / (1.0 + iter as f64),
                 step: 1.0,
-                evals: iter + 1,
-                cpu_s: 0.0,
+                evals,
+                cpu_s,
             };
+            let improved = best.offer(Phase::Optimisation, Improvement { f, cpu_s, evals });
+            let c = Components { f, gamma: f, k_hinf: 1.0, alpha_cl: -1.0, alpha_k: -1.0 };
+            let rec = DesignIterRecord::new(Phase::Optimisation, it, &c, improved);
             if obs.on_iter(&rec) == ControlFlow::Break(()) {
                 status = DesignStatus::Interrupted;
                 break;

@@ -41,7 +41,7 @@ use std::time::{Duration, Instant};
 use crate::campaign::leaves::provenance::Provenance;
 use crate::campaign::model::jobs::{Job, JobId};
 use crate::campaign::records::record::{JobFailure, JobRecord};
-use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, Phase};
+use crate::design::{DesignError, DesignIterRecord, DesignObserver, DesignOutcome, Observed, ObserverMode, Phase};
 use crate::lti::Controller;
 use crate::optim::thread_cpu_time;
 
@@ -131,12 +131,10 @@ impl<E> Coordinator<E> for Solo {
 /// How long a job found claimed elsewhere is left alone before it is tried again.
 pub const BUSY_RETRY: Duration = Duration::from_secs(5);
 
-/// Watches one job on its worker (the trace writer is one).
-pub trait JobObserver: Send {
-    /// Called once per optimiser iteration; `Break` stops the job (status `Interrupted`).
-    fn on_iter(&mut self, _rec: &DesignIterRecord) -> ControlFlow<()> {
-        ControlFlow::Continue(())
-    }
+/// Watches one job on its worker (the trace writer is one): a [`DesignObserver`] of the job's
+/// run (its `on_iter` gets the run's records as they are; `Break` stops the job, status
+/// `Interrupted`), also told how the job ended.
+pub trait JobObserver: DesignObserver + Send {
     /// The job finished with `record` (which is journaled next). An error becomes a warning.
     fn finish(self: Box<Self>, _record: &JobRecord) -> Result<(), ObserverError> {
         Ok(())
@@ -173,6 +171,7 @@ impl ObserverError {
 /// A factory that observes nothing.
 pub fn no_observers(_: &Job) -> Result<Box<dyn JobObserver>, ObserverError> {
     struct Nothing;
+    impl DesignObserver for Nothing {}
     impl JobObserver for Nothing {}
     Ok(Box::new(Nothing))
 }
@@ -699,15 +698,28 @@ struct StartedJob<'a> {
     chained: Option<(JobId, Controller)>,
 }
 
-/// The observer a job actually runs with: the user's (trace), progress events, cancellation.
+/// The observer a job actually runs with: the user's (trace), progress events (throttled:
+/// [`ObserverMode::Throttled`] by the progress interval), cancellation.
 struct WorkerObserver<'a> {
     user: Option<Box<dyn JobObserver>>,
+    progress: Observed<ProgressEvents<'a>>,
     cancel: &'a Arc<AtomicBool>,
+}
+
+/// Sends a progress event of each iteration it is told of to the scheduler thread.
+struct ProgressEvents<'a> {
     tx: &'a mpsc::Sender<WorkerMsg>,
     index: usize,
     worker: usize,
-    interval: Duration,
-    last_sent: Option<Instant>,
+}
+
+impl DesignObserver for ProgressEvents<'_> {
+    fn on_iter(&mut self, rec: &DesignIterRecord) -> ControlFlow<()> {
+        let (index, worker) = (self.index, self.worker);
+        let (phase, iter, f, gamma) = (rec.phase, rec.iter, rec.f, rec.gamma);
+        let _ = self.tx.send(WorkerMsg::Progress { index, worker, phase, iter, f, gamma });
+        ControlFlow::Continue(())
+    }
 }
 
 impl DesignObserver for WorkerObserver<'_> {
@@ -716,17 +728,7 @@ impl DesignObserver for WorkerObserver<'_> {
             Some(u) => u.on_iter(rec),
             None => ControlFlow::Continue(()),
         };
-        if self.last_sent.is_none_or(|t| t.elapsed() >= self.interval) {
-            self.last_sent = Some(Instant::now());
-            let _ = self.tx.send(WorkerMsg::Progress {
-                index: self.index,
-                worker: self.worker,
-                phase: rec.phase,
-                iter: rec.iter,
-                f: rec.f,
-                gamma: rec.gamma,
-            });
-        }
+        let _ = self.progress.on_iter(rec);
         if self.cancel.load(Ordering::Relaxed) {
             return ControlFlow::Break(());
         }
@@ -775,15 +777,9 @@ impl WorkerContext<'_> {
         job: &StartedJob<'_>,
         user: Option<Box<dyn JobObserver>>,
     ) -> (Result<DesignOutcome, JobFailure>, Option<Box<dyn JobObserver>>) {
-        let mut obs = WorkerObserver {
-            user,
-            cancel: self.cancel,
-            tx: &self.tx,
-            index: job.index,
-            worker: self.worker,
-            interval: self.progress_interval,
-            last_sent: None,
-        };
+        let progress = ProgressEvents { tx: &self.tx, index: job.index, worker: self.worker };
+        let progress = Observed::new(ObserverMode::Throttled(self.progress_interval), progress);
+        let mut obs = WorkerObserver { user, progress, cancel: self.cancel };
         let starts = JobStarts { warm: job.init.as_ref(), chained: job.chained.as_ref().map(|(_, k)| k) };
         let result = match catch_unwind(AssertUnwindSafe(|| self.runner.run(job.job, starts, &mut obs))) {
             Ok(Ok(out)) => Ok(out),

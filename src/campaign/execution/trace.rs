@@ -4,8 +4,10 @@
 //! `jsonschema`):
 //! * [`ITER_TOPIC`] — one message per optimiser iteration ([`iter_message`]: phase, start,
 //!   iteration, f, ‖Tzw‖∞ as `gamma`, ‖K‖∞ as `k_hinf` (older builds: `hinf_cl`, `hinf_k`),
-//!   α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds) at trace level `full`; at level
-//!   `sparse` (the default) only the iterations [`SparseFilter`] keeps. A message's MCAP
+//!   α_cl, α_K, dnorm, step, evaluations, elapsed CPU seconds) at trace level `full` (observer
+//!   mode [`ObserverMode::Always`]); at level `sparse` (the default; [`ObserverMode::Sparse`])
+//!   only the iterations [`SparseFilter`] keeps: the writer is a [`DesignObserver`] with a mode
+//!   ([`TraceLevel::mode`]), as any other. A message's MCAP
 //!   sequence number is its index among all the iterations, so a sparse trace's gaps show what
 //!   was left out ([`TraceSummary::offered`]);
 //! * [`RESULT_TOPIC`] — one final message, the job's [`JobRecord`] as journaled (with its
@@ -27,7 +29,7 @@
 //! well: a short job's sparse trace is one chunk, and the smoke campaign's sparse chunks shrink to
 //! about 27 % of their JSON (campaigns/FORMAT.md, "Traces").
 //!
-//! The writer ([`TraceWriter`], a [`JobObserver`]) writes `<job_id>.mcap.<host>.<pid>.tmp` (a
+//! The writer ([`TraceWriter`], a [`JobObserver`], i.e. a [`DesignObserver`] told how the job ended) writes `<job_id>.mcap.<host>.<pid>.tmp` (a
 //! name no other process uses, even on another machine sharing the folder), and on `finish`
 //! renames it atomically to `<job_id>.mcap`; `abandon` deletes the tmp file, so a cut-off run never leaves a
 //! complete-looking trace. The job's claim is held while it runs, so on creation the leftover
@@ -45,10 +47,12 @@ use std::time::{Duration, Instant};
 use serde_json::{json, Value};
 
 use super::scheduler::{no_observers, JobObserver, ObserverError};
-use crate::campaign::leaves::trace_filter::{SparseFilter, TraceLevel};
+use crate::campaign::leaves::trace_filter::TraceLevel;
 use crate::campaign::model::jobs::Job;
 use crate::campaign::records::record::JobRecord;
-use crate::design::DesignIterRecord;
+#[cfg(doc)]
+use crate::design::SparseFilter;
+use crate::design::{DesignIterRecord, DesignObserver, ModeFilter, ObserverMode};
 
 /// Topic of the per-iteration channel.
 pub const ITER_TOPIC: &str = "/hinfix/iterations";
@@ -188,8 +192,8 @@ struct Stamped {
 /// Writes one job's trace; see the module doc.
 pub struct TraceWriter {
     writer: Option<mcap::Writer<BufWriter<File>>>,
-    /// `None`: every iteration (level `full`).
-    filter: Option<SparseFilter<Stamped>>,
+    /// Which iterations are written (the observer mode of the trace level).
+    filter: ModeFilter<Stamped>,
     tmp: PathBuf,
     target: PathBuf,
     iter_channel: u16,
@@ -207,9 +211,9 @@ pub struct TraceWriter {
 impl TraceWriter {
     /// Creates `<dir>/<job_id>.mcap.<host>.<pid>.tmp` (and `dir`), deleting other tmp files of
     /// the job (the caller runs the job, so they are leftovers), and writes the header, schemas
-    /// and channels. `level` [`TraceLevel::Sparse`] writes the iterations [`SparseFilter`]
-    /// keeps, any other level every iteration (`off` is the factory's: it makes no writer).
-    pub fn create(dir: &Path, job_id: &str, level: TraceLevel) -> Result<Self, TraceError> {
+    /// and channels. It writes the iterations that `mode` passes on (a trace level's:
+    /// [`TraceLevel::mode`]).
+    pub fn create(dir: &Path, job_id: &str, mode: ObserverMode) -> Result<Self, TraceError> {
         let target = dir.join(format!("{job_id}.mcap"));
         let host = crate::campaign::leaves::provenance::host_name();
         let tmp = dir.join(format!("{job_id}.mcap.{host}.{}.tmp", std::process::id()));
@@ -244,7 +248,7 @@ impl TraceWriter {
         let result_channel = w.add_channel(s_res, RESULT_TOPIC, "json", &meta).map_err(mc)?;
         Ok(TraceWriter {
             writer: Some(w),
-            filter: (level == TraceLevel::Sparse).then(SparseFilter::new),
+            filter: ModeFilter::new(mode),
             tmp,
             target,
             iter_channel,
@@ -297,25 +301,22 @@ impl TraceWriter {
         self.flush_if_due()
     }
 
-    /// Takes one iteration: writes it (level `full`), or gives it to the filter and writes what
-    /// that releases.
+    /// Takes one iteration: gives it to the mode's filter (stamped with its sequence number and
+    /// time of arrival) and writes what that passes on.
     pub fn record_iter(&mut self, rec: &DesignIterRecord) -> Result<(), TraceError> {
         let (seq, log_time) = self.stamp();
         let s = Stamped { seq, log_time, rec: rec.clone() };
-        match self.filter.as_mut() {
-            None => self.write_iter(s),
-            Some(f) => f.push(rec, s).into_iter().try_for_each(|s| self.write_iter(s)),
-        }
+        self.filter.push(rec, s).into_iter().try_for_each(|s| self.write_iter(s))
     }
 
-    /// Writes the iteration the filter still holds (the last one), the final result, finishes
+    /// Writes the iterations the filter still holds (the last one), the final result, finishes
     /// the file, fsyncs it and renames it into place.
     pub fn complete(mut self, record: &JobRecord) -> Result<PathBuf, TraceError> {
         if let Some(e) = self.error.take() {
             let _ = std::fs::remove_file(&self.tmp);
             return Err(e);
         }
-        for held in self.filter.as_mut().map(SparseFilter::finish).unwrap_or_default() {
+        for held in self.filter.finish() {
             self.write_iter(held)?;
         }
         let data = serde_json::to_value(record).map_err(|source| TraceError::Json {
@@ -348,7 +349,7 @@ impl TraceWriter {
     }
 }
 
-impl JobObserver for TraceWriter {
+impl DesignObserver for TraceWriter {
     fn on_iter(&mut self, rec: &DesignIterRecord) -> ControlFlow<()> {
         if self.error.is_none() {
             if let Err(e) = self.record_iter(rec) {
@@ -359,7 +360,9 @@ impl JobObserver for TraceWriter {
         }
         ControlFlow::Continue(())
     }
+}
 
+impl JobObserver for TraceWriter {
     fn finish(self: Box<Self>, record: &JobRecord) -> Result<(), ObserverError> {
         self.complete(record).map(|_| ()).map_err(ObserverError::failed)
     }
@@ -378,9 +381,9 @@ pub fn trace_observers(
     levels: Vec<TraceLevel>,
 ) -> impl Fn(&Job) -> Result<Box<dyn JobObserver>, ObserverError> + Sync {
     let dir = traces_dir.to_path_buf();
-    move |job: &Job| match levels.get(job.problem).copied().unwrap_or_default() {
-        TraceLevel::Off => no_observers(job),
-        level => TraceWriter::create(&dir, &job.id.0, level)
+    move |job: &Job| match levels.get(job.problem).copied().unwrap_or_default().mode() {
+        None => no_observers(job),
+        Some(mode) => TraceWriter::create(&dir, &job.id.0, mode)
             .map(|w| Box::new(w) as Box<dyn JobObserver>)
             .map_err(ObserverError::failed),
     }
@@ -677,7 +680,7 @@ mod tests {
     fn log_times_are_unix_epoch_times() {
         let dir = tempfile::tempdir().unwrap();
         let before = unix_now_ns();
-        let mut w = TraceWriter::create(dir.path(), "job", TraceLevel::Full).unwrap();
+        let mut w = TraceWriter::create(dir.path(), "job", ObserverMode::Always).unwrap();
         let (_, t0) = w.stamp();
         let (_, t1) = w.stamp();
         let after = unix_now_ns();

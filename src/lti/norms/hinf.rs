@@ -78,13 +78,13 @@
 
 use faer::{c64, Mat};
 
+use super::hinf_hooks::{measured, note, timed, NormEvent, Step};
 use crate::lti::interrupt::{Interrupt, Interrupted};
 use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
 use crate::lti::kernels::level_set_pencil::pencil_crossings;
 use crate::lti::kernels::spectral::eigenvalues;
 use crate::lti::kernels::square_reduced::{hamiltonian_squared_eigenvalues, LowRank, SquaredSpectrum};
-use crate::lti::kernels::step_stats::{count, for_order, timed, Step};
 use crate::lti::system::state_space::StateSpace;
 
 /// Default relative tolerance of [`hinf_norm`].
@@ -243,22 +243,19 @@ pub(crate) fn hinf_norm_reusing(
 ) -> Result<(HinfNorm, Option<FreqResponse>), Interrupted> {
     let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
     stop.poll()?;
-    for_order(sys.order(), || {
-        timed(Step::Norm, || {
-            let mut fr = kept;
-            let poles = if sys.order() >= HESSENBERG_QR_FROM {
-                #[cfg(feature = "test-support")]
-                crate::lti::kernel_bench::note_norm(sys, tol, hints);
-                fr.get_or_insert_with(|| FreqResponse::new(sys)).poles()
-            } else {
-                timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
-            };
-            let norm = match poles {
-                Some(poles) => hinf_norm_from(sys, &poles, &mut fr, tol, hints, stop, enough)?,
-                None => HinfNorm::UNSTABLE,
-            };
-            Ok((norm, fr))
-        })
+    measured(sys, Step::Norm, || {
+        let mut fr = kept;
+        let poles = if sys.order() >= HESSENBERG_QR_FROM {
+            note(NormEvent::Large { sys, tol, hints });
+            fr.get_or_insert_with(|| FreqResponse::new(sys)).poles()
+        } else {
+            timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
+        };
+        let norm = match poles {
+            Some(poles) => hinf_norm_from(sys, &poles, &mut fr, tol, hints, stop, enough)?,
+            None => HinfNorm::UNSTABLE,
+        };
+        Ok((norm, fr))
     })
 }
 
@@ -285,26 +282,24 @@ pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, sl
     if !sys.is_finite() {
         return f64::INFINITY;
     }
-    for_order(sys.order(), || {
-        timed(Step::LowerBound, || {
-            let mut fr = FreqResponse::new(sys);
-            let mut best = Best { gamma: fr.sigma_max(f64::INFINITY), freq: f64::INFINITY };
-            let mut tested = vec![0.0];
-            if wanted > f64::NEG_INFINITY {
-                best.offer(0.0, fr.sigma_max(0.0));
-            }
-            for &w in freqs.iter().filter(|w| !w.is_nan()) {
-                best.offer(w.abs(), fr.sigma_max(w.abs()));
-                tested.push(w.abs());
-            }
-            if best.gamma < wanted {
-                let climb = Climb { max_evals: SCREEN_CLIMB_MAX_EVALS, enough: wanted, ..Climb::FULL };
-                let (w0, s0) = (best.freq, best.gamma);
-                refine_from(&mut fr, &mut best, &tested, w0, s0, climb);
-            }
-            slot.keep(sys, fr);
-            best.gamma
-        })
+    measured(sys, Step::LowerBound, || {
+        let mut fr = FreqResponse::new(sys);
+        let mut best = Best { gamma: fr.sigma_max(f64::INFINITY), freq: f64::INFINITY };
+        let mut tested = vec![0.0];
+        if wanted > f64::NEG_INFINITY {
+            best.offer(0.0, fr.sigma_max(0.0));
+        }
+        for &w in freqs.iter().filter(|w| !w.is_nan()) {
+            best.offer(w.abs(), fr.sigma_max(w.abs()));
+            tested.push(w.abs());
+        }
+        if best.gamma < wanted {
+            let climb = Climb { max_evals: SCREEN_CLIMB_MAX_EVALS, enough: wanted, ..Climb::FULL };
+            let (w0, s0) = (best.freq, best.gamma);
+            refine_from(&mut fr, &mut best, &tested, w0, s0, climb);
+        }
+        slot.keep(sys, fr);
+        best.gamma
     })
 }
 
@@ -317,7 +312,7 @@ pub(crate) fn hinf_norm_with_poles(
     params: &HinfParams<'_>,
 ) -> Result<HinfNorm, Interrupted> {
     let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
-    for_order(sys.order(), || timed(Step::Norm, || hinf_norm_from(sys, poles, &mut None, tol, hints, stop, enough)))
+    measured(sys, Step::Norm, || hinf_norm_from(sys, poles, &mut None, tol, hints, stop, enough))
 }
 
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
@@ -397,41 +392,7 @@ fn hinf_norm_from(
         // γ_L rose by more than rounding (AB13DD's safeguard: otherwise the crossings or probes
         // were spurious).
         let raised = |best: &Best| best.gamma >= before * (1.0 + 0.1 * tol);
-        let mut mids: Vec<f64> = Vec::with_capacity(ws.len() + 2);
-        // σ(∞) = σmax(D) < γ, so an odd count means a crossing was lost, and it may lie in any
-        // interval: also look in [0, w₁] (NN5 in `tests/hinf_regression.rs`: the crossing just
-        // above ω = 0 was lost, 1.5e-4 low) and above the last one.
-        if ws.len() % 2 == 1 && ws[0] > 0.0 {
-            mids.push(0.5 * ws[0]);
-        }
-        if ws.len() == 1 {
-            mids.push(ws[0]);
-        }
-        for pair in ws.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
-            // The pencil maps crossings far above its shift to ω = ∞ (or to a wrong finite ω);
-            // the geometric mean with ∞ would evaluate σ(∞) = σmax(D) < γ, so from order
-            // HESSENBERG_QR_FROM on look above a on a ladder (a peak at 9e3 rad/s was missed, 2 %
-            // low; one at 1.4e7 rad/s, 4e-10 above σmax(D), was still missed with 2a alone; below
-            // that order kept as it was, bit for bit).
-            let above = !b.is_finite() && sys.order() >= HESSENBERG_QR_FROM;
-            if above && a > 0.0 && a.is_finite() {
-                high_frequency_ladder(sys, sigma_d, gamma, a, &mut mids);
-            } else if a > 0.0 {
-                mids.push((a * b).sqrt());
-            } else {
-                mids.push(0.5 * b);
-            }
-        }
-        if ws.len() % 2 == 1 {
-            let last = ws[ws.len() - 1];
-            if last > 0.0 && last.is_finite() {
-                mids.push(2.0 * last);
-            }
-        }
-        // An eigenvalue just off the axis may be a near-tangent pair of crossings that rounding
-        // moved off it (`LevelSet::probes`); σmax at its frequency tells, with an attained value.
-        mids.extend(&probes);
+        let mids = midpoints(sys, sigma_d, gamma, &ws, &probes);
         let mut scan: Vec<(f64, f64)> = Vec::with_capacity(mids.len());
         for &w in &mids {
             let s = fr.sigma_max(w);
@@ -440,16 +401,15 @@ fn hinf_norm_from(
         }
         seen.extend(ws.iter().chain(&mids).copied().filter(|w| w.is_finite()));
         if ws.is_empty() {
-            count(Step::Probe);
+            note(NormEvent::Probed { raised: raised(&best) });
             if !raised(&best) {
                 if verify_stop(fr, &mut best, verify(&ws), &mut seen) {
                     continue;
                 }
                 break; // the probes were off any peak above γ_L
             }
-            count(Step::ProbeFound);
         } else {
-            count(Step::CrossingsFound);
+            note(NormEvent::Crossings);
         }
         let mut all = ws.clone();
         all.extend(&mids);
@@ -467,6 +427,48 @@ fn hinf_norm_from(
         }
     }
     Ok(best.norm())
+}
+
+/// Where σmax is evaluated after a level-set test at `gamma` found the crossings `ws` (sorted)
+/// and the `probes`: between each pair of crossings, and, since σ(∞) = σmax(D) < γ, where an
+/// odd count says a crossing was lost; then the probes.
+fn midpoints(sys: &StateSpace, sigma_d: f64, gamma: f64, ws: &[f64], probes: &[f64]) -> Vec<f64> {
+    let mut mids: Vec<f64> = Vec::with_capacity(ws.len() + 2);
+    // σ(∞) = σmax(D) < γ, so an odd count means a crossing was lost, and it may lie in any
+    // interval: also look in [0, w₁] (NN5 in `tests/hinf_regression.rs`: the crossing just
+    // above ω = 0 was lost, 1.5e-4 low) and above the last one.
+    if ws.len() % 2 == 1 && ws[0] > 0.0 {
+        mids.push(0.5 * ws[0]);
+    }
+    if ws.len() == 1 {
+        mids.push(ws[0]);
+    }
+    for pair in ws.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        // The pencil maps crossings far above its shift to ω = ∞ (or to a wrong finite ω);
+        // the geometric mean with ∞ would evaluate σ(∞) = σmax(D) < γ, so from order
+        // HESSENBERG_QR_FROM on look above a on a ladder (a peak at 9e3 rad/s was missed, 2 %
+        // low; one at 1.4e7 rad/s, 4e-10 above σmax(D), was still missed with 2a alone; below
+        // that order kept as it was, bit for bit).
+        let above = !b.is_finite() && sys.order() >= HESSENBERG_QR_FROM;
+        if above && a > 0.0 && a.is_finite() {
+            high_frequency_ladder(sys, sigma_d, gamma, a, &mut mids);
+        } else if a > 0.0 {
+            mids.push((a * b).sqrt());
+        } else {
+            mids.push(0.5 * b);
+        }
+    }
+    if ws.len() % 2 == 1 {
+        let last = ws[ws.len() - 1];
+        if last > 0.0 && last.is_finite() {
+            mids.push(2.0 * last);
+        }
+    }
+    // An eigenvalue just off the axis may be a near-tangent pair of crossings that rounding
+    // moved off it (`LevelSet::probes`); σmax at its frequency tells, with an attained value.
+    mids.extend(probes);
+    mids
 }
 
 /// Above this κ = γ²/(γ² − σmax(D)²) of the tested level, [`verify_stop`] also climbs the scan's
@@ -911,10 +913,10 @@ impl<'s> Hamiltonian<'s> {
             Some(level) => (level.crossings, level.probes),
             None => {
                 if try_squared {
-                    count(Step::DoubtfulSquared);
+                    note(NormEvent::DoubtfulSquared);
                 }
                 if !self.used_pencil.replace(true) {
-                    count(Step::NormUsingPencil);
+                    note(NormEvent::FirstPencil);
                 }
                 (timed(Step::PencilLevelSet, || pencil_crossings(self.sys, gamma, self.freq_scale))?, Vec::new())
             }
