@@ -12,7 +12,11 @@ use std::path::{Path, PathBuf};
 /// The files outside `src/lti` that may name `TimeDomain::`, how many times, and why (input or
 /// formatting only).
 const ALLOWED: &[(&str, usize, &str)] = &[
-    ("src/campaign/reduction/latex.rs", 1, "formatting: a table cell shows ρ = s + 1 of a discrete-time plant's measure"),
+    (
+        "src/campaign/reduction/latex.rs",
+        1,
+        "formatting: a table cell shows ρ = s + 1 of a discrete-time plant's measure",
+    ),
     ("src/cli/check.rs", 2, "formatting: the JSON keys of `check` (abscissas, or Ts and spectral radii)"),
     ("src/cli/plants.rs", 2, "formatting: the name of the plant's stability quantity in `plants`"),
     ("python/src/norms.rs", 1, "input: the domain of `hinfnorm` from its `dt` argument"),

@@ -24,8 +24,9 @@ use std::sync::Arc;
 use crate::lti::{Controller, Plant};
 use crate::optim::RunControl;
 
+use super::observe::{DesignObserver, NoDesignObserver};
 use super::options::DesignOptions;
-use super::outcome::{DesignError, DesignObserver, DesignOutcome, NoDesignObserver};
+use super::outcome::{DesignError, DesignOutcome};
 use super::problem::Problem;
 use super::structure::Structure;
 
