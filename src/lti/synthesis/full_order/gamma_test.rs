@@ -141,6 +141,9 @@ struct RiccatiCondition {
     weight: ExogenousWeight,
 }
 
+/// A Riccati solution with its eigenvalues (ascending) and eigenvectors.
+type RiccatiSolution = (Mat<f64>, Vec<f64>, Mat<f64>);
+
 impl RiccatiCondition {
     /// The solution with its eigenvalues (ascending) and eigenvectors, or the binding condition
     /// and the reason it fails at γ. `binding`: [`Binding::StateFeedback`] for X,
@@ -151,7 +154,7 @@ impl RiccatiCondition {
         a: MatRef<'_, f64>,
         b: MatRef<'_, f64>,
         gamma: f64,
-    ) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>), (Binding, String)> {
+    ) -> Result<RiccatiSolution, (Binding, String)> {
         let (name, r_name, weight_name) = if binding == Binding::StateFeedback {
             ("X", "R", "I - D11 D11'/gamma^2")
         } else {
