@@ -2,8 +2,7 @@
 //! journal, trace) goes through [`read_capped`] with a documented limit, so a wrong argument
 //! such as `/dev/zero` or a huge file is a clear error instead of reading until memory runs out.
 //! The limits are far above any real file of their kind (the largest shipped plant file is a
-//! few hundred kB). JSON inputs are parsed by [`parse_json_unique_keys`]; [`InputError`] is the
-//! part of a plant's or a controller's file error that says the reading or that parse failed.
+//! few hundred kB).
 
 use std::io::{self, Read};
 use std::path::Path;
@@ -88,33 +87,6 @@ pub fn read_capped_string(path: &Path, limit: u64, what: &str) -> io::Result<Str
     }
     String::from_utf8(bytes)
         .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not UTF-8 text ({})", e.utf8_error())))
-}
-
-/// Why a JSON input file (a plant, a controller) could not be read or parsed: what its own error
-/// says before any check of its content. Both are part of the message, not a `source` (a chain
-/// printer would repeat them).
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum InputError {
-    /// The file could not be read.
-    #[error("cannot read: {0}")]
-    Io(io::Error),
-    /// Not valid JSON.
-    #[error("invalid JSON at line {line}, column {column}: {message}")]
-    Json {
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// The parser's message.
-        message: String,
-    },
-}
-
-impl From<serde_json::Error> for InputError {
-    fn from(e: serde_json::Error) -> Self {
-        InputError::Json { line: e.line(), column: e.column(), message: e.to_string() }
-    }
 }
 
 /// Parses JSON text as `serde_json::from_str` does, but a key that appears twice in one object is

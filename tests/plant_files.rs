@@ -1,7 +1,6 @@
 //! The shipped plant library loads, and malformed plant files are rejected with errors that name
 //! the file, the field and what is wrong.
 
-use hinfix::input::InputError;
 use hinfix::lti::{MatrixJsonError, Plant, PlantErrorKind};
 use serde_json::{json, Value};
 
@@ -108,7 +107,7 @@ fn bad_plant_files_each_get_their_own_error() {
         (
             "malformed JSON",
             "{\"name\": \"T\", ".to_string(),
-            |k| matches!(k, PlantErrorKind::Input(InputError::Json { line: 1, .. })),
+            |k| matches!(k, PlantErrorKind::Json { line: 1, .. }),
             "invalid JSON at line 1",
         ),
         ("not an object", "[1, 2]".to_string(), |k| matches!(k, PlantErrorKind::NotObject), "top level"),
@@ -230,13 +229,13 @@ fn overflowing_number_is_rejected_not_panicked() {
     // 1e999 is not a finite f64; serde_json refuses it as a number.
     let text = with(|_| {}).replace("-2.0", "1e999");
     let e = Plant::from_json_str(&text, "p.json").unwrap_err();
-    assert!(matches!(e.kind, PlantErrorKind::Input(InputError::Json { .. })), "{e}");
+    assert!(matches!(e.kind, PlantErrorKind::Json { .. }), "{e}");
 }
 
 #[test]
 fn unreadable_file_is_an_io_error_naming_it() {
     let e = Plant::load("no/such/plant.json").unwrap_err();
-    assert!(matches!(e.kind, PlantErrorKind::Input(InputError::Io(_))));
+    assert!(matches!(e.kind, PlantErrorKind::Io(_)));
     assert!(e.to_string().contains("no/such/plant.json"));
 }
 

@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 use faer::Mat;
 use serde_json::{Map, Value};
 
-use crate::input::InputError;
 use crate::lti::io::mat_file::{is_mat_path, read_mat_vars, scalar_var_to_json, var_to_json, write_mat, MatReadError};
 use crate::lti::io::matrix_json::{json_shape, json_type, matrix_from_json, matrix_to_json, MatrixJsonError};
 
@@ -64,9 +63,19 @@ pub struct ControllerError {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ControllerErrorKind {
-    /// Could not be read, or is not valid JSON.
-    #[error(transparent)]
-    Input(#[from] InputError),
+    /// Could not be read.
+    #[error("cannot read: {0}")]
+    Io(std::io::Error),
+    /// Not valid JSON.
+    #[error("invalid JSON at line {line}, column {column}: {message}")]
+    Json {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Parser message.
+        message: String,
+    },
     /// A `.mat` file that is not a readable level-5 MAT-file of real matrices.
     #[error("{0}")]
     Mat(#[from] MatReadError),
@@ -152,11 +161,11 @@ impl Controller {
         if is_mat_path(path) {
             let err = |kind| ControllerError { file: path.to_path_buf(), kind };
             let bytes = crate::input::read_capped(path, crate::input::MAX_CONTROLLER_BYTES, "controller file")
-                .map_err(|e| err(InputError::Io(e).into()))?;
+                .map_err(|e| err(ControllerErrorKind::Io(e)))?;
             return controller_from_mat(&bytes).map_err(err);
         }
         let text = crate::input::read_capped_string(path, crate::input::MAX_CONTROLLER_BYTES, "controller file")
-            .map_err(|e| ControllerError { file: path.to_path_buf(), kind: InputError::Io(e).into() })?;
+            .map_err(|e| ControllerError { file: path.to_path_buf(), kind: ControllerErrorKind::Io(e) })?;
         Self::from_json_str(&text, path)
     }
 
@@ -164,7 +173,9 @@ impl Controller {
     /// (m × p) and AK (nk × nk) and every block is checked against them.
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Controller, ControllerError> {
         let err = |kind| ControllerError { file: file.as_ref().to_path_buf(), kind };
-        let doc: Value = crate::input::parse_json_unique_keys(text).map_err(|e| err(InputError::from(e).into()))?;
+        let doc: Value = crate::input::parse_json_unique_keys(text).map_err(|e| {
+            err(ControllerErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() })
+        })?;
         Self::from_json_value(&doc).map_err(err)
     }
 

@@ -27,7 +27,6 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
-use crate::input::InputError;
 use crate::lti::io::mat_file::{
     json_number, read_char_var, read_mat_vars_with_text, scalar_var_to_json, var_to_json, write_mat, MatReadError,
     MatVar,
@@ -105,9 +104,19 @@ pub struct PlantError {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum PlantErrorKind {
-    /// The file could not be read, or is not valid JSON.
-    #[error(transparent)]
-    Input(#[from] InputError),
+    /// The file could not be read.
+    #[error("cannot read: {0}")]
+    Io(std::io::Error),
+    /// Not valid JSON.
+    #[error("invalid JSON at line {line}, column {column}: {message}")]
+    Json {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The parser's message.
+        message: String,
+    },
     /// A `.mat` file that is not a readable level-5 MAT-file of real matrices.
     #[error("{0}")]
     Mat(#[from] MatReadError),
@@ -223,7 +232,7 @@ impl Plant {
         if crate::lti::io::mat_file::is_mat_path(path) {
             let err = |kind| PlantError { file: path.to_path_buf(), kind };
             let bytes = crate::input::read_capped(path, crate::input::MAX_PLANT_BYTES, "plant file")
-                .map_err(|e| err(InputError::Io(e).into()))?;
+                .map_err(|e| err(PlantErrorKind::Io(e)))?;
             return Self::from_mat_bytes(&bytes, path);
         }
         let err = |kind| PlantError { file: path.to_path_buf(), kind };
@@ -232,7 +241,7 @@ impl Plant {
             return Self::from_json_str(&text, path);
         }
         let text = crate::input::read_capped_string(path, crate::input::MAX_PLANT_BYTES, "plant file")
-            .map_err(|e| err(InputError::Io(e).into()))?;
+            .map_err(|e| err(PlantErrorKind::Io(e)))?;
         Self::from_json_str(&text, path)
     }
 
@@ -249,7 +258,8 @@ impl Plant {
     /// the dimensions are inferred from the blocks (an empty `[]` block is then a zero block).
     pub fn from_json_str(text: &str, file: impl AsRef<Path>) -> Result<Plant, PlantError> {
         let err = |kind| PlantError { file: file.as_ref().to_path_buf(), kind };
-        let mut doc: Value = crate::input::parse_json_unique_keys(text).map_err(|e| err(InputError::from(e).into()))?;
+        let mut doc: Value = crate::input::parse_json_unique_keys(text)
+            .map_err(|e| err(PlantErrorKind::Json { line: e.line(), column: e.column(), message: e.to_string() }))?;
         if let Value::Object(o) = &mut doc {
             let stem = file.as_ref().file_stem().map_or_else(|| "plant".into(), |s| s.to_string_lossy().into_owned());
             let stem = stem.strip_suffix(".json").map(str::to_string).unwrap_or(stem);
@@ -428,7 +438,7 @@ pub fn is_gzip_json_path(path: &Path) -> bool {
 fn read_gzip_text(path: &Path) -> Result<String, PlantErrorKind> {
     use std::io::Read;
     let limit = crate::input::MAX_PLANT_BYTES;
-    let bytes = crate::input::read_capped(path, limit, "plant file").map_err(InputError::Io)?;
+    let bytes = crate::input::read_capped(path, limit, "plant file").map_err(PlantErrorKind::Io)?;
     let decoder = libflate::gzip::Decoder::new(bytes.as_slice()).map_err(|e| PlantErrorKind::Gzip(e.to_string()))?;
     let mut text = Vec::new();
     decoder.take(limit + 1).read_to_end(&mut text).map_err(|e| PlantErrorKind::Gzip(e.to_string()))?;
