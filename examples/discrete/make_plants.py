@@ -12,15 +12,15 @@ Development-time only (hinfix and its tests never run Python):
 
 `campaign plant examples/discrete/HE1_Ts0.1.json` shows a plant with its full-order γ.
 """
-import json
 import os
+import sys
 
 import numpy as np
 import scipy.linalg
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-NAMES = ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22")
+sys.path.insert(0, os.path.dirname(HERE))
+import he1 as HE1  # noqa: E402  (examples/he1.py)
 
 
 def zoh(a, b, ts):
@@ -33,31 +33,21 @@ def zoh(a, b, ts):
 
 
 def main():
-    he1 = json.load(open(os.path.join(ROOT, "plants", "HE1.json")))
-    mats = {k: np.array(he1[k], dtype=float).reshape(len(he1[k]), -1) for k in NAMES}
+    he1, mats = HE1.load()
     m1 = mats["B1"].shape[1]
     for ts in (0.1, 0.01):
         ad, bd = zoh(mats["A"], np.hstack([mats["B1"], mats["B2"]]), ts)
-        doc = {
-            "name": f"HE1_Ts{ts}",
-            "description": f"COMPleib HE1 sampled with a zero-order hold on w and u at Ts = {ts} s",
-            "source": {
-                "citation": he1["source"]["citation"] + f"; zero-order hold at Ts = {ts} s",
-                "script": "examples/discrete/make_plants.py",
-            },
-            "notes": "x[t+1] = e^{A Ts} x[t] + (∫ e^{Aτ}dτ) [B1 B2] [w; u][t]; C1, C2 and the D blocks are HE1's.",
-            "Ts": ts,
-            "dims": he1["dims"],
-            "A": ad.tolist(),
-            "B1": bd[:, :m1].tolist(),
-            "B2": bd[:, m1:].tolist(),
-        }
-        for k in ("C1", "C2", "D11", "D12", "D21", "D22"):
-            doc[k] = mats[k].tolist()
-        path = os.path.join(HERE, f"HE1_Ts{ts}.json")
-        with open(path, "w") as f:
-            json.dump(doc, f, indent=1)
-            f.write("\n")
+        path = HE1.write(
+            HERE,
+            f"HE1_Ts{ts}",
+            f"COMPleib HE1 sampled with a zero-order hold on w and u at Ts = {ts} s",
+            f"zero-order hold at Ts = {ts} s",
+            "examples/discrete/make_plants.py",
+            "x[t+1] = e^{A Ts} x[t] + (∫ e^{Aτ}dτ) [B1 B2] [w; u][t]; C1, C2 and the D blocks are HE1's.",
+            he1,
+            {**mats, "A": ad, "B1": bd[:, :m1], "B2": bd[:, m1:]},
+            ts=ts,
+        )
         print(f"wrote {path}: spectral radius {max(abs(np.linalg.eigvals(ad))):.6f}")
 
 

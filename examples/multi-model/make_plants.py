@@ -13,41 +13,34 @@ Development-time only (hinfix and its tests never run Python):
 
     python3 examples/multi-model/make_plants.py     (numpy)
 """
-import json
 import os
+import sys
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-NAMES = ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22")
+sys.path.insert(0, os.path.dirname(HERE))
+import he1 as HE1  # noqa: E402  (examples/he1.py)
+
 DELTAS = (-0.2, 0.0, 0.2)
 
 
 def main():
-    he1 = json.load(open(os.path.join(ROOT, "plants", "HE1.json")))
-    mats = {k: np.array(he1[k], dtype=float).reshape(len(he1[k]), -1) for k in NAMES}
+    he1, mats = HE1.load()
     n = mats["A"].shape[0]
     r = np.round(np.random.default_rng(1).uniform(-1.0, 1.0, size=(n, n)), 2)
     for j, delta in enumerate(DELTAS, start=1):
         a = mats["A"] * (1.0 + delta * r)
-        doc = {
-            "name": f"HE1_op{j}",
-            "description": f"COMPleib HE1 at operating point {j} of 3: A ∘ (1 + {delta:+.1f}·R)",
-            "source": {
-                "citation": he1["source"]["citation"] + f"; A perturbed entrywise by {delta:+.1f}·R",
-                "script": "examples/multi-model/make_plants.py",
-            },
-            "notes": f"A_j = A ∘ (1 + δ_j R) with δ_j = {delta:+.1f} and R = {r.tolist()}; B, C, D are HE1's.",
-            "dims": he1["dims"],
-            "A": a.tolist(),
-        }
-        for k in NAMES[1:]:
-            doc[k] = mats[k].tolist()
-        path = os.path.join(HERE, f"HE1_op{j}.json")
-        with open(path, "w") as f:
-            json.dump(doc, f, indent=1)
-            f.write("\n")
+        path = HE1.write(
+            HERE,
+            f"HE1_op{j}",
+            f"COMPleib HE1 at operating point {j} of 3: A ∘ (1 + {delta:+.1f}·R)",
+            f"A perturbed entrywise by {delta:+.1f}·R",
+            "examples/multi-model/make_plants.py",
+            f"A_j = A ∘ (1 + δ_j R) with δ_j = {delta:+.1f} and R = {r.tolist()}; B, C, D are HE1's.",
+            he1,
+            {**mats, "A": a},
+        )
         print(f"wrote {path}: spectral abscissa {max(np.linalg.eigvals(a).real):+.6f}")
 
 

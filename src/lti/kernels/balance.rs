@@ -85,15 +85,21 @@ pub fn balance(a: MatRef<'_, f64>) -> (Mat<f64>, Vec<f64>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    #[test]
-    fn a_badly_scaled_matrix_is_balanced_exactly_with_the_same_eigenvalues() {
-        // A = T·M·T⁻¹ with M well scaled and T = diag(1, 1e6, 1e-6): entries up to 1e12
+    /// (M, A): A = T·M·T⁻¹ with M a well-scaled 3×3 matrix and T = diag(1, 1e6, 1e-6), so A has
+    /// the eigenvalues of M and entries up to 1e12 (this test's and `spectral`'s).
+    pub(crate) fn badly_scaled_3x3() -> (Mat<f64>, Mat<f64>) {
         let m = faer::mat![[-1.0, 2.0, 0.5], [-3.0, -1.0, 1.0], [0.25, -0.5, -2.0]];
         let t = [1.0, 1e6, 1e-6];
         let a = Mat::from_fn(3, 3, |i, j| t[i] * m[(i, j)] / t[j]);
+        (m, a)
+    }
+
+    #[test]
+    fn a_badly_scaled_matrix_is_balanced_exactly_with_the_same_eigenvalues() {
+        let (m, a) = badly_scaled_3x3();
         let (b, d) = balance(a.as_ref());
         assert!(b.norm_l2() < 10.0 * m.norm_l2(), "{:?}", b);
         assert_eq!(balanced_for_eigenvalues(a.as_ref()), Some(b.clone()));

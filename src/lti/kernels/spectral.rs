@@ -319,10 +319,8 @@ mod tests {
 
     #[test]
     fn verified_abscissa_of_a_badly_scaled_matrix_is_accurate() {
-        // A = T·M·T⁻¹, T = diag(1, 1e6, 1e-6): the same eigenvalues as M, entries up to 1e12
-        let m = faer::mat![[-1.0, 2.0, 0.5], [-3.0, -1.0, 1.0], [0.25, -0.5, -2.0]];
-        let t = [1.0, 1e6, 1e-6];
-        let a = Mat::from_fn(3, 3, |i, j| t[i] * m[(i, j)] / t[j]);
+        // A = T·M·T⁻¹: the same eigenvalues as M, entries up to 1e12
+        let (m, a) = crate::lti::kernels::balance::tests::badly_scaled_3x3();
         let alpha_m = spectral_abscissa(m.as_ref());
         assert!((verified_spectral_abscissa(a.as_ref()) - alpha_m).abs() < 1e-13);
         assert!(stability_margin(a.as_ref()) < 1e-10, "{}", stability_margin(a.as_ref()));

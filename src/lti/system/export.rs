@@ -72,49 +72,48 @@ fn python_matrix(m: MatRef<'_, f64>) -> String {
 pub fn export_code(k: &Controller, target: ExportTarget, source: &str) -> String {
     let (nk, m, p) = (k.order(), k.outputs(), k.inputs());
     let mats = [("AK", k.ak.as_ref()), ("BK", k.bk.as_ref()), ("CK", k.ck.as_ref()), ("DK", k.dk.as_ref())];
-    let mut s = String::new();
     let update = if k.domain.is_discrete() { "xk[t+1] = AK xk[t] + BK y[t]" } else { "xk' = AK xk + BK y" };
     let ts = k.domain.ts().map(|ts| number(ts, target));
-    match target {
-        ExportTarget::Matlab => {
-            s += &format!(
-                "% hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
-            );
-            s += &format!("% Sign convention: POSITIVE feedback u = K y ({update}, u = CK xk + DK y).\n");
-            s += "% Closed loop with the plant P = ss(A, [B1 B2], [C1; C2], [D11 D12; D21 D22]):\n";
-            s += "%   Tzw = lft(P, K);                 % lft keeps u = K y\n";
-            s += "%   L = feedback(P22, K, +1);        % feedback() is negative by default: use +1 (or -K)\n";
-            for (name, mat) in mats {
-                s += &format!("{name} = {};\n", matlab_matrix(mat));
-            }
-            match &ts {
-                None => s += "K = ss(AK, BK, CK, DK);\n",
-                Some(ts) => {
-                    s += &format!(
-                        "Ts = {ts};  % sampling time (s): a discrete-time controller\nK = ss(AK, BK, CK, DK, Ts);\n"
-                    )
-                }
-            }
-        }
-        ExportTarget::Python => {
-            s += &format!(
-                "# hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
-            );
-            s += &format!("# Sign convention: POSITIVE feedback u = K y ({update}, u = CK xk + DK y).\n");
-            s += "# Closed loop with P = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]), np.block([[D11, D12], [D21, D22]])):\n";
-            s += "#   Tzw = P.lft(K)                          # lower LFT, keeps u = K y\n";
-            s +=
-                "#   L = control.feedback(P22, K, sign=1)    # feedback() is negative by default: use sign=1 (or -K)\n";
-            s += "import numpy as np\nimport control\n\n";
-            for (name, mat) in mats {
-                s += &format!("{name} = {}\n", python_matrix(mat));
-            }
-            match &ts {
-                None => s += "K = control.ss(AK, BK, CK, DK)\n",
-                Some(ts) => s += &format!("Ts = {ts}  # sampling time (s): a discrete-time controller\nK = control.ss(AK, BK, CK, DK, dt=Ts)\n"),
-            }
-        }
+    let (comment, end) = match target {
+        ExportTarget::Matlab => ("%", ";"),
+        ExportTarget::Python => ("#", ""),
+    };
+    let mut s = format!(
+        "{comment} hinfix controller from {source}: order {nk}, {m} control input(s) u, {p} measurement(s) y.\n"
+    );
+    s += &format!("{comment} Sign convention: POSITIVE feedback u = K y ({update}, u = CK xk + DK y).\n");
+    s += match target {
+        ExportTarget::Matlab => concat!(
+            "% Closed loop with the plant P = ss(A, [B1 B2], [C1; C2], [D11 D12; D21 D22]):\n",
+            "%   Tzw = lft(P, K);                 % lft keeps u = K y\n",
+            "%   L = feedback(P22, K, +1);        % feedback() is negative by default: use +1 (or -K)\n",
+        ),
+        ExportTarget::Python => concat!(
+            "# Closed loop with P = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]), np.block([[D11, D12], [D21, D22]])):\n",
+            "#   Tzw = P.lft(K)                          # lower LFT, keeps u = K y\n",
+            "#   L = control.feedback(P22, K, sign=1)    # feedback() is negative by default: use sign=1 (or -K)\n",
+            "import numpy as np\nimport control\n\n",
+        ),
+    };
+    for (name, mat) in mats {
+        let text = match target {
+            ExportTarget::Matlab => matlab_matrix(mat),
+            ExportTarget::Python => python_matrix(mat),
+        };
+        s += &format!("{name} = {text}{end}\n");
     }
+    s += &match (target, &ts) {
+        (ExportTarget::Matlab, None) => "K = ss(AK, BK, CK, DK);\n".to_string(),
+        (ExportTarget::Matlab, Some(ts)) => {
+            format!("Ts = {ts};  % sampling time (s): a discrete-time controller\nK = ss(AK, BK, CK, DK, Ts);\n")
+        }
+        (ExportTarget::Python, None) => "K = control.ss(AK, BK, CK, DK)\n".to_string(),
+        (ExportTarget::Python, Some(ts)) => {
+            format!(
+                "Ts = {ts}  # sampling time (s): a discrete-time controller\nK = control.ss(AK, BK, CK, DK, dt=Ts)\n"
+            )
+        }
+    };
     s
 }
 

@@ -27,7 +27,7 @@
 //! finiteness, residual and stabilising checks); any failure there means "γ infeasible".
 //!
 
-use faer::Mat;
+use faer::{Mat, MatRef};
 
 use super::exogenous_weights::ExogenousWeight;
 use super::linalg::{concat_cols, concat_rows, feedthrough_bound, solve, sym_eig};
@@ -68,21 +68,13 @@ impl Channels {
 /// [`Problem::test`].
 pub(crate) struct Problem {
     n: usize,
-    m1: usize,
-    p1: usize,
     a: Mat<f64>,
     b: Mat<f64>,
     c: Mat<f64>,
-    /// D1•ᵀ D1• ((m1+m2)²), D1•ᵀ C1.
-    d1t_d1: Mat<f64>,
-    d1t_c1: Mat<f64>,
-    /// The X equation's constant term as a function of γ.
-    qx: ExogenousWeight,
-    /// D•1 D•1ᵀ ((p1+p2)²), D•1 B1ᵀ.
-    dd1_dd1t: Mat<f64>,
-    dd1_b1t: Mat<f64>,
-    /// The Y equation's constant term as a function of γ.
-    qy: ExogenousWeight,
+    /// Condition (ii): D1•ᵀ D1• ((m1+m2)²), D1•ᵀ C1 and the X equation's constant term.
+    x: RiccatiCondition,
+    /// Condition (iii): D•1 D•1ᵀ ((p1+p2)²), D•1 B1ᵀ and the Y equation's constant term.
+    y: RiccatiCondition,
     /// Condition (i) bound.
     pub(crate) gamma_d: f64,
 }
@@ -102,15 +94,9 @@ impl Problem {
         let qy = ExogenousWeight::filter(b1.as_ref(), d11.as_ref(), d21.as_ref())?;
         Ok(Problem {
             n,
-            m1,
-            p1,
             a: plant.a.clone(),
-            d1t_d1: d1.transpose() * &d1,
-            d1t_c1: d1.transpose() * &c1,
-            qx,
-            dd1_dd1t: &dd1 * dd1.transpose(),
-            dd1_b1t: &dd1 * b1.transpose(),
-            qy,
+            x: RiccatiCondition { gram: d1.transpose() * &d1, shifted: m1, cross: d1.transpose() * &c1, weight: qx },
+            y: RiccatiCondition { gram: &dd1 * dd1.transpose(), shifted: p1, cross: &dd1 * b1.transpose(), weight: qy },
             b,
             c,
             gamma_d,
@@ -125,43 +111,10 @@ impl Problem {
             return Err((Binding::Feedthrough, format!("gamma {gamma} <= D11 bound {}", self.gamma_d)));
         }
         // X: R = D1ᵀD1 − diag(γ²I, 0); M = R⁻¹ [D1ᵀC1, Bᵀ].
-        let mut r = self.d1t_d1.clone();
-        for i in 0..self.m1 {
-            r[(i, i)] -= g2;
-        }
-        let rhs = concat_cols(self.d1t_c1.as_ref(), self.b.transpose());
-        let m = solve(r.as_ref(), rhs.as_ref()).ok_or((Binding::StateFeedback, "R singular".to_string()))?;
-        let (r_dc, r_bt) = (m.subcols(0, n), m.subcols(n, n));
-        let ax = &self.a - &self.b * r_dc;
-        let gx = &self.b * r_bt;
-        let qx = self
-            .qx
-            .at(gamma)
-            .ok_or((Binding::Feedthrough, "I - D11 D11'/gamma^2 not positive definite".to_string()))?;
-        let x = solve_care(ax.as_ref(), gx.as_ref(), qx.as_ref())
-            .map_err(|e| (Binding::StateFeedback, format!("X: {e}")))?
-            .x;
-        let (xl, xv) = sym_eig(x.as_ref()).ok_or((Binding::StateFeedback, "eig(X) failed".to_string()))?;
-        psd_check(&xl).map_err(|s| (Binding::StateFeedback, format!("X: {s}")))?;
-
-        // Y: R̃ = D•1D•1ᵀ − diag(γ²I, 0); N = R̃⁻¹ [D•1B1ᵀ, C].
-        let mut rt = self.dd1_dd1t.clone();
-        for i in 0..self.p1 {
-            rt[(i, i)] -= g2;
-        }
-        let rhs = concat_cols(self.dd1_b1t.as_ref(), self.c.as_ref());
-        let nn = solve(rt.as_ref(), rhs.as_ref()).ok_or((Binding::Filter, "R~ singular".to_string()))?;
-        let (rt_db, rt_c) = (nn.subcols(0, n), nn.subcols(n, n));
-        // CARE in transposed form: A_yᵀ Y + Y A_y − Y G_y Y + Q_y with A_y = (A − B1 D•1ᵀ R̃⁻¹ C)ᵀ.
-        let ay = self.a.transpose() - self.c.transpose() * rt_db;
-        let gy = self.c.transpose() * rt_c;
-        let qy = self
-            .qy
-            .at(gamma)
-            .ok_or((Binding::Feedthrough, "I - D11' D11/gamma^2 not positive definite".to_string()))?;
-        let y = solve_care(ay.as_ref(), gy.as_ref(), qy.as_ref()).map_err(|e| (Binding::Filter, format!("Y: {e}")))?.x;
-        let (yl, _) = sym_eig(y.as_ref()).ok_or((Binding::Filter, "eig(Y) failed".to_string()))?;
-        psd_check(&yl).map_err(|s| (Binding::Filter, format!("Y: {s}")))?;
+        let (_, xl, xv) = self.x.solve(Binding::StateFeedback, self.a.as_ref(), self.b.as_ref(), gamma)?;
+        // Y: R̃ = D•1D•1ᵀ − diag(γ²I, 0); N = R̃⁻¹ [D•1B1ᵀ, C]; the CARE in transposed form,
+        // A_yᵀ Y + Y A_y − Y G_y Y + Q_y with A_y = (A − B1 D•1ᵀ R̃⁻¹ C)ᵀ.
+        let (y, _, _) = self.y.solve(Binding::Filter, self.a.transpose(), self.c.transpose(), gamma)?;
 
         // ρ(XY) = λmax(X^{1/2} Y X^{1/2}).
         let sq = Mat::from_fn(n, n, |i, j| xv[(i, j)] * xl[j].max(0.0).sqrt());
@@ -174,6 +127,54 @@ impl Problem {
         } else {
             Err((Binding::Coupling, format!("rho(XY)/gamma^2 = {:.6}", rho / g2)))
         }
+    }
+}
+
+/// Condition (ii) or (iii) of the module docs, the two in one form: with R the Gram matrix
+/// `gram` less γ² on its first `shifted` diagonal entries and [M₁ M₂] = R⁻¹ [`cross`, Bᵀ], the
+/// CARE of (A − B M₁, B M₂, Q(γ)) (Q = `weight`) has a stabilising solution ⪰ 0. X is
+/// (A, B) = (A, [B1 B2]); Y is the transposed form, (A, B) = (Aᵀ, Cᵀ).
+struct RiccatiCondition {
+    gram: Mat<f64>,
+    shifted: usize,
+    cross: Mat<f64>,
+    weight: ExogenousWeight,
+}
+
+/// A Riccati solution with its eigenvalues (ascending) and eigenvectors.
+type RiccatiSolution = (Mat<f64>, Vec<f64>, Mat<f64>);
+
+impl RiccatiCondition {
+    /// The solution with its eigenvalues (ascending) and eigenvectors, or the binding condition
+    /// and the reason it fails at γ. `binding`: [`Binding::StateFeedback`] for X,
+    /// [`Binding::Filter`] for Y (which also names the matrices in the reasons).
+    fn solve(
+        &self,
+        binding: Binding,
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        gamma: f64,
+    ) -> Result<RiccatiSolution, (Binding, String)> {
+        let (name, r_name, weight_name) = if binding == Binding::StateFeedback {
+            ("X", "R", "I - D11 D11'/gamma^2")
+        } else {
+            ("Y", "R~", "I - D11' D11/gamma^2")
+        };
+        let n = a.nrows();
+        let mut r = self.gram.clone();
+        for i in 0..self.shifted {
+            r[(i, i)] -= gamma * gamma;
+        }
+        let rhs = concat_cols(self.cross.as_ref(), b.transpose());
+        let m = solve(r.as_ref(), rhs.as_ref()).ok_or((binding, format!("{r_name} singular")))?;
+        let (r_cross, r_bt) = (m.subcols(0, n), m.subcols(n, n));
+        let a_closed = a - b * r_cross;
+        let g = b * r_bt;
+        let q = self.weight.at(gamma).ok_or((Binding::Feedthrough, format!("{weight_name} not positive definite")))?;
+        let x = solve_care(a_closed.as_ref(), g.as_ref(), q.as_ref()).map_err(|e| (binding, format!("{name}: {e}")))?.x;
+        let (l, v) = sym_eig(x.as_ref()).ok_or((binding, format!("eig({name}) failed")))?;
+        psd_check(&l).map_err(|s| (binding, format!("{name}: {s}")))?;
+        Ok((x, l, v))
     }
 }
 

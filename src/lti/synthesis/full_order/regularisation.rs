@@ -19,7 +19,7 @@
 //! the value at the smallest trusted δ is reported, with the whole sequence, in
 //! [`super::FullOrderGamma::regularisation_history`]. Very slowly converging plants (BDT2) are reported as such.
 
-use faer::Mat;
+use faer::{Mat, MatRef};
 
 use super::bracketing::{gamma_opt, Bracket};
 use super::gamma_test::{Channels, Problem};
@@ -118,48 +118,32 @@ pub(crate) fn augment(plant: &Plant, delta: f64, reg12: bool, reg21: bool) -> Ch
     let (mut b1, mut c1) = (plant.b1.clone(), plant.c1.clone());
     let (mut d11, mut d12, mut d21) = (plant.d11.clone(), plant.d12.clone(), plant.d21.clone());
     if reg12 {
-        let p1 = c1.nrows();
-        c1 = Mat::from_fn(p1 + n + m2, n, |i, j| {
-            if i < p1 {
-                c1[(i, j)]
-            } else if i - p1 == j {
-                delta
-            } else {
-                0.0
-            }
-        });
-        d12 = Mat::from_fn(p1 + n + m2, m2, |i, j| {
-            if i < p1 {
-                d12[(i, j)]
-            } else if i >= p1 + n && i - p1 - n == j {
-                delta
-            } else {
-                0.0
-            }
-        });
-        d11 = Mat::from_fn(p1 + n + m2, d11.ncols(), |i, j| if i < p1 { d11[(i, j)] } else { 0.0 });
+        // [C1; δI; 0], [D12; 0; δI], [D11; 0; 0]
+        c1 = append_rows(c1.as_ref(), n + m2, 0, delta);
+        d12 = append_rows(d12.as_ref(), n + m2, n, delta);
+        d11 = append_rows(d11.as_ref(), n + m2, 0, 0.0);
     }
     if reg21 {
-        let m1 = b1.ncols();
-        b1 = Mat::from_fn(n, m1 + n + p2, |i, j| {
-            if j < m1 {
-                b1[(i, j)]
-            } else if j - m1 == i {
-                delta
-            } else {
-                0.0
-            }
-        });
-        d21 = Mat::from_fn(p2, m1 + n + p2, |i, j| {
-            if j < m1 {
-                d21[(i, j)]
-            } else if j >= m1 + n && j - m1 - n == i {
-                delta
-            } else {
-                0.0
-            }
-        });
-        d11 = Mat::from_fn(d11.nrows(), m1 + n + p2, |i, j| if j < m1 { d11[(i, j)] } else { 0.0 });
+        // [B1 δI 0], [D21 0 δI], [D11 0 0]
+        b1 = append_rows(b1.transpose(), n + p2, 0, delta).transpose().to_owned();
+        d21 = append_rows(d21.transpose(), n + p2, n, delta).transpose().to_owned();
+        d11 = append_rows(d11.transpose(), n + p2, 0, 0.0).transpose().to_owned();
     }
     Channels { b1, c1, d11, d12, d21 }
+}
+
+/// `x` with `extra` rows appended below it, zero but for δ on the diagonal of the block that
+/// starts `from` rows below `x` (entry (r + from + j, j), r = `x`'s row count): the added rows
+/// of an augmented channel (δ = 0: zero rows). Columns are appended by transposing.
+fn append_rows(x: MatRef<'_, f64>, extra: usize, from: usize, delta: f64) -> Mat<f64> {
+    let r = x.nrows();
+    Mat::from_fn(r + extra, x.ncols(), |i, j| {
+        if i < r {
+            x[(i, j)]
+        } else if i >= r + from && i - r - from == j {
+            delta
+        } else {
+            0.0
+        }
+    })
 }
