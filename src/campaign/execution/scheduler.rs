@@ -349,7 +349,7 @@ enum WorkerMsg {
 /// Runs every job of `jobs` that is not in `done` (the journals), respecting warm-start chains
 /// and `coord`'s claims, and reports events to `on_event` on the calling thread. Returns the
 /// counts, or the first callback or coordinator error (after cancelling and draining in-flight
-/// jobs). The same as [`Scheduler::new`] followed by [`Scheduler::run`].
+/// jobs): builds the [`Scheduler`] and runs it ([`Scheduler::run`]).
 pub fn execute<'a, E>(
     jobs: &'a [Job],
     done: &HashMap<JobId, JobRecord>,
@@ -359,7 +359,28 @@ pub fn execute<'a, E>(
     opts: &'a ExecuteOptions,
     on_event: impl FnMut(CampaignEvent) -> Result<(), E>,
 ) -> Result<RunStats, ExecuteError<E>> {
-    Scheduler::new(jobs, done, runner, observers, coord, opts, on_event).run()
+    let pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
+    Scheduler {
+        jobs,
+        runner,
+        observers,
+        coord,
+        opts,
+        on_event,
+        index_of: jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect(),
+        finished: done.iter().map(|(id, r)| (id.clone(), r.controller().cloned())).collect(),
+        chain_gamma: HashMap::new(),
+        stats: RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() },
+        pending,
+        busy_until: HashMap::new(),
+        free: (0..opts.threads).rev().collect(),
+        running: 0,
+        last_poll: Instant::now(),
+        force_poll: false,
+        idle_sweep: false,
+        first_err: None,
+    }
+    .run()
 }
 
 /// What the claim of a ready job decided ([`Scheduler::claim`]).
@@ -374,7 +395,7 @@ enum ClaimStep {
 
 /// One `execute` call: the campaign's jobs, what runs and observes them, the coordinator of the
 /// claims, the event callback (the journal is one of its consumers) and the state of the queue.
-/// Built once ([`Scheduler::new`]); [`Scheduler::run`] runs it on the calling thread, each job
+/// Built once ([`execute`]); [`Scheduler::run`] runs it on the calling thread, each job
 /// on a worker with a `WorkerContext` (module docs).
 pub struct Scheduler<'a, E, F> {
     jobs: &'a [Job],
@@ -410,40 +431,6 @@ impl<'a, E, F> Scheduler<'a, E, F>
 where
     F: FnMut(CampaignEvent) -> Result<(), E>,
 {
-    /// The scheduler of `jobs`, of which those in `done` (the journals) are skipped; see
-    /// [`execute`] for the other arguments.
-    pub fn new(
-        jobs: &'a [Job],
-        done: &HashMap<JobId, JobRecord>,
-        runner: &'a dyn JobRunner,
-        observers: &'a ObserverFactory<'_>,
-        coord: &'a mut dyn Coordinator<E>,
-        opts: &'a ExecuteOptions,
-        on_event: F,
-    ) -> Self {
-        let pending: VecDeque<usize> = (0..jobs.len()).filter(|&i| !done.contains_key(&jobs[i].id)).collect();
-        Scheduler {
-            jobs,
-            runner,
-            observers,
-            coord,
-            opts,
-            on_event,
-            index_of: jobs.iter().enumerate().map(|(i, j)| (&j.id, i)).collect(),
-            finished: done.iter().map(|(id, r)| (id.clone(), r.controller().cloned())).collect(),
-            chain_gamma: HashMap::new(),
-            stats: RunStats { total: jobs.len(), already_done: jobs.len() - pending.len(), ..RunStats::default() },
-            pending,
-            busy_until: HashMap::new(),
-            free: (0..opts.threads).rev().collect(),
-            running: 0,
-            last_poll: Instant::now(),
-            force_poll: false,
-            idle_sweep: false,
-            first_err: None,
-        }
-    }
-
     /// Runs the jobs (module docs): returns the counts, or the first callback or coordinator
     /// error after cancelling and draining in-flight jobs.
     pub fn run(mut self) -> Result<RunStats, ExecuteError<E>> {
