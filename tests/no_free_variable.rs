@@ -23,7 +23,8 @@ fn h2_at_order_zero_with_a_forced_feedthrough_is_answered_at_once() {
     let t0 = Instant::now();
     let o = Design::new(&problem, &opts).run().unwrap();
     let secs = t0.elapsed().as_secs_f64();
-    assert!(secs < 1.0, "{secs} s");
+    // not a timing target: the budget (60 s) was not spent; the evaluation count says "at once"
+    assert!(secs < opts.cpumax / 2.0, "{secs} s");
     assert_eq!(o.search.stop, SearchStop::NoFreeVariable);
     assert_eq!((o.evaluations, o.search.starts), (1, 0));
     assert!((o.controller.dk[(0, 0)] + 0.3).abs() < 1e-12 && (o.controller.dk[(1, 0)] - 0.2).abs() < 1e-12);
@@ -54,7 +55,8 @@ fn a_structure_that_fixes_every_entry_is_evaluated_once() {
     let t0 = Instant::now();
     let o = Design::new(&Problem::single(p.clone()), &opts).structure(Some(&s)).run().unwrap();
     let secs = t0.elapsed().as_secs_f64();
-    assert!(secs < 1.0, "{secs} s");
+    // not a timing target: the budget (60 s) was not spent; the evaluation count says "at once"
+    assert!(secs < opts.cpumax / 2.0, "{secs} s");
     assert_eq!(o.search.stop, SearchStop::NoFreeVariable);
     assert_eq!(o.controller, k);
     assert_eq!(o.status, DesignStatus::Converged);

@@ -306,7 +306,7 @@ fn structure_files_and_campaign_errors_speak_plainly() {
     ]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("structure") && err.contains("AK") && err.contains("not stable"), "{err}");
-    assert!(started.elapsed().as_secs() < 10, "refused only after the budget");
+    assert!(started.elapsed().as_secs() < 20, "refused only after the 30-s budget");
     // serde's type names never reach a campaign author
     for (key, value) in [
         ("weights", "{ a = 1 }"),
