@@ -153,7 +153,7 @@ fn real_design_campaign_writes_journal_traces_and_reports() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("REA2"), "{stdout}");
     let t = results.join("t");
-    for f in ["runs.jsonl", "best.csv", "tables.tex", "compare.csv", "compare.tex"] {
+    for f in ["runs.jsonl", "best.csv", "tables.tex", "compare.csv", "compare.tex", "library.tex"] {
         assert!(t.join(f).is_file(), "{f} missing");
     }
     let recs = read_journal(&t.join("runs.jsonl")).unwrap().records;
@@ -363,4 +363,9 @@ fn latex_structure_catches_what_would_not_compile() {
         let e = common::latex_structure(&bad).unwrap_err();
         assert!(e.contains(why), "{e} (wanted: {why})");
     }
+    // a longtable: its caption rows and head and foot markers are no rows of cells
+    let long = "\\begin{longtable}{lr}\n\\caption{A, B}\\label{t} \\\\\n\\toprule\na & b \\\\\n\\midrule\n\\endfirsthead\n\\caption[]{(continued)} \\\\\n\\toprule\na & b \\\\\n\\endhead\n\\multicolumn{2}{r}{more} \\\\\n\\endfoot\n\\bottomrule\n\\endlastfoot\nx & 1 \\\\\n\\end{longtable}\n";
+    assert_eq!(common::latex_structure(long), Ok(()));
+    let e = common::latex_structure(&long.replace("x & 1", "x & 1 & 2")).unwrap_err();
+    assert!(e.contains("has 3 cells, the tabular has 2 columns"), "{e}");
 }

@@ -8,7 +8,7 @@ use std::process::Command;
 
 use hinfix::campaign::plot::{log_ticks, png_bytes, svg_text, SIZE};
 use hinfix::campaign::plot::{ConvergenceFigure, GammaOrderFigure};
-use hinfix::campaign::TraceIteration;
+use hinfix::campaign::{FullOrderSource, TraceIteration};
 
 const BIN: &str = env!("CARGO_BIN_EXE_campaign");
 
@@ -240,7 +240,7 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
         ours: vec![(1, 0.000351), (2, 0.00035)],
         plain: vec![],
         paper: vec![(1, 0.00035), (2, 0.00035)],
-        full_order: Some((1e-6, false)),
+        full_order: Some((1e-6, FullOrderSource::Computed)),
     };
     assert!(pa.log_axis());
     let he1 = GammaOrderFigure {
@@ -248,7 +248,7 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
         ours: vec![(1, 0.124), (2, 0.11)],
         plain: vec![],
         paper: vec![(1, 0.1235)],
-        full_order: Some((0.0737, false)),
+        full_order: Some((0.0737, FullOrderSource::Paper)),
     };
     assert!(!he1.log_axis());
     let p = Path::new("g.png");
@@ -271,7 +271,7 @@ fn gamma_vs_order_labels_its_whole_range_and_the_bound() {
         ours: vec![(1, 40.0), (2, 4.0), (3, 2.6)],
         plain: vec![(1, 3.0), (2, 2.55)],
         paper: vec![],
-        full_order: Some((2.5, false)),
+        full_order: Some((2.5, FullOrderSource::Computed)),
     };
     assert!(fig.log_axis());
     let svg = svg_text(&fig, Path::new("g.svg")).unwrap();
@@ -282,6 +282,10 @@ fn gamma_vs_order_labels_its_whole_range_and_the_bound() {
     {
         assert!(texts.iter().any(|t| t == label), "{label} missing from {texts:?}");
     }
+    // a bound that is not computed here says where it is from
+    let from_index = GammaOrderFigure { full_order: Some((2.5, FullOrderSource::LibraryIndex)), ..fig };
+    let texts = svg_texts(&svg_text(&from_index, Path::new("g.svg")).unwrap());
+    assert!(texts.iter().any(|t| t == "full-order bound 2.5 (library index)"), "{texts:?}");
 }
 
 /// A fast job's trace with thousands of local searches: the figure shows the best objective

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use hinfix::campaign::BestRow;
-use hinfix::campaign::{compare_rows, FullOrderRow};
+use hinfix::campaign::{compare_rows, FullOrderRow, FullOrderSource};
 use hinfix::campaign::{compare_tex, sig4, sig_figs, tables_tex, tables_tex_about, CampaignAbout};
 use hinfix::campaign::{load_reference, ReferenceRow, PAPER_PLANT_FINGERPRINTS, REFERENCE_CSV};
 use hinfix::design::ObjectiveKind;
@@ -77,10 +77,14 @@ fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_us
         row("ZerenOzbay", 5, 34.9),
         row("My_Plant", 1, 2.5),
     ];
-    let full = vec![
-        FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: false, controller_stable: None },
-        FullOrderRow { plant: "ZerenOzbay".into(), gamma: 34.24, from_paper: false, controller_stable: None },
-    ];
+    let computed = |plant: &str, gamma| FullOrderRow {
+        plant: plant.into(),
+        n: None,
+        gamma,
+        source: FullOrderSource::Computed,
+        controller_stable: None,
+    };
+    let full = vec![computed("PA", 1e-6), computed("ZerenOzbay", 34.24)];
     let tex = tables_tex(&best, &full, &reference);
     let block = |p: &str| {
         let start = tex.find(&format!("\\label{{tab:hinfix-{p}")).unwrap_or_else(|| panic!("no label for {p}:\n{tex}"));
@@ -103,15 +107,38 @@ fn paper_layout_with_literature_only_where_there_is_some_and_dagger_only_when_us
     assert_eq!(tex.matches("\\caption{").count(), 3);
     assert!(!tex.contains("dagger"), "no † when no value is the paper's");
 
-    let with_paper = vec![FullOrderRow { plant: "PA".into(), gamma: 1e-6, from_paper: true, controller_stable: None }];
+    let with_paper = vec![FullOrderRow { source: FullOrderSource::Paper, ..computed("PA", 1e-6) }];
     let tex2 = tables_tex(&best[..2], &with_paper, &reference);
     assert_eq!(tex2.matches("$^\\dagger$").count(), 2, "one mark and its note:\n{tex2}");
+    assert!(tex2.contains("full-order value from the paper (not computed here: $n > 60$, or the computation failed)"));
+    // a value of the plant library's index: its own mark and note
+    let with_index = vec![FullOrderRow { source: FullOrderSource::LibraryIndex, ..computed("PA", 1e-6) }];
+    let tex3 = tables_tex(&best[..2], &with_index, &reference);
+    assert_eq!(tex3.matches("$^\\ddagger$").count(), 2, "one mark and its note:\n{tex3}");
+    assert!(tex3.contains("from the plant library's index (\\texttt{plants/compleib/INDEX.csv}"), "{tex3}");
+    assert!(!tex3.contains("$^\\dagger$"), "{tex3}");
 
     // Both files compile.
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tables.tex"), tables_tex(&best, &with_paper, &reference)).unwrap();
     std::fs::write(dir.path().join("compare.tex"), compare_tex(&compare_rows(&best, &full, &reference))).unwrap();
     common::latex_compiles(dir.path());
+}
+
+/// The paper's values (HIFOO and the literature it quotes) are of strong stabilisation: a plain
+/// row of a paper plant has no paper value and no ratio, so it is never "above the paper".
+#[test]
+fn plain_rows_are_not_compared_with_the_paper() {
+    let plain = |r: &BestRow| BestRow { objective: ObjectiveKind::Plain, gamma: r.gamma * 0.5, ..r.clone() };
+    let (pa, zo) = (row("PA", 2, 0.0003498), row("ZerenOzbay", 10, 35.0));
+    let rows = compare_rows(&[pa.clone(), plain(&pa), zo.clone(), plain(&zo)], &[], &reference());
+    assert_eq!((rows[0].paper, rows[0].ratio > 0.99), (0.00035, true));
+    assert_eq!(rows[2].literature.len(), 2, "{:?}", rows[2]);
+    for plain in [&rows[1], &rows[3]] {
+        assert!(plain.paper.is_nan() && plain.ratio.is_nan() && plain.literature.is_empty(), "{plain:?}");
+    }
+    let tex = compare_tex(&rows);
+    assert!(tex.contains("PA & 2 & plain & 0.0002 & -- & -- & -- & --"), "{tex}");
 }
 
 /// A plant without a published reference gets the campaign layout: no paper columns, a caption
@@ -135,8 +162,13 @@ fn a_plant_of_ones_own_gets_the_campaign_layout_and_the_two_objectives_side_by_s
         ..strong(k, g)
     };
     let best = vec![strong(1, 3.0), plain(1, 2.5, false), strong(2, 2.6), plain(2, 2.6, true), strong(3, 2.55)];
-    let full =
-        vec![FullOrderRow { plant: "two_mass".into(), gamma: 2.4, from_paper: false, controller_stable: Some(false) }];
+    let full = vec![FullOrderRow {
+        plant: "two_mass".into(),
+        n: Some(4),
+        gamma: 2.4,
+        source: FullOrderSource::Computed,
+        controller_stable: Some(false),
+    }];
     let about = CampaignAbout {
         names: vec!["own".into()],
         eps: vec![1e-3, 1e-2],

@@ -9,7 +9,8 @@
 //! The modules are in five parts, one folder each, from the bottom up (a part imports only its
 //! own and those below it, `tests/module_graph.rs`; docs/ARCHITECTURE.md §1):
 //!
-//! * `leaves/`: provenance, the paper's reference values, escaping, what a sparse trace keeps;
+//! * `leaves/`: provenance, the paper's reference values, the plant library's full-order values,
+//!   escaping, what a sparse trace keeps;
 //! * `model/`: the validated [`Campaign`], its TOML file, its jobs and their ids;
 //! * `records/`: a job's record, the journal, claims, shards;
 //! * `execution/`: the scheduler and order chaining, traces, progress, resume;
@@ -37,6 +38,9 @@ pub use execution::trace::{
     iter_message, read_iterations, summarise, summarise_bytes, trace_observers, PhaseSummary, TraceError,
     TraceIteration, TraceSummary, TraceWriter, ITER_TOPIC, RESULT_TOPIC,
 };
+pub use leaves::library_index::{
+    IndexEntry, IndexFieldProblem, LibraryIndex, LibraryIndexError, LIBRARY_FINGERPRINTS_CSV, LIBRARY_INDEX_CSV,
+};
 pub use leaves::provenance::Provenance;
 pub use leaves::reference::{
     load_default_reference, load_reference, paper_plant_name, RefMethod, ReferenceError, ReferenceRow, RowProblem,
@@ -61,11 +65,11 @@ pub use records::record::{FailureKind, JobFailure, JobRecord, JobResult, JobStat
 pub use records::shard::{select as shard_jobs, Shard};
 pub use reduction::compare::{
     compare_rows, cost_rows, full_order_controller_stable, CampaignAbout, CompareRow, CostRow, FullOrderRow,
-    FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+    FullOrderSource, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
 };
 pub use reduction::export::{
-    BestCsv, CompareCsv, CompareTex, CsvFile, Exporter, HtmlPage, PlantsCsv, ReportData, StrongVsPlainCsv, TablesTex,
-    HTML_PAGE, TABLES,
+    BestCsv, CompareCsv, CompareTex, CsvFile, Exporter, HtmlPage, LibraryTex, PlantsCsv, ReportData, StrongVsPlainCsv,
+    TablesTex, HTML_PAGE, TABLES,
 };
 pub use reduction::html::report_html;
 pub use reduction::latex::{campaign_table, compare_tex, cost_table, sig4, sig_figs, tables_tex, tables_tex_about};

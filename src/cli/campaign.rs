@@ -123,9 +123,10 @@ fn load(a: &CampaignFileArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Resul
     Ok(Loaded { campaign, jobs, dir, fake })
 }
 
-/// Under the comparison table, when an entry is above the paper's value (ratio > 1 + 1e-3): the
-/// campaign's budget per job against the paper's protocol, so that a reader of a small campaign
-/// (the smoke run: HE1 n_K = 2 at 1.0116) sees why. `None` when no entry is above.
+/// Under the comparison table, when an entry is above the paper's value (ratio > 1 + 1e-3; only
+/// strong entries have a paper value, `campaign::compare_rows`): the campaign's budget per job
+/// against the paper's protocol, so that a reader of a small campaign (the smoke run: HE1
+/// n_K = 2 at 1.0116) sees why. `None` when no entry is above.
 fn budget_note(c: &Campaign, compare: &[crate::campaign::CompareRow]) -> Option<String> {
     let above = compare.iter().filter(|r| r.ratio.is_finite() && r.ratio > 1.0 + 1e-3).count();
     if above == 0 {
@@ -385,8 +386,9 @@ pub fn plot(a: PlotArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<Exi
     let l = load(&a.campaign, fake)?;
     let records = finished_records(&l, &a.extra)?;
     let reference = load_default_reference().context("reading the paper's reference table")?;
+    let library = crate::campaign::LibraryIndex::load_default()?;
     let (plants, problems) = (plant_map(&l.campaign), crate::campaign::problem_map(&l.campaign));
-    let s = crate::campaign::plot::write_plots(&l.dir, &records, &plants, &problems, &reference)?;
+    let s = crate::campaign::plot::write_plots(&l.dir, &records, &plants, &problems, &reference, &library)?;
     for f in &s.files {
         println!("{}", f.display());
     }

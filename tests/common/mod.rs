@@ -4,12 +4,17 @@
 use std::path::Path;
 use std::process::Command;
 
-/// The LaTeX tables are always checked structurally ([`latex_structure`]); where `pdflatex` is
-/// installed they are also compiled for real. Without `pdflatex` the structural check is all,
+/// The LaTeX tables of `dir` (`tables.tex`, `compare.tex`, and `library.tex` where there is one)
+/// are always checked structurally ([`latex_structure`]); where `pdflatex` is installed they are
+/// also compiled for real, in one document. Without `pdflatex` the structural check is all,
 /// unless CI asks for the real compile: with `CI` set (as `.ci/run` sets it) a missing `pdflatex`
 /// fails the test, except where `HINFIX_NO_PDFLATEX=1` says that none could be installed.
 pub fn latex_compiles(dir: &Path) {
-    for f in ["tables.tex", "compare.tex"] {
+    let mut files = vec!["tables.tex", "compare.tex"];
+    if dir.join("library.tex").is_file() {
+        files.push("library.tex");
+    }
+    for f in &files {
         let tex = std::fs::read_to_string(dir.join(f)).unwrap();
         if let Err(e) = latex_structure(&tex) {
             panic!("{f}: {e}\n{tex}");
@@ -26,9 +31,12 @@ pub fn latex_compiles(dir: &Path) {
         eprintln!("note: pdflatex not found; the LaTeX tables were checked structurally only");
         return;
     }
+    let inputs: String = files.iter().map(|f| format!("\\input{{{f}}}\n")).collect();
     std::fs::write(
         dir.join("wrap.tex"),
-        "\\documentclass{article}\n\\usepackage{booktabs}\n\\begin{document}\n\\input{tables.tex}\n\\input{compare.tex}\n\\end{document}\n",
+        format!(
+            "\\documentclass{{article}}\n\\usepackage{{booktabs}}\n\\usepackage{{longtable}}\n\\begin{{document}}\n{inputs}\\end{{document}}\n"
+        ),
     )
     .unwrap();
     let out = Command::new("pdflatex")
@@ -42,9 +50,11 @@ pub fn latex_compiles(dir: &Path) {
 
 /// What makes a table fragment fail to compile, checked without LaTeX: environments nest and
 /// close (`\begin{x}` … `\end{x}`); braces balance; `#` never appears and `_`, `^` only in math
-/// (both unescaped); `$` math closes on its line; every `tabular` has booktabs rules, and each of
-/// its rows has as many cells (`\multicolumn{k}` counting k) as its column specification has
-/// columns. `%` starts a comment, as in LaTeX.
+/// (both unescaped); `$` math closes on its line; every `tabular` and `longtable` has booktabs
+/// rules, and each of its rows has as many cells (`\multicolumn{k}` counting k) as its column
+/// specification has columns (a `longtable`'s `\caption` rows and its head and foot markers
+/// `\endfirsthead`, `\endhead`, `\endfoot`, `\endlastfoot` aside). `%` starts a comment, as in
+/// LaTeX.
 pub fn latex_structure(tex: &str) -> Result<(), String> {
     let mut envs: Vec<(String, usize, Vec<String>)> = Vec::new(); // (name, columns, rows)
     let mut depth = 0i64;
@@ -80,7 +90,7 @@ pub fn latex_structure(tex: &str) -> Result<(), String> {
         while !rest.is_empty() {
             if let Some(r) = rest.strip_prefix("\\begin{") {
                 let (name, r) = r.split_once('}').ok_or_else(|| at("\\begin without }".into()))?;
-                let (cols, r) = if name == "tabular" { column_spec(r).map_err(&at)? } else { (0, r) };
+                let (cols, r) = if is_table(name) { column_spec(r).map_err(&at)? } else { (0, r) };
                 envs.push((name.to_string(), cols, Vec::new()));
                 rest = r;
             } else if let Some(r) = rest.strip_prefix("\\end{") {
@@ -89,8 +99,8 @@ pub fn latex_structure(tex: &str) -> Result<(), String> {
                 if open != name {
                     return Err(at(format!("\\end{{{name}}} closes \\begin{{{open}}}")));
                 }
-                if name == "tabular" {
-                    check_tabular(cols, &rows).map_err(&at)?;
+                if is_table(name) {
+                    check_tabular(cols, &rows, name == "longtable").map_err(&at)?;
                 }
                 rest = r;
             } else {
@@ -99,7 +109,7 @@ pub fn latex_structure(tex: &str) -> Result<(), String> {
                 let next =
                     tail.find("\\begin{").into_iter().chain(tail.find("\\end{")).min().map_or(rest.len(), |i| i + skip);
                 if let Some((name, _, rows)) = envs.last_mut() {
-                    if name == "tabular" {
+                    if is_table(name) {
                         rows.push(rest[..next].to_string());
                     }
                 }
@@ -114,6 +124,11 @@ pub fn latex_structure(tex: &str) -> Result<(), String> {
         return Err(format!("{depth} unclosed {{"));
     }
     Ok(())
+}
+
+/// Whether environment `name` is a table whose rows [`check_tabular`] checks.
+fn is_table(name: &str) -> bool {
+    name == "tabular" || name == "longtable"
 }
 
 fn strip_comment(line: &str) -> &str {
@@ -147,15 +162,20 @@ fn column_spec(s: &str) -> Result<(usize, &str), String> {
 }
 
 /// Every row of a tabular (text up to each `\\`) has `cols` cells; booktabs rules are present.
-fn check_tabular(cols: usize, rows: &[String]) -> Result<(), String> {
+/// In a `longtable`, a row that is a `\caption` is no row of cells, and the head and foot
+/// markers are not cells.
+fn check_tabular(cols: usize, rows: &[String], longtable: bool) -> Result<(), String> {
     let body = rows.join("\n");
     if !(body.contains("\\toprule") && body.contains("\\bottomrule")) {
         return Err("tabular without booktabs \\toprule/\\bottomrule".into());
     }
+    let mut skip = vec!["\\toprule", "\\midrule", "\\bottomrule"];
+    if longtable {
+        skip.extend(["\\endfirsthead", "\\endlastfoot", "\\endhead", "\\endfoot"]);
+    }
     for row in body.split("\\\\").map(str::trim) {
-        let row =
-            ["\\toprule", "\\midrule", "\\bottomrule"].iter().fold(row.to_string(), |r, rule| r.replace(rule, ""));
-        if row.trim().is_empty() {
+        let row = skip.iter().fold(row.to_string(), |r, rule| r.replace(rule, ""));
+        if row.trim().is_empty() || longtable && row.trim().starts_with("\\caption") {
             continue;
         }
         let b = row.as_bytes();

@@ -1,16 +1,23 @@
 //! The comparison behind the report tables: per plant the full-order bound, per (plant, n_K)
 //! our best verified γ against the paper's HIFOO value and the literature. Pure functions of the
-//! best rows, the plants and the paper's reference rows; [`super::report`] writes them as CSV and
-//! [`super::latex`] renders them.
+//! best rows, the plants, the paper's reference rows and the plant library's index;
+//! [`super::report`] writes them as CSV and [`super::latex`] renders them.
 //!
-//! Full-order bound: computed with `lti::full_order_gamma` for plants with n ≤
-//! [`FULL_ORDER_MAX_N`]; above that (minutes of CPU, or failure, e.g. AC10) the paper's
-//! full-order value is used and marked `from_paper`.
+//! Full-order bound ([`FullOrderSource`]): computed with `lti::full_order_gamma` for plants with
+//! n ≤ [`FULL_ORDER_MAX_N`]; where it is not (above that it takes minutes of CPU, and it fails on
+//! some plants, e.g. AC10), the paper's full-order value; failing that, the plant library's
+//! (`LibraryIndex`: `plants/compleib/INDEX.csv`, matched by fingerprint; an upper bound for the
+//! singular plants, some values approximate).
+//!
+//! The paper's values (HIFOO and the literature it quotes) are all of stable controllers, strong
+//! stabilisation (Gumussoy, Millstone & Overton 2008): they are set beside our `strong` rows only
+//! ([`compare_rows`]); a `plain` row (K may be unstable) solves another problem.
 
 use crate::campaign::records::record::JobRecord;
 use std::collections::BTreeMap;
 
 use super::reduce::{BestRow, PlantMap};
+use crate::campaign::leaves::library_index::LibraryIndex;
 use crate::campaign::leaves::reference::{RefMethod, ReferenceRow};
 use crate::design::ObjectiveKind;
 use crate::lti::{continuous_time_image, full_order_gamma, verified_stability, CentralProblem, Plant};
@@ -18,15 +25,30 @@ use crate::lti::{continuous_time_image, full_order_gamma, verified_stability, Ce
 /// Largest plant order for which the full-order bound is computed here.
 pub const FULL_ORDER_MAX_N: usize = 60;
 
+/// Where a plant's full-order bound comes from, in the order they are tried.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FullOrderSource {
+    /// Computed here (`lti::full_order_gamma`, n ≤ [`FULL_ORDER_MAX_N`]).
+    Computed,
+    /// The paper's full-order value (hinfsyn).
+    Paper,
+    /// The plant library's index (`LibraryIndex`, `plants/compleib/INDEX.csv`).
+    LibraryIndex,
+    /// None: γ is NaN.
+    Unavailable,
+}
+
 /// The full-order bound of one plant.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FullOrderRow {
     /// Plant.
     pub plant: String,
+    /// The plant's order n, the full controller order (`None` for a problem of several plants).
+    pub n: Option<usize>,
     /// γ_opt (NaN if unavailable).
     pub gamma: f64,
-    /// True if taken from the paper rather than computed.
-    pub from_paper: bool,
+    /// Where γ_opt comes from.
+    pub source: FullOrderSource,
     /// Whether the full-order central controller at 1.01·γ_opt ([`FULL_ORDER_CENTRAL_LEVEL`]) is
     /// stable; computed only for plants without a published reference (their tables say it),
     /// `None` otherwise or when it cannot be built.
@@ -111,52 +133,61 @@ pub struct CompareRow {
     pub objective: ObjectiveKind,
     /// Our best re-verified γ.
     pub ours: f64,
-    /// The paper's HIFOO γ (NaN if none).
+    /// The paper's HIFOO γ (NaN if none, and for a `plain` row).
     pub paper: f64,
-    /// Literature rows (source, γ).
+    /// Literature rows (source, γ; none for a `plain` row).
     pub literature: Vec<(String, f64)>,
     /// Full-order bound.
     pub full_order: f64,
-    /// ours / paper.
+    /// ours / paper (NaN without a paper value).
     pub ratio: f64,
 }
 
-/// Full-order bounds of the plants that appear in `best` (`plants` keyed by fingerprint).
-pub fn full_order_rows(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<FullOrderRow> {
+/// Full-order bounds of the plants that appear in `best` (`plants` keyed by fingerprint), each
+/// from the first [`FullOrderSource`] that has one.
+pub fn full_order_rows(
+    best: &[BestRow],
+    plants: &PlantMap,
+    reference: &[ReferenceRow],
+    library: &LibraryIndex,
+) -> Vec<FullOrderRow> {
     let mut seen: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
     seen.dedup();
     seen.into_iter()
         .map(|(name, fp)| {
+            let plant = plants.get(fp);
             let paper = reference.iter().find(|r| r.is_for(fp) && r.method == RefMethod::FullOrder).map(|r| r.gamma);
-            let computed = plants
-                .get(fp)
-                .filter(|p| p.dims.n <= FULL_ORDER_MAX_N)
-                .and_then(|p| full_order_gamma(p).ok())
-                .map(|g| g.gamma);
+            let computed =
+                plant.filter(|p| p.dims.n <= FULL_ORDER_MAX_N).and_then(|p| full_order_gamma(p).ok()).map(|g| g.gamma);
             let has_reference = reference.iter().any(|r| r.is_for(fp));
-            let controller_stable = match (has_reference, computed, plants.get(fp)) {
+            let controller_stable = match (has_reference, computed, plant) {
                 (false, Some(_), Some(p)) => full_order_controller_stable(p),
                 _ => None,
             };
-            match computed {
-                Some(g) => FullOrderRow { plant: name.into(), gamma: g, from_paper: false, controller_stable },
-                None => FullOrderRow {
-                    plant: name.into(),
-                    gamma: paper.unwrap_or(f64::NAN),
-                    from_paper: paper.is_some(),
-                    controller_stable,
-                },
-            }
+            let (gamma, source) = [
+                (computed, FullOrderSource::Computed),
+                (paper, FullOrderSource::Paper),
+                (library.full_order_gamma(fp), FullOrderSource::LibraryIndex),
+            ]
+            .into_iter()
+            .find_map(|(g, source)| Some((g?, source)))
+            .unwrap_or((f64::NAN, FullOrderSource::Unavailable));
+            FullOrderRow { plant: name.into(), n: plant.map(|p| p.dims.n), gamma, source, controller_stable }
         })
         .collect()
 }
 
-/// Joins our best rows with the reference.
+/// Joins our best rows with the reference: the paper's and the literature's values beside the
+/// `strong` rows only (all are of stable controllers); a `plain` row's `paper` and `ratio` are
+/// NaN and its literature empty.
 pub fn compare_rows(best: &[BestRow], full: &[FullOrderRow], reference: &[ReferenceRow]) -> Vec<CompareRow> {
     best.iter()
         .map(|b| {
+            let strong = b.objective == ObjectiveKind::Strong;
             let at = |m: RefMethod| {
-                reference.iter().filter(move |r| r.is_for(&b.plant_fingerprint) && r.order == b.order && r.method == m)
+                reference
+                    .iter()
+                    .filter(move |r| strong && r.is_for(&b.plant_fingerprint) && r.order == b.order && r.method == m)
             };
             let paper = at(RefMethod::Hifoo).map(|r| r.gamma).fold(f64::NAN, f64::min);
             let literature = at(RefMethod::Literature).map(|r| (r.source.clone(), r.gamma)).collect();

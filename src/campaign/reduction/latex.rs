@@ -5,7 +5,8 @@ use crate::lti::TimeDomain;
 use std::fmt::Write as _;
 
 use super::compare::{
-    cost_rows, CampaignAbout, CompareRow, CostRow, FullOrderRow, FULL_ORDER_CENTRAL_LEVEL, FULL_ORDER_MAX_N,
+    cost_rows, CampaignAbout, CompareRow, CostRow, FullOrderRow, FullOrderSource, FULL_ORDER_CENTRAL_LEVEL,
+    FULL_ORDER_MAX_N,
 };
 use super::reduce::BestRow;
 use crate::campaign::leaves::reference::{RefMethod, ReferenceRow};
@@ -52,6 +53,29 @@ pub fn sig4(x: f64) -> String {
     format!("${mant}\\times10^{{{exp}}}$")
 }
 
+/// The mark of a full-order value not computed here: † the paper's, ‡ the plant library's index
+/// (`FullOrderSource`); none for a computed one.
+pub(crate) fn full_order_mark(source: FullOrderSource) -> &'static str {
+    match source {
+        FullOrderSource::Paper => "$^\\dagger$",
+        FullOrderSource::LibraryIndex => "$^\\ddagger$",
+        FullOrderSource::Computed | FullOrderSource::Unavailable => "",
+    }
+}
+
+/// What the mark of [`full_order_mark`] says, as a sentence for under a table or a caption;
+/// `None` for an unmarked value.
+pub(crate) fn full_order_note(source: FullOrderSource) -> Option<String> {
+    let why = format!("not computed here: $n > {FULL_ORDER_MAX_N}$, or the computation failed");
+    match source {
+        FullOrderSource::Paper => Some(format!("$^\\dagger$ full-order value from the paper ({why}).")),
+        FullOrderSource::LibraryIndex => Some(format!(
+            "$^\\ddagger$ full-order value from the plant library's index (\\texttt{{plants/compleib/INDEX.csv}}; {why}): for a singular plant (regularised) or where SLICOT's SB10AD controller gave it, an upper bound of the full-order infimum, for some plants an approximate one."
+        )),
+        FullOrderSource::Computed | FullOrderSource::Unavailable => None,
+    }
+}
+
 /// A LaTeX `\label` key part: ASCII letters and digits kept, everything else `-`, with a short
 /// hash when that changed the name (`sanitise::as_key`), so two plants never share a label.
 fn label_key(name: &str) -> String {
@@ -75,10 +99,11 @@ fn highest_order_first<'a, R>(rows: &[&'a R], order: impl Fn(&R) -> usize) -> Ve
 
 /// `tables.tex`, in the layout of the paper's tables: one `table` per plant with a caption and a
 /// `\label{tab:hinfix-<plant>}`; first the full-order bound (computed here, or the paper's value
-/// marked †, with whether the paper's full-order controller is stable), then per n_K from the
-/// highest down: our best re-verified γ, the paper's HIFOO γ and ours/paper. Plants for which the
-/// reference table has values from earlier literature get a literature column (their orders
-/// appear as rows of their own when we have no result there). 4 significant figures throughout.
+/// marked † — ‡ for the plant library's —, with whether the paper's full-order controller is
+/// stable), then per n_K from the highest down: our best re-verified γ, the paper's HIFOO γ and
+/// ours/paper. Plants for which the reference table has values from earlier literature get a
+/// literature column (their orders appear as rows of their own when we have no result there).
+/// 4 significant figures throughout.
 ///
 /// A plant without a published reference (no row of `reference` is its), or one the campaign ran
 /// only with the plain objective, gets the campaign layout instead ([`campaign_table`]); a plant
@@ -173,7 +198,7 @@ fn paper_table(p: &str, fp: &str, best: &[BestRow], f: Option<&FullOrderRow>, re
                 cells.join("; ")
             }
         };
-        let dagger = f.is_some_and(|f| f.from_paper);
+        let note = f.and_then(|f| full_order_note(f.source));
         let paper_full = refs(RefMethod::FullOrder).next();
         let caption = format!(
             "{}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified stable controller of each order $n_K$ (hinfix), against the HIFOO results of Gumussoy, Millstone \\& Overton (2008).",
@@ -189,7 +214,7 @@ fn paper_table(p: &str, fp: &str, best: &[BestRow], f: Option<&FullOrderRow>, re
                 None => "",
             };
             let order = paper_full.map(|r| format!(" ($n_K = {}${stab})", r.order)).unwrap_or_default();
-            let mark = if dagger { "$^\\dagger$" } else { "" };
+            let mark = full_order_mark(f.source);
             let pf = paper_full.map_or(f64::NAN, |r| r.gamma);
             let _ = write!(s, "full order{order} & {}{mark} & {} & {}", sig4(f.gamma), sig4(pf), sig4(f.gamma / pf));
             if has_lit {
@@ -211,11 +236,8 @@ fn paper_table(p: &str, fp: &str, best: &[BestRow], f: Option<&FullOrderRow>, re
             s.push_str(" \\\\\n");
         }
         s.push_str("\\bottomrule\n\\end{tabular}\n");
-        if dagger {
-            let _ = writeln!(
-                s,
-                "\\par\\footnotesize $^\\dagger$ full-order value from the paper (not recomputed here: $n > {FULL_ORDER_MAX_N}$)."
-            );
+        if let Some(note) = note {
+            let _ = writeln!(s, "\\par\\footnotesize {note}");
         }
         s.push_str("\\end{table}\n\n");
     }
@@ -248,7 +270,7 @@ fn sig4_inf(x: f64) -> String {
 
 /// The caption's account of the campaign: "the campaign `name` (N jobs: ε ∈ {…}, S seeds,
 /// C CPU s per job)".
-fn about_text(about: &CampaignAbout) -> String {
+pub(crate) fn about_text(about: &CampaignAbout) -> String {
     if about.names.is_empty() {
         return "the campaign".into();
     }
@@ -292,7 +314,12 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
     // The full-order row holds only its number; what it is goes in a note under the table (a
     // multicolumn row with the text made the table 116–132 pt wider than the page).
     if let Some(f) = f {
-        let _ = writeln!(s, "full$^*$ & -- & {} & -- & -- & -- & -- & -- \\\\\n\\midrule", sig4(f.gamma));
+        let _ = writeln!(
+            s,
+            "full$^*$ & -- & {}{} & -- & -- & -- & -- & -- \\\\\n\\midrule",
+            sig4(f.gamma),
+            full_order_mark(f.source)
+        );
     }
     let mut sorted: Vec<&&BestRow> = rows.iter().collect();
     sorted.sort_by(|a, b| b.order.cmp(&a.order).then(a.objective.name().cmp(b.objective.name()).reverse()));
@@ -330,6 +357,9 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
             "\\par\\footnotesize $^*$ full order: the unconstrained bound $\\gamma = {}$ (any order, $K$ may be unstable){k}.",
             sig4(f.gamma)
         );
+        if let Some(note) = full_order_note(f.source) {
+            let _ = writeln!(s, "\\par {note}");
+        }
     }
     s.push_str("\\end{table}\n\n");
     s

@@ -1,6 +1,6 @@
 //! The campaign's report: its records reduced once ([`ReportData`]) and written by the
 //! exporters of `super::export`, each file atomically (tmp in the same directory, fsync,
-//! rename): the tables `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`, and
+//! rename): the tables `best.csv`, `tables.tex`, `compare.csv`, `compare.tex`, `library.tex`, and
 //! `strong_vs_plain.csv` when the campaign ran both objectives on a (plant, n_K), `plants.csv`
 //! when it ran a problem of several plants ([`write_problem_reports`]); the page
 //! `report/index.html` ([`write_html_report`]). Pure functions of journal records, the plants and
@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::campaign::execution::run::duplicate_ids;
+use crate::campaign::leaves::library_index::{LibraryIndex, LibraryIndexError};
 use crate::campaign::leaves::reference::{load_default_reference, ReferenceError, ReferenceRow};
 use crate::campaign::leaves::sanitise::for_terminal;
 use crate::campaign::model::campaign::{Campaign, Problem};
@@ -121,14 +122,16 @@ pub fn write_exports(data: &ReportData, exporters: &[&(dyn Exporter + Sync)]) ->
 }
 
 /// Reduces `records` and writes the report tables into `out_dir` (created if needed).
-/// `plants` maps plant fingerprints to the plants (as `Job::plant` holds them).
+/// `plants` maps plant fingerprints to the plants (as `Job::plant` holds them); `reference` and
+/// `library` give the full-order bounds not computed here.
 pub fn write_reports(
     out_dir: &Path,
     records: &[JobRecord],
     plants: &PlantMap,
     reference: &[ReferenceRow],
+    library: &LibraryIndex,
 ) -> Result<ReportSummary, ReportError> {
-    write_problem_reports(out_dir, records, plants, &ProblemMap::new(), reference)
+    write_problem_reports(out_dir, records, plants, &ProblemMap::new(), reference, library)
 }
 
 /// [`write_reports`] with the campaign's problems of several plants (`problems`, by
@@ -140,9 +143,10 @@ pub fn write_problem_reports(
     plants: &PlantMap,
     problems: &ProblemMap,
     reference: &[ReferenceRow],
+    library: &LibraryIndex,
 ) -> Result<ReportSummary, ReportError> {
     std::fs::create_dir_all(out_dir).map_err(|source| ReportError::Io { path: out_dir.to_path_buf(), source })?;
-    let data = ReportData::reduce(out_dir, records, plants, problems, reference);
+    let data = ReportData::reduce(out_dir, records, plants, problems, reference, library);
     let files = write_exports(&data, &TABLES)?;
     Ok(ReportSummary { files, best: data.best, compare: data.compare })
 }
@@ -175,6 +179,9 @@ pub enum CampaignReportError {
     /// The paper's built-in reference table.
     #[error("reading the paper's reference table: {0}")]
     Reference(#[source] ReferenceError),
+    /// The plant library's index of full-order values.
+    #[error(transparent)]
+    LibraryIndex(#[from] LibraryIndexError),
     /// Writing a report file.
     #[error(transparent)]
     Report(#[from] ReportError),
@@ -210,10 +217,12 @@ pub fn problem_map(c: &Campaign) -> ProblemMap {
 }
 
 /// Reduces `records` (the campaign's, duplicates included) to the report files in `dir`
-/// (best.csv, tables.tex, compare.csv/.tex).
+/// (best.csv, tables.tex, compare.csv/.tex, library.tex, …), with the paper's reference table
+/// and the index of the plant library in use (`LibraryIndex::load_default`).
 pub fn report(dir: &Path, c: &Campaign, records: &[JobRecord]) -> Result<CampaignReport, CampaignReportError> {
     let reference = load_default_reference().map_err(CampaignReportError::Reference)?;
-    let summary = write_problem_reports(dir, records, &plant_map(c), &problem_map(c), &reference)?;
+    let library = LibraryIndex::load_default()?;
+    let summary = write_problem_reports(dir, records, &plant_map(c), &problem_map(c), &reference, &library)?;
     Ok(CampaignReport { summary, duplicates: duplicate_ids(records) })
 }
 

@@ -1,8 +1,9 @@
 //! The report files, one [`Exporter`] each (one small file per output format): `best.csv`,
-//! `tables.tex`, `strong_vs_plain.csv`, `plants.csv`, `compare.csv`, `compare.tex` (the tables
-//! that `campaign run` and `campaign report` write, [`TABLES`]) and the page `report/index.html`
-//! ([`HTML_PAGE`], `campaign report` only). Every exporter is a pure function of the reduced
-//! report ([`ReportData`]); `super::report` writes what they return, atomically.
+//! `tables.tex`, `strong_vs_plain.csv`, `plants.csv`, `compare.csv`, `compare.tex`,
+//! `library.tex` (the tables that `campaign run` and `campaign report` write, [`TABLES`]) and the
+//! page `report/index.html` ([`HTML_PAGE`], `campaign report` only). Every exporter is a pure
+//! function of the reduced report ([`ReportData`]); `super::report` writes what they return,
+//! atomically.
 //!
 //! A new output format is one file here: a unit struct implementing [`Exporter`] (its file name
 //! and its bytes; a CSV file implements [`CsvFile`], its rows), listed in [`TABLES`], and one line
@@ -13,12 +14,14 @@ mod best_csv;
 mod compare_csv;
 mod compare_tex;
 mod html_page;
+mod library_tex;
 mod plants_csv;
 mod strong_vs_plain_csv;
 mod tables_tex;
 
 use std::path::Path;
 
+use crate::campaign::leaves::library_index::LibraryIndex;
 use crate::campaign::leaves::reference::ReferenceRow;
 use crate::campaign::records::record::JobRecord;
 use crate::campaign::reduction::compare::{compare_rows, full_order_rows, CampaignAbout, CompareRow, FullOrderRow};
@@ -28,6 +31,7 @@ pub use best_csv::BestCsv;
 pub use compare_csv::CompareCsv;
 pub use compare_tex::CompareTex;
 pub use html_page::HtmlPage;
+pub use library_tex::LibraryTex;
 pub use plants_csv::PlantsCsv;
 pub use strong_vs_plain_csv::StrongVsPlainCsv;
 pub use tables_tex::TablesTex;
@@ -48,23 +52,24 @@ pub struct ReportData<'a> {
     pub full: Vec<FullOrderRow>,
     /// Ours against the paper.
     pub compare: Vec<CompareRow>,
-    /// The campaign's ε, seeds, budgets and plants (the captions of `tables.tex`).
+    /// The campaign's ε, seeds, budgets and plants (the captions of `tables.tex` and `library.tex`).
     pub about: CampaignAbout,
 }
 
 impl<'a> ReportData<'a> {
     /// Reduces `records` (`plants` and `problems` by fingerprint, as `Job::plant` and
     /// `Job::multi` hold them): each controller re-verified, the best per entry, the full-order
-    /// bounds and the comparison rows.
+    /// bounds (computed, else the paper's, else `library`'s) and the comparison rows.
     pub fn reduce(
         dir: &'a Path,
         records: &'a [JobRecord],
         plants: &PlantMap,
         problems: &ProblemMap,
         reference: &'a [ReferenceRow],
+        library: &LibraryIndex,
     ) -> Self {
         let best = best_per_problem(records, plants, problems);
-        let full = full_order_rows(&best, plants, reference);
+        let full = full_order_rows(&best, plants, reference, library);
         let compare = compare_rows(&best, &full, reference);
         let about = CampaignAbout::of(records).with_plants(plants);
         ReportData { dir, records, reference, best, full, compare, about }
@@ -113,8 +118,8 @@ impl<T: CsvFile> Exporter for T {
 }
 
 /// The tables, in the order they are written.
-pub const TABLES: [&(dyn Exporter + Sync); 6] =
-    [&BestCsv, &TablesTex, &StrongVsPlainCsv, &PlantsCsv, &CompareCsv, &CompareTex];
+pub const TABLES: [&(dyn Exporter + Sync); 7] =
+    [&BestCsv, &TablesTex, &StrongVsPlainCsv, &PlantsCsv, &CompareCsv, &CompareTex, &LibraryTex];
 
 /// The HTML page.
 pub const HTML_PAGE: &(dyn Exporter + Sync) = &HtmlPage;
@@ -141,16 +146,21 @@ mod snapshots {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report")
     }
 
-    fn assert_snapshot(exporter: &dyn Exporter) {
+    /// `f` of the fixture journal's report data (with the project's plant library index).
+    pub(super) fn with_fixture<T>(f: impl FnOnce(ReportData) -> T) -> T {
         let dir = dir();
         let campaign = Campaign::load(&dir.join("report.toml")).unwrap();
         let records = read_journal(&dir.join("runs.jsonl")).unwrap().records;
         let reference = load_default_reference().unwrap();
-        let data = ReportData::reduce(&dir, &records, &plant_map(&campaign), &problem_map(&campaign), &reference);
+        let library = LibraryIndex::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("plants")).unwrap();
+        f(ReportData::reduce(&dir, &records, &plant_map(&campaign), &problem_map(&campaign), &reference, &library))
+    }
+
+    fn assert_snapshot(exporter: &dyn Exporter) {
+        let got = with_fixture(|data| exporter.export(&data).unwrap().unwrap_or_default());
         let name = Path::new(exporter.file()).file_name().unwrap().to_string_lossy();
-        let want = std::fs::read_to_string(dir.join("expected").join(format!("{name}.snap"))).unwrap();
-        let got = String::from_utf8(exporter.export(&data).unwrap().unwrap_or_default()).unwrap();
-        assert_eq!(got, want, "{}", exporter.file());
+        let want = std::fs::read_to_string(dir().join("expected").join(format!("{name}.snap"))).unwrap();
+        assert_eq!(String::from_utf8(got).unwrap(), want, "{}", exporter.file());
     }
 
     /// One test per exporter, named after its file.
@@ -172,6 +182,7 @@ mod snapshots {
         plants_csv: PlantsCsv,
         compare_csv: CompareCsv,
         compare_tex: CompareTex,
+        library_tex: LibraryTex,
         html_page: HtmlPage,
     );
 }

@@ -11,6 +11,7 @@ use plotters::prelude::*;
 use super::render::{
     colour, draw_legend, log_ticks, msg, padded_range, spans_decades, styled_mesh, tick, DrawError, Figure, FONT_FAMILY,
 };
+use crate::campaign::reduction::compare::FullOrderSource;
 
 /// Data of one γ-vs-order figure.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,8 +25,8 @@ pub struct GammaOrderFigure {
     pub plain: Vec<(usize, f64)>,
     /// (n_K, the paper's HIFOO γ).
     pub paper: Vec<(usize, f64)>,
-    /// The full-order bound γ_opt (None if unknown), and whether it is the paper's value.
-    pub full_order: Option<(f64, bool)>,
+    /// The full-order bound γ_opt (None if unknown), and where it comes from.
+    pub full_order: Option<(f64, FullOrderSource)>,
 }
 
 impl GammaOrderFigure {
@@ -68,11 +69,13 @@ impl GammaOrderFigure {
             })
             .draw()
             .map_err(msg)?;
-        if let Some((g, from_paper)) = self.full_order {
-            let label = if from_paper {
-                format!("full-order bound {} (paper's value)", tick(g))
-            } else {
-                format!("full-order bound γ_opt = {}", tick(g))
+        if let Some((g, source)) = self.full_order {
+            let label = match source {
+                FullOrderSource::Paper => format!("full-order bound {} (paper's value)", tick(g)),
+                FullOrderSource::LibraryIndex => format!("full-order bound {} (library index)", tick(g)),
+                FullOrderSource::Computed | FullOrderSource::Unavailable => {
+                    format!("full-order bound γ_opt = {}", tick(g))
+                }
             };
             let style = ShapeStyle::from(&colour::BOUND).stroke_width(2);
             chart

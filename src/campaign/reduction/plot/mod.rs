@@ -9,9 +9,9 @@
 //!   each (plant, order), peak marked; for a problem of several plants (or another objective)
 //!   one per plant, `sigma_<problem>_nK<k>_<plant>`.
 //!
-//! Like the report files, the figures are pure functions of the journal, the traces, the plants
-//! and the reference table. Drawing is `plotters` with a bundled font (`render.rs`), so nothing
-//! outside Rust crates is needed.
+//! Like the report files, the figures are pure functions of the journal, the traces, the plants,
+//! the reference table and the plant library's index. Drawing is `plotters` with a bundled font
+//! (`render.rs`), so nothing outside Rust crates is needed.
 
 pub mod convergence;
 pub(crate) mod gamma_order;
@@ -24,6 +24,7 @@ use super::compare::full_order_rows;
 use super::reduce::{best_per_problem, verify, verify_problem, BestRow, PlantMap, ProblemMap, Verdict};
 use super::report::ReportError;
 use crate::campaign::execution::trace::{read_iterations, TraceError};
+use crate::campaign::leaves::library_index::LibraryIndex;
 use crate::campaign::leaves::reference::{RefMethod, ReferenceRow};
 use crate::campaign::records::record::JobRecord;
 use crate::design::ObjectiveKind;
@@ -113,9 +114,15 @@ pub fn file_part_among(name: &str, all: &[&str]) -> String {
     format!("{}-{hash}", &part[..part.len().min(MAX_FILE_PART - 9)])
 }
 
-/// The γ-vs-order figure of each plant in `best`.
-pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[ReferenceRow]) -> Vec<GammaOrderFigure> {
-    let full = full_order_rows(best, plants, reference);
+/// The γ-vs-order figure of each plant in `best` (the full-order bound as the report has it:
+/// computed, else `reference`'s, else `library`'s).
+pub fn gamma_order_figures(
+    best: &[BestRow],
+    plants: &PlantMap,
+    reference: &[ReferenceRow],
+    library: &LibraryIndex,
+) -> Vec<GammaOrderFigure> {
+    let full = full_order_rows(best, plants, reference, library);
     let mut names: Vec<(&str, &str)> = best.iter().map(|r| (r.plant.as_str(), r.plant_fingerprint.as_str())).collect();
     names.dedup();
     names
@@ -134,7 +141,7 @@ pub fn gamma_order_figures(best: &[BestRow], plants: &PlantMap, reference: &[Ref
                 .map(|r| (r.order, r.gamma))
                 .collect();
             paper.sort_by_key(|x| x.0);
-            let full_order = full.iter().find(|f| f.plant == p && f.gamma.is_finite()).map(|f| (f.gamma, f.from_paper));
+            let full_order = full.iter().find(|f| f.plant == p && f.gamma.is_finite()).map(|f| (f.gamma, f.source));
             GammaOrderFigure { plant: p.to_string(), ours, plain, paper, full_order }
         })
         .collect()
@@ -155,6 +162,7 @@ pub fn write_plots(
     plants: &PlantMap,
     problems: &ProblemMap,
     reference: &[ReferenceRow],
+    library: &LibraryIndex,
 ) -> Result<PlotSummary, PlotError> {
     let dir = campaign_dir.join("plots");
     std::fs::create_dir_all(&dir).map_err(|source| ReportError::Io { path: dir.clone(), source })?;
@@ -166,7 +174,7 @@ pub fn write_plots(
         Ok(files) => out.files.extend(files),
         Err(e) => out.failed.push(e.to_string()),
     };
-    for fig in gamma_order_figures(&best, plants, reference) {
+    for fig in gamma_order_figures(&best, plants, reference, library) {
         keep(write_png_and_svg(&fig, &dir.join(format!("gamma-vs-order_{}", part(&fig.plant)))), &mut out);
     }
     for row in &best {
