@@ -272,25 +272,25 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
         });
         row.runs += 1;
         match verdict {
-            Some(Verdict::Verified { gamma, alpha_k, k_hinf, controller_stable, plants, .. }) => {
-                let (gamma, alpha_k, k_hinf, controller_stable) = (*gamma, *alpha_k, *k_hinf, *controller_stable);
+            Some(v @ Verdict::Verified { gamma, .. }) => {
                 row.verified += 1;
-                gammas.push(gamma);
-                if !(gamma >= row.gamma) {
-                    row.gamma = gamma;
-                    row.job_id = Some(r.job_id.0.clone());
-                    row.eps = Some(r.eps);
-                    row.seed = Some(r.seed);
-                    row.k_hinf = Some(k_hinf);
-                    row.alpha_k = alpha_k;
-                    row.controller_stable = Some(controller_stable);
-                    row.plants = plants.clone();
-                    row.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
-                    row.chain_cpu_to_best_s = row.cpu_to_best_s.zip(chain_cpu_before(r)).map(|(t, before)| t + before);
-                }
+                gammas.push(*gamma);
+                row.offer(r, v, chain_cpu_before(r));
             }
             _ if r.failed() => row.failed += 1,
             _ => row.unverified += 1,
+        }
+    }
+    // A plain row also takes the strong jobs' controllers of its (plant, order): a stable K that
+    // stabilises is a plain solution too, so plain ≤ strong in every table (the row's job id then
+    // names the strong job; its counts stay those of the plain jobs).
+    for &(r, ref verdict) in per_job.values() {
+        if r.options.objective != ObjectiveKind::Strong {
+            continue;
+        }
+        let key = (labels[&r.plant_fingerprint].clone(), r.order, ObjectiveKind::Plain as u8);
+        if let (Some((row, _)), Some(v @ Verdict::Verified { .. })) = (rows.get_mut(&key), verdict) {
+            row.offer(r, v, chain_cpu_before(r));
         }
     }
     rows.into_values()
@@ -302,6 +302,25 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
 }
 
 impl BestRow {
+    /// Makes the verified record `r` (figures `verdict`) the row's best if its γ is lower
+    /// (`chain_cpu_before`: the CPU seconds of the jobs it was started from).
+    fn offer(&mut self, r: &JobRecord, verdict: &Verdict, chain_cpu_before: Option<f64>) {
+        let Verdict::Verified { gamma, alpha_k, k_hinf, controller_stable, plants, .. } = verdict else { return };
+        if gamma >= &self.gamma {
+            return;
+        }
+        self.gamma = *gamma;
+        self.job_id = Some(r.job_id.0.clone());
+        self.eps = Some(r.eps);
+        self.seed = Some(r.seed);
+        self.k_hinf = Some(*k_hinf);
+        self.alpha_k = *alpha_k;
+        self.controller_stable = Some(*controller_stable);
+        self.plants = plants.clone();
+        self.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
+        self.chain_cpu_to_best_s = self.cpu_to_best_s.zip(chain_cpu_before).map(|(t, before)| t + before);
+    }
+
     /// The row of a (plant, order) before any record: γ NaN, no best job, every count 0.
     pub fn new(plant: String, plant_fingerprint: String, order: usize) -> BestRow {
         BestRow {
@@ -475,6 +494,35 @@ mod tests {
         // a chain whose head is not in the journals has no chain figure
         let rows = best_per_order(&[gain_record(&p, 3, 0.0, 7.0, Some(&best))], &map(&[&p]));
         assert_eq!(rows[0].chain_cpu_to_best_s, None);
+    }
+
+    /// A plain row takes a strong job's controller of its (plant, order) when it is better (a
+    /// stable K is a plain solution too), keeping its own counts; a strong-only campaign gets no
+    /// plain row, and a better plain job keeps its row.
+    #[test]
+    fn a_plain_row_is_never_above_the_strong_row() {
+        let p = plant("P", 1.0);
+        let with = |objective, seed, d| {
+            let mut r = gain_record(&p, seed, d, 1.0, None);
+            r.options.objective = objective;
+            r.job_id = job_id(&p.fingerprint(), &r.options, None, RunnerTag::Design);
+            r
+        };
+        // γ = 1/(1 − d): plain 2.0, strong 1.0
+        let (plain, strong) = (with(ObjectiveKind::Plain, 0, 0.5), with(ObjectiveKind::Strong, 1, 0.0));
+        let rows = best_per_order(&[plain.clone(), strong.clone()], &map(&[&p]));
+        let (s, pl) = (&rows[0], &rows[1]);
+        assert_eq!((s.objective, pl.objective), (ObjectiveKind::Strong, ObjectiveKind::Plain));
+        assert!((pl.gamma - 1.0).abs() < 1e-9 && pl.gamma == s.gamma, "{pl:?}");
+        assert_eq!(pl.job_id.as_deref(), Some(strong.job_id.0.as_str()));
+        assert_eq!((pl.runs, pl.verified, pl.controller_stable, pl.seed), (1, 1, Some(true), Some(1)));
+        // strong only: no plain row
+        assert_eq!(best_per_order(std::slice::from_ref(&strong), &map(&[&p])).len(), 1);
+        // a better plain job keeps its own row
+        let better = with(ObjectiveKind::Plain, 2, -1.0); // γ 0.5
+        let rows = best_per_order(&[better.clone(), strong], &map(&[&p]));
+        assert_eq!(rows[1].job_id.as_deref(), Some(better.job_id.0.as_str()));
+        assert!((rows[1].gamma - 0.5).abs() < 1e-9);
     }
 
     #[test]
