@@ -7,8 +7,11 @@
 //! column per order and objective made the table of orders 0–3 some 160 pt wider than an
 //! article's text. `$^{\mathrm{u}}$` marks a best plain controller that is unstable; `n.s.` (not
 //! stabilised) an entry whose jobs ran but gave no re-verified controller, `--` one no job ran.
-//! The caption states the campaign (ε, seeds, budgets) and every mark used; the header repeats on
-//! each page. Written whenever the campaign has a best row.
+//! A full-order value above the plant's best fixed-order γ is marked `$^{*}$`: it cannot be the
+//! infimum over full-order controllers (every fixed-order controller is one), so it is the value
+//! of a regularised problem (singular D12 or D21: AC1, AC12, AC18 and NN10 of COMPleib) or an
+//! approximation, and the caption says so. The caption states the campaign (ε, seeds, budgets) and
+//! every mark used; the header repeats on each page. Written whenever the campaign has a best row.
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -17,6 +20,7 @@ use super::{Exporter, ReportData};
 use crate::campaign::reduction::compare::FullOrderSource;
 use crate::campaign::reduction::latex::{about_text, escape, full_order_mark, full_order_note, sig4};
 use crate::design::ObjectiveKind;
+use crate::lti::NORM_TIE_RTOL;
 
 /// `library.tex`.
 pub struct LibraryTex;
@@ -33,6 +37,9 @@ impl Exporter for LibraryTex {
 
 /// The mark of a plain entry whose best controller is unstable.
 const UNSTABLE_MARK: &str = "$^{\\mathrm{u}}$";
+
+/// The mark of a full-order value above the plant's best fixed-order γ (module docs).
+const ABOVE_FIXED_ORDER_MARK: &str = "$^{*}$";
 
 /// A sort key of a plant name: letter case folded, each run of digits a number (so `AC2` comes
 /// before `AC10`); a run of digits sorts before text.
@@ -82,10 +89,22 @@ fn library_tex(data: &ReportData) -> Option<String> {
     }
 
     let mut rows = String::new();
+    let mut any_above = false;
     for (i, (name, fp)) in plants.into_iter().enumerate() {
         let full = data.full.iter().find(|f| f.plant == name);
         let n = full.and_then(|f| f.n).map_or("--".to_string(), |n| n.to_string());
-        let full_order = full.map_or("--".to_string(), |f| format!("{}{}", sig4(f.gamma), full_order_mark(f.source)));
+        let lowest = data
+            .best
+            .iter()
+            .filter(|b| b.plant_fingerprint == fp && b.job_id.is_some())
+            .map(|b| b.gamma)
+            .fold(f64::INFINITY, f64::min);
+        let full_order = full.map_or("--".to_string(), |f| {
+            let above = f.gamma > lowest * (1.0 + NORM_TIE_RTOL);
+            any_above |= above;
+            let mark = if above { ABOVE_FIXED_ORDER_MARK } else { "" };
+            format!("{}{}{mark}", sig4(f.gamma), full_order_mark(f.source))
+        });
         if both && i > 0 {
             rows.push_str("\\addlinespace\n");
         }
@@ -123,11 +142,14 @@ fn library_tex(data: &ReportData) -> Option<String> {
             ObjectiveKind::Strong => "strong: $K$ stable".into(),
         })
         .collect();
-    let notes: Vec<String> = [FullOrderSource::Paper, FullOrderSource::LibraryIndex]
+    let mut notes: Vec<String> = [FullOrderSource::Paper, FullOrderSource::LibraryIndex]
         .into_iter()
         .filter(|s| data.full.iter().any(|f| f.source == *s))
         .filter_map(full_order_note)
         .collect();
+    if any_above {
+        notes.push(format!("{ABOVE_FIXED_ORDER_MARK} above a fixed-order $\\gamma$ of the plant, so not the infimum over full-order controllers: the value of a regularised problem (singular $D_{{12}}$ or $D_{{21}}$) or an approximation."));
+    }
     let caption = format!(
         "Best closed-loop $H_\\infty$ norm $\\gamma$ of a re-verified controller per plant and controller order $n_K$ found by {}; {}. $n$: the plant's order; full order: the optimal $\\gamma$ of a full-order controller (any order, $K$ may be unstable), computed here unless marked. n.s.\\ (not stabilised): jobs ran, but none gave a re-verified controller; --: no job ran.{}",
         about_text(&data.about),
@@ -170,6 +192,20 @@ mod tests {
             library_tex(&data)
         })
         .is_none());
+    }
+
+    /// A full-order value above the plant's best fixed-order γ is marked and explained; one at or
+    /// below it is not.
+    #[test]
+    fn a_full_order_value_above_a_fixed_order_one_is_marked() {
+        let tex = with_fixture(|mut data| {
+            data.full[0].gamma = 1.0; // HE1's best rows: 0.1155 (plain), 0.1270 (strong)
+            library_tex(&data).unwrap()
+        });
+        assert!(tex.contains("\nHE1 & 4 & 1.000$^{*}$ & plain"), "{tex}");
+        assert!(tex.contains("$^{*}$ above a fixed-order $\\gamma$ of the plant, so not the infimum"), "{tex}");
+        let tex = with_fixture(|data| library_tex(&data).unwrap());
+        assert!(!tex.contains("$^{*}$"), "{tex}");
     }
 
     #[test]
