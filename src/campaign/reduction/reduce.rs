@@ -275,7 +275,7 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
             Some(v @ Verdict::Verified { gamma, .. }) => {
                 row.verified += 1;
                 gammas.push(*gamma);
-                row.offer(r, v, chain_cpu_before(r));
+                row.offer(r, v, || chain_cpu_before(r));
             }
             _ if r.failed() => row.failed += 1,
             _ => row.unverified += 1,
@@ -290,7 +290,7 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
         }
         let key = (labels[&r.plant_fingerprint].clone(), r.order, ObjectiveKind::Plain as u8);
         if let (Some((row, _)), Some(v @ Verdict::Verified { .. })) = (rows.get_mut(&key), verdict) {
-            row.offer(r, v, chain_cpu_before(r));
+            row.offer(r, v, || chain_cpu_before(r));
         }
     }
     rows.into_values()
@@ -303,8 +303,8 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
 
 impl BestRow {
     /// Makes the verified record `r` (figures `verdict`) the row's best if its γ is lower
-    /// (`chain_cpu_before`: the CPU seconds of the jobs it was started from).
-    fn offer(&mut self, r: &JobRecord, verdict: &Verdict, chain_cpu_before: Option<f64>) {
+    /// (`chain_cpu_before`: the CPU seconds of the jobs it was started from, walked only then).
+    fn offer(&mut self, r: &JobRecord, verdict: &Verdict, chain_cpu_before: impl FnOnce() -> Option<f64>) {
         let Verdict::Verified { gamma, alpha_k, k_hinf, controller_stable, plants, .. } = verdict else { return };
         if gamma >= &self.gamma {
             return;
@@ -318,7 +318,7 @@ impl BestRow {
         self.controller_stable = Some(*controller_stable);
         self.plants = plants.clone();
         self.cpu_to_best_s = r.outcome().map(|o| o.search.cpu_to_best_s).filter(|t| t.is_finite());
-        self.chain_cpu_to_best_s = self.cpu_to_best_s.zip(chain_cpu_before).map(|(t, before)| t + before);
+        self.chain_cpu_to_best_s = self.cpu_to_best_s.zip(chain_cpu_before()).map(|(t, before)| t + before);
     }
 
     /// The row of a (plant, order) before any record: γ NaN, no best job, every count 0.
