@@ -252,6 +252,23 @@ fn unknown_name_lists_the_library() {
 }
 
 #[test]
+fn a_plant_listed_as_missing_is_named_so() {
+    // CM6 (no public data) and HF2D1 (left out for size) are in plants/compleib/MISSING.md,
+    // ZerenOzbay (a paper problem without data) in plants/MISSING.md.
+    for (name, list) in
+        [("CM6", "compleib/MISSING.md"), ("HF2D1", "compleib/MISSING.md"), ("ZerenOzbay", "plants/MISSING.md")]
+    {
+        let s = hinfix::lti::resolve_plant(name).unwrap_err().to_string();
+        assert!(s.contains(&format!("`{name}` is listed in")) && s.contains(list), "{s}");
+    }
+    // a name only inside another word of a list is not listed: CM6_I, HF2D
+    for name in ["CM6_I", "HF2D", "NoSuchPlant"] {
+        let s = hinfix::lti::resolve_plant(name).unwrap_err().to_string();
+        assert!(!s.contains("is listed in"), "{s}");
+    }
+}
+
+#[test]
 fn unknown_top_level_key_is_rejected_by_name() {
     // A misspelt matrix (`d12`) or a key this version does not know was ignored.
     for key in ["d12", "ts", "dt", "comment"] {

@@ -113,6 +113,11 @@ pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
         .iter()
         .find(|k| k.eq_ignore_ascii_case(name_or_path))
         .map(|k| format!("did you mean `{k}`? "))
+        .or_else(|| {
+            listed_as_missing(name_or_path).map(|list| {
+                format!("`{name_or_path}` is listed in {} as a plant whose data do not ship; ", list.display())
+            })
+        })
         .unwrap_or_default();
     // The whole list only while it is short: the library holds about 150 plants.
     let known = match names.len() {
@@ -120,6 +125,32 @@ pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
         n => format!("{n} plants, listed by `campaign plants`"),
     };
     Err(PlantError { file, kind: PlantErrorKind::UnknownName { name: name_or_path.to_string(), hint, known } })
+}
+
+/// The `MISSING.md` of the library folder or of one of its collections that names `name` as a
+/// whole word (letters, digits and `_` around it do not count), if any: the plants the library
+/// lists as missing (no public data, or left out for size) are explained there.
+fn listed_as_missing(name: &str) -> Option<PathBuf> {
+    let dir = plants_dir();
+    let mut lists = vec![dir.join(MISSING_LIST)];
+    let mut subdirs: Vec<PathBuf> =
+        std::fs::read_dir(&dir).ok()?.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.is_dir()).collect();
+    subdirs.sort();
+    lists.extend(subdirs.into_iter().map(|d| d.join(MISSING_LIST)));
+    lists.into_iter().find(|list| std::fs::read_to_string(list).is_ok_and(|text| names_word(&text, name)))
+}
+
+/// The file of a library folder that lists its missing plants.
+const MISSING_LIST: &str = "MISSING.md";
+
+/// Whether `text` holds `word` with no letter, digit or `_` right before or after it.
+fn names_word(text: &str, word: &str) -> bool {
+    let is_word = |c: char| c.is_alphanumeric() || c == '_';
+    !word.is_empty()
+        && text.match_indices(word).any(|(i, _)| {
+            !text[..i].chars().next_back().is_some_and(is_word)
+                && !text[i + word.len()..].chars().next().is_some_and(is_word)
+        })
 }
 
 /// Up to this many library names are listed in an unknown-name error.
