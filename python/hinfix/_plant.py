@@ -81,6 +81,10 @@ def blocks(P, nmeas=None, ncon=None):
     if nmeas is None or ncon is None:
         raise TypeError("nmeas and ncon are required with a StateSpace plant (as for control.hinfsyn)")
     # at least one disturbance input w and one performance output z must remain
+    for count, kind, split in ((P.noutputs, "output", "a measurement y and a performance output z"),
+                               (P.ninputs, "input", "a control u and a disturbance w")):
+        if count < 2:
+            raise ValueError(f"P has {count} {kind}{'' if count == 1 else 's'}: a plant needs at least two, {split}")
     nmeas = _count(nmeas, "nmeas", P.noutputs - 1, f"P has {P.noutputs} outputs and one at least is z")
     ncon = _count(ncon, "ncon", P.ninputs - 1, f"P has {P.ninputs} inputs and one at least is w")
     A, B, C, D = (as_matrix(m, n) for m, n in zip((P.A, P.B, P.C, P.D), "ABCD"))

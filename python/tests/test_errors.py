@@ -23,6 +23,11 @@ def test_partition_errors(he1):
         hinfix.design(P, nmeas, 7, 1)
     with pytest.raises(TypeError, match="nmeas must be a whole number"):
         hinfix.design(P, 1.5, ncon, 1)
+    # a SISO system has no room for both a measurement and a performance output
+    with pytest.raises(ValueError, match=r"P has 1 output: a plant needs at least two, a measurement y"):
+        hinfix.design(control.tf([1], [1, 1]), 1, 1, 0)
+    with pytest.raises(ValueError, match=r"P has 1 input: a plant needs at least two, a control u"):
+        hinfix.design(control.ss(np.zeros((1, 1)), np.ones((1, 1)), np.ones((2, 1)), np.zeros((2, 1))), 1, 1, 0)
 
 
 def test_option_errors_carry_the_crates_message(he1):
