@@ -121,9 +121,16 @@ pub(super) fn design(
         (Some((s, p)), Some(d)) => Some(ScaledObjectives { stab_obj: s, perf_obj: p, d: Rc::clone(d) }),
         _ => None,
     };
-    let res =
-        Search { stab_obj: &mut stab_obj, perf_obj: &mut perf_obj, adapter: &mut adapter, rng: &mut rng, ctl, scaled }
-            .run(opts, &first, &kinds, nvar)?;
+    let res = Search {
+        stab_obj: &mut stab_obj,
+        perf_obj: &mut perf_obj,
+        adapter: &mut adapter,
+        rng: &mut rng,
+        ctl,
+        problem,
+        scaled,
+    }
+    .run(opts, &first, &kinds, nvar)?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
     let (final_x, ended) = how_it_ended(&res, opts, interrupted);
     let k = perf_obj.controller_at(&final_x);

@@ -90,7 +90,9 @@ impl Search<'_, '_, '_> {
                     r = self.refine(st, r, c, ctl)?;
                 }
                 r.x = self.to_raw(&r.x, c);
-                let better = st.offer_perf(&r, &self.to_raw(xs, c), k, c);
+                let from = self.to_raw(xs, c);
+                let verified = self.verified_end(st, &mut r, &from);
+                let better = st.offer_perf(&r, &from, k, c, verified);
                 Ok((stop_of(r.termination), better))
             }
             // f_h = +∞ at a point with α just below 0 (the norm's stability test has a margin):
@@ -199,12 +201,15 @@ impl Search<'_, '_, '_> {
         let x0 = self.to_coords(&best.x, c);
         let Some(mut r) = self.gs_perf(st, &x0, c, ctl)? else { return Ok(false) };
         r.x = self.to_raw(&r.x, c);
+        // A verified incumbent is replaced only by a point that verifies too (module `verified`).
+        let verified = self.verified_end(st, &mut r, &best.x);
         let b = st.perf.as_mut().expect("checked above");
-        if r.f < b.f {
+        if r.f < b.f && (verified || !b.verified) {
             b.x = r.x;
             b.f = r.f;
             b.dnorm = r.dnorm;
             b.evaldist = r.evaldist;
+            b.verified = verified;
         } else if r.x == b.x && r.dnorm < b.dnorm {
             b.dnorm = r.dnorm;
             b.evaldist = r.evaldist;

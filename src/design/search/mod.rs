@@ -27,6 +27,7 @@
 mod budget;
 mod local;
 mod plan;
+mod verified;
 
 use std::rc::Rc;
 
@@ -37,6 +38,7 @@ use crate::optim::{OptimResult, RunControl, Termination};
 use super::objective::{DesignObjective, ObjectivePhase, ObserverAdapter};
 use super::options::DesignOptions;
 use super::outcome::{DesignError, Phase, PhaseStats, SearchStop, SearchSummary, StartKind};
+use super::problem::Problem;
 use super::scaling::{from_scaled, to_scaled};
 use budget::{ctl_stop, improves, stop_of, GsRounds};
 use plan::{NextStart, StartPlan};
@@ -64,6 +66,8 @@ pub(crate) struct Best {
     pub from: Vec<f64>,
     /// The coordinates of the local search that produced it.
     pub coords: Coords,
+    /// Whether it is stable with the verification margin (f_h points; [`verified`]).
+    pub verified: bool,
 }
 
 /// The coordinates of one local search (docs/ALGORITHMS.md §8.6): the controller's parameters x,
@@ -158,18 +162,26 @@ impl<'s> State<'s> {
         let old = self.stab.as_ref().map_or(f64::INFINITY, |b| b.f);
         let better = improves(f, old, self.opts.stall_rtol, 1.0);
         if self.stab.is_none() || f < old {
-            self.stab = Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, coords });
+            let verified = false; // not asked of f_s points
+            self.stab =
+                Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, coords, verified });
         }
         better
     }
 
-    /// Records an f_h end point; returns whether it improved the best f_h (stall sense).
-    fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize, coords: Coords) -> bool {
-        let old = self.perf.as_ref().map_or(f64::INFINITY, |b| b.f);
-        let better = improves(r.f, old, self.opts.stall_rtol, 0.0);
-        if r.f.is_finite() && r.f < old {
+    /// Records an f_h end point, `verified` if it is stable with the verification margin;
+    /// returns whether it improved the best f_h (stall sense). A verified point beats an
+    /// unverified one whatever their f_h ([`verified`]).
+    fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize, coords: Coords, verified: bool) -> bool {
+        let (old, old_verified) = self.perf.as_ref().map_or((f64::INFINITY, false), |b| (b.f, b.verified));
+        if old_verified && !verified {
+            return false;
+        }
+        let upgrade = verified && !old_verified && self.perf.is_some() && r.f.is_finite();
+        let better = upgrade || improves(r.f, old, self.opts.stall_rtol, 0.0);
+        if r.f.is_finite() && (upgrade || r.f < old) {
             let (x, from) = (r.x.clone(), from.to_vec());
-            self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from, coords });
+            self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from, coords, verified });
             // Cut by `maxit`, or by the search's share of a budget (`return_gs_reserve` may give
             // the search more).
             self.perf_cut =
@@ -213,6 +225,8 @@ pub(crate) struct Search<'r, 'o, 'a> {
     pub rng: &'r mut dyn RngCore,
     /// The whole run's control.
     pub ctl: &'r RunControl,
+    /// The design problem: what the returned controller must stabilise ([`verified`]).
+    pub problem: &'r Problem,
     /// The objectives in plant-scaled variables, if the plant is scaled (`design::scaling`) and
     /// the run's [`VariableScaling`] mode is not off.
     pub scaled: Option<ScaledObjectives<'r, 'o>>,
@@ -373,6 +387,7 @@ impl Search<'_, '_, '_> {
             start: 0,
             from: first[0].clone(),
             coords: Coords::Raw,
+            verified: false,
         });
         let best_start = st.perf.as_ref().map_or(stab.start, |b| b.start);
         let (phase, f) = match &st.perf {
@@ -401,14 +416,39 @@ mod tests {
         OptimResult { x: vec![0.0], f, g: vec![0.0], dnorm, evaldist: 0.0, termination, iters: 1, evals: 1, cpu_s: 0.0 }
     }
 
+    /// `offer_perf`: a verified point beats an unverified one whatever their f_h; among points of
+    /// one kind the smaller f_h wins (module `verified`).
+    #[test]
+    fn a_verified_point_beats_an_unverified_one() {
+        let opts = DesignOptions::default();
+        let mut st = State::new(&opts);
+        let at = |x: f64, f: f64| OptimResult { x: vec![x], ..end(f, 0.1, Termination::LineSearchFailed) };
+        assert!(st.offer_perf(&at(1.0, 1.0), &[0.0], 0, Coords::Raw, false));
+        assert!(st.offer_perf(&at(2.0, 3.0), &[0.0], 1, Coords::Raw, true), "an upgrade counts as progress");
+        assert_eq!((st.perf.as_ref().unwrap().x[0], st.perf.as_ref().unwrap().verified), (2.0, true));
+        assert!(!st.offer_perf(&at(3.0, 0.5), &[0.0], 2, Coords::Raw, false), "unverified never displaces");
+        assert_eq!(st.perf.as_ref().unwrap().x[0], 2.0);
+        assert!(!st.offer_perf(&at(4.0, 3.5), &[0.0], 3, Coords::Raw, true));
+        assert!(st.offer_perf(&at(5.0, 2.0), &[0.0], 4, Coords::Raw, true));
+        assert_eq!(st.perf.as_ref().unwrap().x[0], 5.0);
+    }
+
     /// `refines`: only uncertified continued local searches that end within `refine_rtol` above
     /// the incumbent and were not cut by a budget.
     #[test]
     fn near_misses_are_refined_only_within_the_tolerance() {
         let opts = DesignOptions { refine_rtol: 0.03, ..Default::default() };
         let zero = |phase| PhaseStats { phase, iters: 0, evals: 0, cpu_s: 0.0 };
-        let best =
-            |f| Best { x: vec![1.0], f, dnorm: 0.0, evaldist: 0.0, start: 0, from: vec![1.0], coords: Coords::Raw };
+        let best = |f| Best {
+            x: vec![1.0],
+            f,
+            dnorm: 0.0,
+            evaldist: 0.0,
+            start: 0,
+            from: vec![1.0],
+            coords: Coords::Raw,
+            verified: true,
+        };
         let mut st = State {
             opts: &opts,
             stats: [zero(Phase::Stabilisation), zero(Phase::Optimisation), zero(Phase::GradientSampling)],
