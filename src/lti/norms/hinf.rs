@@ -10,7 +10,10 @@
 //! result for the singular values of a transfer matrix and a quadratically convergent algorithm for
 //! computing its L∞-norm", Systems & Control Letters 15 (1990).
 //!
-//! 1. Unstable (any Re λ(A) ≥ 0, exactly the HIFOO rule) or non-finite data → +∞.
+//! 1. Unstable (any Re λ(A) ≥ 0, exactly the HIFOO rule) or non-finite data → +∞. Where
+//!    balancing A's state coordinates pays (‖A‖_F falls by more than the factor
+//!    `kernels::balance::BALANCE_GAIN`), everything below runs on the balanced realisation, the
+//!    same transfer function exactly (`balanced_realisation`); every other system as given.
 //! 2. Lower bound γ_L = max σmax(G(iω)) over ω = ∞ (σmax(D)), ω = 0 and one test frequency per
 //!    mode, ω = |λ|·√max(¼, 1 − 2(Re λ/|λ|)²) (AB13DD's choice; for n > [`MAX_POLE_TEST_FREQS`]
 //!    only the least damped modes; from order [`HESSENBERG_QR_FROM`] on, well-damped modes only
@@ -80,6 +83,7 @@ use faer::{c64, Mat};
 
 use super::hinf_hooks::{measured, note, timed, NormEvent, Step};
 use crate::lti::interrupt::{Interrupt, Interrupted};
+use crate::lti::kernels::balance::{balance, BALANCE_GAIN};
 use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
 use crate::lti::kernels::level_set_pencil::pencil_crossings;
@@ -342,6 +346,46 @@ fn hinf_norm_from(
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
     stop.poll()?;
+    match balanced_realisation(sys) {
+        // A frequency-response evaluator of its own: `fr` (kept for the gradient's vectors at the
+        // peak, `gradient.rs`) is of `sys`'s coordinates.
+        Some(balanced) => level_set_norm(&balanced, poles, &mut None, tol, hints, stop, enough, sigma_d),
+        None => level_set_norm(sys, poles, fr, tol, hints, stop, enough, sigma_d),
+    }
+}
+
+/// `sys` in balanced state coordinates, (D⁻¹AD, D⁻¹B, CD, D) with D diagonal of powers of two
+/// (`kernels::balance`: the same transfer function, exactly), where balancing A lowers ‖A‖_F by
+/// more than [`BALANCE_GAIN`]; else `None` (use `sys`, bit for bit as before).
+///
+/// Why: in unbalanced coordinates both the frequency response and the level-set test lose
+/// accuracy. A closed loop of COMPleib's AC12 with a third-order controller of gain 550
+/// (‖A‖ = 6.6e3, balanced 57; ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5 rad/s
+/// where they are 5.62, 5.71, 17.8 and 19.9) and σmax only to 1.6e-8 relative, and the norm
+/// came out 5.6 % low (`tests/hinf_regression.rs`); balanced, both are right.
+pub(crate) fn balanced_realisation(sys: &StateSpace) -> Option<StateSpace> {
+    let (a, d) = balance(sys.a.as_ref());
+    if !(a.norm_l2() * BALANCE_GAIN < sys.a.norm_l2()) {
+        return None;
+    }
+    let b = Mat::from_fn(sys.b.nrows(), sys.b.ncols(), |i, j| sys.b[(i, j)] / d[i]);
+    let c = Mat::from_fn(sys.c.nrows(), sys.c.ncols(), |i, j| sys.c[(i, j)] * d[j]);
+    Some(StateSpace { a, b, c, d: sys.d.clone() })
+}
+
+/// The norm of a stable `sys` of order ≥ 1 with σmax(D) = `sigma_d` (module docs, steps 2–4), in
+/// the coordinates it is given in; `fr` as in [`hinf_norm_from`].
+#[allow(clippy::too_many_arguments)]
+fn level_set_norm(
+    sys: &StateSpace,
+    poles: &[c64],
+    fr: &mut Option<FreqResponse>,
+    tol: f64,
+    hints: &[f64],
+    stop: Interrupt<'_>,
+    enough: f64,
+    sigma_d: f64,
+) -> Result<HinfNorm, Interrupted> {
     let fr = fr.get_or_insert_with(|| FreqResponse::new(sys));
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
@@ -1096,6 +1140,40 @@ fn known_peak_eigenvalues(mu: &[c64], peak_freq: f64, window: f64, eligible: imp
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The norm does not depend on the state coordinates: badly scaled realisations
+    /// (T⁻¹AT, T⁻¹B, CT with T = diag(10^k) spreading 12 decades) of stable systems, half of
+    /// them with small C and D, give the norm of the well-scaled one. (The balanced path,
+    /// `balanced_realisation`, runs on every scaled one; the failure it mends is AC12's closed
+    /// loop in `tests/hinf_regression.rs`, which such random realisations do not reproduce.)
+    #[test]
+    fn badly_scaled_realisations_have_the_same_norm() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+        for case in 0..20 {
+            let (n, m, p) = (5 + case % 4, 1 + case % 3, 1 + case % 2);
+            let mut a = Mat::from_fn(n, n, |_, _| rng.gen_range(-1.0..1.0));
+            let shift = crate::lti::kernels::spectral::spectral_abscissa(a.as_ref()) + 0.05 + 0.1 * (case % 3) as f64;
+            for i in 0..n {
+                a[(i, i)] -= shift;
+            }
+            let b = Mat::from_fn(n, m, |_, _| rng.gen_range(-1.0..1.0));
+            let small = if case % 2 == 0 { 1e-4 } else { 1.0 };
+            let c = Mat::from_fn(p, n, |_, _| small * rng.gen_range(-1.0..1.0));
+            let d = Mat::from_fn(p, m, |_, _| small * rng.gen_range(-0.5..0.5));
+            let sys = StateSpace { a, b, c, d };
+            let t: Vec<f64> = (0..n).map(|i| 10f64.powf(12.0 * i as f64 / (n - 1) as f64 - 6.0)).collect();
+            let scaled = StateSpace {
+                a: Mat::from_fn(n, n, |i, j| sys.a[(i, j)] * t[j] / t[i]),
+                b: Mat::from_fn(n, m, |i, j| sys.b[(i, j)] / t[i]),
+                c: Mat::from_fn(p, n, |i, j| sys.c[(i, j)] * t[j]),
+                d: sys.d.clone(),
+            };
+            let want = hinf_norm(&sys, &HinfParams::default()).unwrap().value;
+            let got = hinf_norm(&scaled, &HinfParams::default()).unwrap().value;
+            assert!(want.is_finite() && (got / want - 1.0).abs() < 1e-8, "case {case}: {got} against {want}");
+        }
+    }
 
     /// The error bound e of the synthetic spectra below.
     const E: f64 = 1e-10;
