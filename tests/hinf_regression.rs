@@ -54,6 +54,19 @@ fn ac12_with_third_order_controller_finds_the_higher_peak() {
     assert_closed_loop_reaches_peak("ac12", 2.3958726299370354e-4, 18.425426879431075, 1e-10, 1e-10);
 }
 
+/// COMPleib ROC8 with a second-order controller of the COMPleib campaign (plain, results/compleib,
+/// n_K = 2): a well-scaled loop (‖A‖ = 6.4, cond(A) = 84) with a nearly unobservable mode at
+/// −1.0e-7 ± 0.44504j. σmax(T(iω)) has a broad peak 3.4926731167 at 1.787 rad/s and a spike of
+/// width 2e-7 rad/s to 3.4927086472 at 0.445041352 rad/s, 1.0e-5 higher. The norm reported the
+/// broad peak. Reference: SLICOT AB13DD (python-control 0.10.2 / slycot, `linfnorm`) found the
+/// spike (3.4927085094, off its top); its top by a golden-section search in 40-digit mpmath.
+/// σmax is evaluated to about 1e-9 there in double precision (the mode's damping), hence the
+/// tolerances.
+#[test]
+fn roc8_with_second_order_controller_finds_the_spike() {
+    assert_closed_loop_reaches_peak("roc8", 3.49270864715556, 0.44504135238410937, 1e-9, 1e-9);
+}
+
 /// A nearly flat optimal loop: the cross-term plant (tests/fixtures/full_order/cross_terms.py)
 /// with an order-3 controller designed on it. σmax(T(iω)) stays within 2.3e-7 (relative) of
 /// σmax(D_cl) = 0.5853817014 from ω = 0 to ∞, and rises above it only in one bump,
@@ -93,7 +106,7 @@ fn assert_closed_loop_reaches_peak(
     assert!((sigma_direct(&cl, peak_freq) - peak).abs() <= ref_tol * peak, "{name}: reference not attained");
     let h = hinf_norm(&cl, &HinfParams::default()).unwrap();
     assert!(
-        h.value >= peak * (1.0 - 2.0 * DEFAULT_HINF_TOL),
+        h.value >= peak * (1.0 - tol.max(2.0 * DEFAULT_HINF_TOL)),
         "{name}: ‖Tzw‖∞ = {} at ω = {}, below the peak {peak}",
         h.value,
         h.peak_freq
