@@ -157,7 +157,7 @@ fn journal_of_8ee3691_reads_every_status_to_the_same_values() {
 }
 
 /// `campaign report` on the 8ee3691 journal writes the tables that build wrote (best.csv and
-/// compare.csv, stored next to the journal; γ to 1e-12, see [`assert_same_table`]): reading the
+/// compare.csv, stored next to the journal; γ to 2e-10, see [`assert_same_table`]): reading the
 /// old format changes no result. The
 /// campaigns are the ones that build ran, with its search options pinned (later builds changed
 /// the defaults, and so the job ids).
@@ -186,7 +186,7 @@ fn report_on_the_journal_of_8ee3691_gives_its_tables() {
     }
 }
 
-/// The tables are equal cell by cell, numbers to 1e-12 relative: `report` re-verifies each
+/// The tables are equal cell by cell, numbers to 2e-10 relative (twice the norm's tolerance): `report` re-verifies each
 /// controller, recomputing γ with the current H∞ norm, and a change of that norm's rounding
 /// (e.g. a different level-set path) may move the last digits; nothing else may differ. Columns
 /// are matched by their header: a column added since (best.csv's `k_hinf`, `near_best`, …) is
@@ -213,7 +213,9 @@ fn assert_same_table(got: &str, want: &str, what: &str) {
             if x.is_nan() && y.is_nan() && [a, *b].iter().all(|c| c.is_empty() || *c == "nan") {
                 continue;
             }
-            assert!((x - y).abs() <= 1e-12 * x.abs().max(y.abs()), "{what}: {a} vs {b} in\n{gl}\n{wl}");
+            // within the norm's own tolerance (1e-10 relative): another refinement path may
+            // stop at another attained value below the peak
+            assert!((x - y).abs() <= 2e-10 * x.abs().max(y.abs()), "{what}: {a} vs {b} in\n{gl}\n{wl}");
         }
     }
 }
