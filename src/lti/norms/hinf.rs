@@ -74,7 +74,8 @@
 //! frequency evaluations (their midpoints cannot raise γ_L, so the loop stops), whereas a missed
 //! one would under-estimate the norm, so the test errs on the loose side. Since σ(∞) = σmax(D) < γ,
 //! the crossings come in pairs; an odd count means one was lost, and σmax is also evaluated above
-//! the last crossing and at each crossing found (the lost one may be its partner: a narrow spike).
+//! the last crossing. σmax is also evaluated at each crossing found, and a value clearly above
+//! the level ([`SPIKE_RTOL`]) taken: the two crossings of a narrow spike can come back as one.
 //!
 //! If the Hamiltonian eigensolver fails or the iteration limit is hit, the best lower bound γ_L
 //! found so far is returned (it is an attained value of σmax(G(iω))).
@@ -437,7 +438,8 @@ fn level_set_norm(
         // were spurious).
         let raised = |best: &Best| best.gamma >= before * (1.0 + 0.1 * tol);
         let mids = midpoints(sys, sigma_d, gamma, &ws, &probes);
-        let mut scan: Vec<(f64, f64)> = Vec::with_capacity(mids.len());
+        let mut scan: Vec<(f64, f64)> = Vec::with_capacity(mids.len() + ws.len());
+        spike_tops(fr, &mut best, gamma * (1.0 + SPIKE_RTOL), &ws, &mut scan);
         for &w in &mids {
             let s = fr.sigma_max(w);
             best.offer(w, s);
@@ -471,6 +473,31 @@ fn level_set_norm(
         }
     }
     Ok(best.norm())
+}
+
+/// σmax at a crossing that clearly exceeds the level: relative to the level, by
+/// [`spike_tops`]' test.
+const SPIKE_RTOL: f64 = 1e-9;
+
+/// σmax at each finite crossing `ws` of a level-set test; a value above `above` (the level
+/// raised by [`SPIKE_RTOL`], so that a true crossing, where σmax equals the level up to the
+/// crossing's rounding, is not taken) is offered to `best` and added to `scan` (for the
+/// refinement's climbs).
+///
+/// Why: the two crossings of a narrow spike can come back from the test as one frequency, inside
+/// the spike. Paired with the wrong neighbours, the midpoints missed it: closed loops of COMPleib's
+/// AC1 with a second-order controller and with the same controller padded to order 3 (a mode at
+/// −2.4e-5 ± 0.0639j: a spike 2.4e-5 rad/s wide, its crossings 3e-7 apart at the level of the
+/// broad peak) came out 6.2e-5 low (`tests/hinf_regression.rs`). σmax at that one frequency is
+/// the spike's height.
+fn spike_tops(fr: &mut FreqResponse, best: &mut Best, above: f64, ws: &[f64], scan: &mut Vec<(f64, f64)>) {
+    for &w in ws.iter().filter(|w| **w > 0.0 && w.is_finite()) {
+        let s = fr.sigma_max(w);
+        if s > above {
+            best.offer(w, s);
+            scan.push((w, s));
+        }
+    }
 }
 
 /// Where σmax is evaluated after a level-set test at `gamma` found the crossings `ws` (sorted)
@@ -507,13 +534,6 @@ fn midpoints(sys: &StateSpace, sigma_d: f64, gamma: f64, ws: &[f64], probes: &[f
         let last = ws[ws.len() - 1];
         if last > 0.0 && last.is_finite() {
             mids.push(2.0 * last);
-        }
-        // The lost crossing may be the partner of one that was found: the two crossings of a
-        // narrow spike that the test returned as one. σmax at that crossing is then above the
-        // level (AC1 in `tests/hinf_regression.rs`: a spike 2.4e-5 rad/s wide, crossings 3e-7
-        // apart, 6.2e-5 above the level; missed, the norm came out 6.2e-5 low).
-        if ws.len() > 1 {
-            mids.extend(ws.iter().copied().filter(|w| *w > 0.0 && w.is_finite()));
         }
     }
     // An eigenvalue just off the axis may be a near-tangent pair of crossings that rounding
@@ -728,18 +748,15 @@ impl Climb {
 }
 
 /// How many local peaks the refinement climbs (step 3 of the module docs, and after each
-/// level-set test): the best point so far and the [`EXTRA_REFINED_PEAKS`] next best points of the
-/// last scan, at every order.
-///
-/// Below order [`HESSENBERG_QR_FROM`] it used to be the best point alone. A closed loop of
-/// COMPleib's ROC8 with a second-order controller (results/compleib) has a mode at
-/// −1.0e-7 ± 0.44504j, nearly unobservable: a spike of width 2e-7 rad/s rising 1.0e-5 above the
-/// response's broad peak at 1.787 rad/s. Its mode's test frequency lands on the spike's flank; the
-/// refinement climbed the broad peak only, and the level-set test at that level saw the spike's
-/// two crossings as one, so the norm came out 1.0e-5 low (`tests/hinf_regression.rs`). A climb
-/// of the next best scan points finds the spike's top with an attained value.
-fn refined_peaks(_order: usize) -> usize {
-    1 + EXTRA_REFINED_PEAKS
+/// level-set test): the best point so far, plus from order [`HESSENBERG_QR_FROM`] on the
+/// [`EXTRA_REFINED_PEAKS`] next best points of the last scan. Below that order one, as it was
+/// (bit for bit).
+fn refined_peaks(order: usize) -> usize {
+    if order >= HESSENBERG_QR_FROM {
+        1 + EXTRA_REFINED_PEAKS
+    } else {
+        1
+    }
 }
 
 /// [`refine`] around the best point so far; then a coarse climb ([`COARSE_REFINE_LOG_TOL`], at
