@@ -1179,15 +1179,15 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
         for case in 0..20 {
             let (n, m, p) = (5 + case % 4, 1 + case % 3, 1 + case % 2);
-            let mut a = Mat::from_fn(n, n, |_, _| rng.gen_range(-1.0..1.0));
+            let mut a = Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
             let shift = crate::lti::kernels::spectral::spectral_abscissa(a.as_ref()) + 0.05 + 0.1 * (case % 3) as f64;
             for i in 0..n {
                 a[(i, i)] -= shift;
             }
-            let b = Mat::from_fn(n, m, |_, _| rng.gen_range(-1.0..1.0));
+            let b = Mat::from_fn(n, m, |_, _| rng.random_range(-1.0..1.0));
             let small = if case % 2 == 0 { 1e-4 } else { 1.0 };
-            let c = Mat::from_fn(p, n, |_, _| small * rng.gen_range(-1.0..1.0));
-            let d = Mat::from_fn(p, m, |_, _| small * rng.gen_range(-0.5..0.5));
+            let c = Mat::from_fn(p, n, |_, _| small * rng.random_range(-1.0..1.0));
+            let d = Mat::from_fn(p, m, |_, _| small * rng.random_range(-0.5..0.5));
             let sys = StateSpace { a, b, c, d };
             let t: Vec<f64> = (0..n).map(|i| 10f64.powf(12.0 * i as f64 / (n - 1) as f64 - 6.0)).collect();
             let scaled = StateSpace {
