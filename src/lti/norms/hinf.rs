@@ -12,8 +12,8 @@
 //!
 //! 1. Unstable (any Re λ(A) ≥ 0, exactly the HIFOO rule) or non-finite data → +∞. Where
 //!    balancing A's state coordinates pays (‖A‖_F falls by more than the factor
-//!    `kernels::balance::BALANCE_GAIN`), everything below runs on the balanced realisation, the
-//!    same transfer function exactly (`balanced_realisation`); every other system as given.
+//!    `kernels::balance::BALANCE_GAIN`), the level-set tests of step 4 run on the balanced
+//!    realisation, the same transfer function exactly (`balanced_realisation`).
 //! 2. Lower bound γ_L = max σmax(G(iω)) over ω = ∞ (σmax(D)), ω = 0 and one test frequency per
 //!    mode, ω = |λ|·√max(¼, 1 − 2(Re λ/|λ|)²) (AB13DD's choice; for n > [`MAX_POLE_TEST_FREQS`]
 //!    only the least damped modes; from order [`HESSENBERG_QR_FROM`] on, well-damped modes only
@@ -347,23 +347,21 @@ fn hinf_norm_from(
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
     stop.poll()?;
-    match balanced_realisation(sys) {
-        // A frequency-response evaluator of its own: `fr` (kept for the gradient's vectors at the
-        // peak, `gradient.rs`) is of `sys`'s coordinates.
-        Some(balanced) => level_set_norm(&balanced, poles, &mut None, tol, hints, stop, enough, sigma_d),
-        None => level_set_norm(sys, poles, fr, tol, hints, stop, enough, sigma_d),
-    }
+    level_set_norm(sys, poles, fr, tol, hints, stop, enough, sigma_d)
 }
 
 /// `sys` in balanced state coordinates, (D⁻¹AD, D⁻¹B, CD, D) with D diagonal of powers of two
 /// (`kernels::balance`: the same transfer function, exactly), where balancing A lowers ‖A‖_F by
-/// more than [`BALANCE_GAIN`]; else `None` (use `sys`, bit for bit as before).
+/// more than [`BALANCE_GAIN`]; else `None` (use `sys`, bit for bit as before). The level-set test
+/// is made on it.
 ///
-/// Why: in unbalanced coordinates both the frequency response and the level-set test lose
-/// accuracy. A closed loop of COMPleib's AC12 with a third-order controller of gain 550
-/// (‖A‖ = 6.6e3, balanced 57; ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5 rad/s
-/// where they are 5.62, 5.71, 17.8 and 19.9) and σmax only to 1.6e-8 relative, and the norm
-/// came out 5.6 % low (`tests/hinf_regression.rs`); balanced, both are right.
+/// Why: in unbalanced coordinates the level-set test loses its accuracy. A closed loop of
+/// COMPleib's AC12 with a third-order controller of gain 550 (‖A‖ = 6.6e3, balanced 57;
+/// ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5 rad/s where they are 5.62, 5.71,
+/// 17.8 and 19.9), and the norm came out 5.6 % low (`tests/hinf_regression.rs`). σmax itself is
+/// still evaluated on `sys`, to about 1e-8 there: the evaluator is shared with the line-search
+/// screen and the gradient (a balanced one would cost a second Hessenberg reduction per norm on
+/// every badly scaled plant).
 pub(crate) fn balanced_realisation(sys: &StateSpace) -> Option<StateSpace> {
     let (a, d) = balance(sys.a.as_ref());
     if !(a.norm_l2() * BALANCE_GAIN < sys.a.norm_l2()) {
@@ -415,7 +413,10 @@ fn level_set_norm(
         return Ok(best.norm());
     }
 
-    let ham = Hamiltonian::new(sys, sigma_d, poles);
+    // The level-set test on the balanced realisation where balancing pays; σmax on `sys` (its
+    // evaluator is shared with the line-search screen and the gradient, `ResponseSlot`).
+    let balanced = balanced_realisation(sys);
+    let ham = Hamiltonian::new(balanced.as_ref().unwrap_or(sys), sigma_d, poles);
     // For `verify_stop`: the scan's points (hints and modes) and every frequency tested so far.
     let modes_scan = scan;
     let mut seen: Vec<f64> = tested;
