@@ -13,11 +13,11 @@ this only counts them.
 import argparse
 import collections
 import csv
-import glob
-import json
 import math
 import os
 import statistics
+
+from protocol_progress import records
 
 
 def read_csv(folder, name):
@@ -34,14 +34,11 @@ def number(text):
 
 
 def journal(folder):
+    """Jobs and CPU seconds of the folder's journals."""
     jobs, cpu = 0, 0.0
-    for path in sorted(glob.glob(os.path.join(folder, "runs*.jsonl"))):
-        with open(path, encoding="utf-8") as f:
-            for line in f:
-                if line.strip():
-                    r = json.loads(line)
-                    jobs += 1
-                    cpu += r.get("cpu_s") or 0.0
+    for r in records(folder):
+        jobs += 1
+        cpu += r.get("cpu_s") or 0.0
     return jobs, cpu
 
 

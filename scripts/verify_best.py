@@ -9,7 +9,6 @@ plants/ and plants/compleib/ (.json or .json.gz); continuous time only.
 """
 import argparse
 import csv
-import glob
 import gzip
 import json
 import math
@@ -17,6 +16,8 @@ import os
 
 import control
 import numpy as np
+
+from protocol_progress import records
 
 
 def plant_file(name):
@@ -44,14 +45,7 @@ def load_plant(name):
 
 
 def controllers(folder):
-    out = {}
-    for path in sorted(glob.glob(os.path.join(folder, "runs*.jsonl"))):
-        for line in open(path, encoding="utf-8"):
-            if line.strip():
-                r = json.loads(line)
-                if r.get("controller"):
-                    out[r["job_id"]] = r["controller"]
-    return out
+    return {r["job_id"]: r["controller"] for r in records(folder) if r.get("controller")}
 
 
 def main():

@@ -281,33 +281,23 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
             _ => row.unverified += 1,
         }
     }
-    // A plain row also takes the strong jobs' controllers of its (plant, order): a stable K that
-    // stabilises is a plain solution too, so plain ≤ strong in every table (the row's job id then
-    // names the strong job; its counts stay those of the plain jobs).
+    // Each objective's row also takes the other objective's controllers that solve its problem
+    // (the row's job id then names that job; its counts stay those of its own jobs):
+    // * a plain row, a strong job's: a stable K that stabilises is a plain solution too, so
+    //   plain ≤ strong in every table;
+    // * a strong row, a plain job's that is stable and whose controller term is inactive
+    //   (ε‖K‖∞ ≤ γ at the job's ε): a solution of the strong problem with objective γ (CDP
+    //   n_K = 1 in results/compleib: the strong job ended at 36.2 from its chained start, the
+    //   plain job found γ = 3.95 with a stable K, ε‖K‖∞ = 1e-4).
     for &(r, ref verdict) in per_job.values() {
-        if r.options.objective != ObjectiveKind::Strong {
-            continue;
-        }
-        let key = (labels[&r.plant_fingerprint].clone(), r.order, ObjectiveKind::Plain as u8);
-        if let (Some((row, _)), Some(v @ Verdict::Verified { .. })) = (rows.get_mut(&key), verdict) {
+        let Some(v @ Verdict::Verified { gamma, k_hinf, controller_stable, .. }) = verdict else { continue };
+        let other = match r.options.objective {
+            ObjectiveKind::Strong => ObjectiveKind::Plain,
+            ObjectiveKind::Plain if *controller_stable && r.eps * k_hinf <= *gamma => ObjectiveKind::Strong,
+            ObjectiveKind::Plain => continue,
+        };
+        if let Some((row, _)) = rows.get_mut(&(labels[&r.plant_fingerprint].clone(), r.order, other as u8)) {
             row.offer(r, v, || chain_cpu_before(r));
-        }
-    }
-    // And a strong row takes the plain jobs' stable controllers whose controller term is
-    // inactive (ε‖K‖∞ ≤ γ at the job's ε): such a controller is a solution of the strong problem
-    // with objective γ (CDP n_K = 1 in results/compleib: the strong job ended at 36.2 from its
-    // chained start, the plain job found γ = 3.95 with a stable K, ε‖K‖∞ = 1e-4).
-    for &(r, ref verdict) in per_job.values() {
-        if r.options.objective != ObjectiveKind::Plain {
-            continue;
-        }
-        let key = (labels[&r.plant_fingerprint].clone(), r.order, ObjectiveKind::Strong as u8);
-        if let (Some((row, _)), Some(v @ Verdict::Verified { gamma, k_hinf, controller_stable: true, .. })) =
-            (rows.get_mut(&key), verdict)
-        {
-            if r.eps * k_hinf <= *gamma {
-                row.offer(r, v, || chain_cpu_before(r));
-            }
         }
     }
     rows.into_values()

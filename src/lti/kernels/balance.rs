@@ -35,8 +35,15 @@ pub const BALANCE_GAIN: f64 = 100.0;
 /// The matrix to compute `a`'s eigenvalues from: its balanced form ([`balance`]) if that lowers
 /// the Frobenius norm by more than [`BALANCE_GAIN`], else `None` (use `a`).
 pub fn balanced_for_eigenvalues(a: MatRef<'_, f64>) -> Option<Mat<f64>> {
-    let (b, _) = balance(a);
-    (b.norm_l2() * BALANCE_GAIN < a.norm_l2()).then_some(b)
+    balance_if_it_pays(a).map(|(b, _)| b)
+}
+
+/// [`balance`]`(a)` (the balanced matrix and the diagonal of D) if it lowers the Frobenius norm
+/// by more than [`BALANCE_GAIN`], else `None`: the one test of where balancing pays (the
+/// eigenvalues of verification, the H∞ norm's level-set test).
+pub fn balance_if_it_pays(a: MatRef<'_, f64>) -> Option<(Mat<f64>, Vec<f64>)> {
+    let (b, d) = balance(a);
+    (b.norm_l2() * BALANCE_GAIN < a.norm_l2()).then_some((b, d))
 }
 
 /// The balanced matrix D⁻¹·A·D and the diagonal of D (powers of 2). Non-finite entries are left

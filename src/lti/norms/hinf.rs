@@ -84,7 +84,7 @@ use faer::{c64, Mat};
 
 use super::hinf_hooks::{measured, note, timed, NormEvent, Step};
 use crate::lti::interrupt::{Interrupt, Interrupted};
-use crate::lti::kernels::balance::{balance, BALANCE_GAIN};
+use crate::lti::kernels::balance::balance_if_it_pays;
 use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
 use crate::lti::kernels::level_set_pencil::pencil_crossings;
@@ -347,44 +347,6 @@ fn hinf_norm_from(
         return Ok(HinfNorm { value: sigma_d, peak_freq: f64::INFINITY });
     }
     stop.poll()?;
-    level_set_norm(sys, poles, fr, tol, hints, stop, enough, sigma_d)
-}
-
-/// `sys` in balanced state coordinates, (D⁻¹AD, D⁻¹B, CD, D) with D diagonal of powers of two
-/// (`kernels::balance`: the same transfer function, exactly), where balancing A lowers ‖A‖_F by
-/// more than [`BALANCE_GAIN`]; else `None` (use `sys`, bit for bit as before). The level-set test
-/// is made on it.
-///
-/// Why: in unbalanced coordinates the level-set test loses its accuracy. A closed loop of
-/// COMPleib's AC12 with a third-order controller of gain 550 (‖A‖ = 6.6e3, balanced 57;
-/// ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5 rad/s where they are 5.62, 5.71,
-/// 17.8 and 19.9), and the norm came out 5.6 % low (`tests/hinf_regression.rs`). σmax itself is
-/// still evaluated on `sys`, to about 1e-8 there: the evaluator is shared with the line-search
-/// screen and the gradient (a balanced one would cost a second Hessenberg reduction per norm on
-/// every badly scaled plant).
-pub(crate) fn balanced_realisation(sys: &StateSpace) -> Option<StateSpace> {
-    let (a, d) = balance(sys.a.as_ref());
-    if !(a.norm_l2() * BALANCE_GAIN < sys.a.norm_l2()) {
-        return None;
-    }
-    let b = Mat::from_fn(sys.b.nrows(), sys.b.ncols(), |i, j| sys.b[(i, j)] / d[i]);
-    let c = Mat::from_fn(sys.c.nrows(), sys.c.ncols(), |i, j| sys.c[(i, j)] * d[j]);
-    Some(StateSpace { a, b, c, d: sys.d.clone() })
-}
-
-/// The norm of a stable `sys` of order ≥ 1 with σmax(D) = `sigma_d` (module docs, steps 2–4), in
-/// the coordinates it is given in; `fr` as in [`hinf_norm_from`].
-#[allow(clippy::too_many_arguments)]
-fn level_set_norm(
-    sys: &StateSpace,
-    poles: &[c64],
-    fr: &mut Option<FreqResponse>,
-    tol: f64,
-    hints: &[f64],
-    stop: Interrupt<'_>,
-    enough: f64,
-    sigma_d: f64,
-) -> Result<HinfNorm, Interrupted> {
     let fr = fr.get_or_insert_with(|| FreqResponse::new(sys));
     let mut best = Best { gamma: sigma_d, freq: f64::INFINITY };
     best.offer(0.0, fr.sigma_max(0.0));
@@ -474,6 +436,25 @@ fn level_set_norm(
         }
     }
     Ok(best.norm())
+}
+
+/// `sys` in balanced state coordinates, (D⁻¹AD, D⁻¹B, CD, D) with D diagonal of powers of two
+/// (`kernels::balance`: the same transfer function, exactly), where balancing A lowers ‖A‖_F by
+/// more than `kernels::balance::BALANCE_GAIN`; else `None` (use `sys`, bit for bit as before). The level-set test
+/// is made on it.
+///
+/// Why: in unbalanced coordinates the level-set test loses its accuracy. A closed loop of
+/// COMPleib's AC12 with a third-order controller of gain 550 (‖A‖ = 6.6e3, balanced 57;
+/// ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5 rad/s where they are 5.62, 5.71,
+/// 17.8 and 19.9), and the norm came out 5.6 % low (`tests/hinf_regression.rs`). σmax itself is
+/// still evaluated on `sys`, to about 1e-8 there: the evaluator is shared with the line-search
+/// screen and the gradient (a balanced one would cost a second Hessenberg reduction per norm on
+/// every badly scaled plant).
+fn balanced_realisation(sys: &StateSpace) -> Option<StateSpace> {
+    let (a, d) = balance_if_it_pays(sys.a.as_ref())?;
+    let b = Mat::from_fn(sys.b.nrows(), sys.b.ncols(), |i, j| sys.b[(i, j)] / d[i]);
+    let c = Mat::from_fn(sys.c.nrows(), sys.c.ncols(), |i, j| sys.c[(i, j)] * d[j]);
+    Some(StateSpace { a, b, c, d: sys.d.clone() })
 }
 
 /// σmax at a crossing that clearly exceeds the level: relative to the level, by

@@ -47,17 +47,22 @@ pub struct LibraryPlant {
 pub fn library_plants() -> std::io::Result<Vec<LibraryPlant>> {
     let dir = plants_dir();
     let mut all = plants_in(&dir, None)?;
-    let mut subdirs: Vec<(String, PathBuf)> = std::fs::read_dir(&dir)?
+    for (name, path) in collections(&dir)? {
+        all.extend(plants_in(&path, Some(&name))?);
+    }
+    Ok(all)
+}
+
+/// The collections of the library folder `dir` (its direct subfolders), as (name, path), sorted.
+fn collections(dir: &Path) -> std::io::Result<Vec<(String, PathBuf)>> {
+    let mut subdirs: Vec<(String, PathBuf)> = std::fs::read_dir(dir)?
         .filter_map(|e| e.ok())
         .map(|e| e.path())
         .filter(|p| p.is_dir())
         .filter_map(|p| Some((p.file_name()?.to_str()?.to_string(), p)))
         .collect();
     subdirs.sort();
-    for (name, path) in subdirs {
-        all.extend(plants_in(&path, Some(&name))?);
-    }
-    Ok(all)
+    Ok(subdirs)
 }
 
 /// The plant files directly in `dir`, sorted by name.
@@ -132,12 +137,10 @@ pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
 /// lists as missing (no public data, or left out for size) are explained there.
 fn listed_as_missing(name: &str) -> Option<PathBuf> {
     let dir = plants_dir();
-    let mut lists = vec![dir.join(MISSING_LIST)];
-    let mut subdirs: Vec<PathBuf> =
-        std::fs::read_dir(&dir).ok()?.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.is_dir()).collect();
-    subdirs.sort();
-    lists.extend(subdirs.into_iter().map(|d| d.join(MISSING_LIST)));
-    lists.into_iter().find(|list| std::fs::read_to_string(list).is_ok_and(|text| names_word(&text, name)))
+    let folders = std::iter::once(dir.clone()).chain(collections(&dir).ok()?.into_iter().map(|(_, path)| path));
+    folders
+        .map(|folder| folder.join(MISSING_LIST))
+        .find(|list| std::fs::read_to_string(list).is_ok_and(|text| names_word(&text, name)))
 }
 
 /// The file of a library folder that lists its missing plants.
