@@ -60,7 +60,9 @@ def main():
     by_obj = collections.defaultdict(list)
     for r in best:
         by_obj[r["objective"]].append(r)
-    verified = lambda r: r["verified"] not in ("", "0") and math.isfinite(number(r["gamma"]))
+    # A row has a re-verified controller when it has a job and a finite γ: its own jobs' or, through
+    # the cross-objective rule (campaigns/FORMAT.md, best.csv), the other objective's.
+    verified = lambda r: r["job_id"] != "" and math.isfinite(number(r["gamma"]))
     done = f"{jobs} of {a.expected}" if a.expected else f"{jobs}"
     print(f"- jobs journaled: {done} ({100 * jobs / a.expected:.1f} %), {cpu / 3600:.2f} CPU h"
           if a.expected else f"- jobs journaled: {done}, {cpu / 3600:.2f} CPU h")

@@ -73,7 +73,9 @@ impl<'a> Design<'a> {
     /// [`StartKind::Chained`](super::StartKind::Chained), no perturbations of it), so that no
     /// budget can end the run before it: the run then never returns a controller whose
     /// objective is above the padded controller's, which (same ε) is the objective of `k`
-    /// itself. `None`: no chained start.
+    /// itself. If `k`'s order is below `opts.order`, the second local search starts from the
+    /// padded controller with its new modes coupled (`starts::couple_padded_modes`,
+    /// docs/ALGORITHMS.md §8.2: the padded point is a saddle for them). `None`: no chained start.
     pub fn chained(mut self, k: Option<&'a Controller>) -> Self {
         self.chained = k;
         self

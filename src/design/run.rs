@@ -31,7 +31,10 @@ use super::problem::{
 };
 use super::scaling::variable_scaling;
 use super::search::{ScaledObjectives, Search, SearchResult};
-use super::starts::{open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts};
+use super::starts::{
+    couple_padded_modes, open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts,
+    PADDED_COUPLING,
+};
 use super::structure::Structure;
 
 /// The given starting controllers of a run: `init` (with its perturbations, in place of the
@@ -203,7 +206,18 @@ fn first_starts(
     let mut first = starting_points(plant, opts, starts.init, shape, nvar, vars, rng);
     let mut kinds = vec![if starts.init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
     if let Some(k) = starts.chained {
-        first.insert(0, vars(controller_to_x(&padded_to(plant, k, shape.nk))));
+        let padded = vars(controller_to_x(&padded_to(plant, k, shape.nk)));
+        if k.order() < shape.nk {
+            // the padded point is a saddle for its new modes (docs/ALGORITHMS.md §8.2); a
+            // structure that fixes their coupling leaves nothing to couple
+            let coupled = couple_padded_modes(&padded_to(plant, k, shape.nk), k.order(), PADDED_COUPLING, rng);
+            let coupled = vars(controller_to_x(&coupled));
+            if coupled != padded {
+                first.insert(0, coupled);
+                kinds.insert(0, StartKind::Chained);
+            }
+        }
+        first.insert(0, padded);
         kinds.insert(0, StartKind::Chained);
     }
     if opts.open_loop_start {

@@ -136,11 +136,86 @@ pub fn pad_controller(k: &Controller, nk: usize, diag: f64) -> Option<Controller
     Some(Controller { ak, bk, ck, dk: k.dk.clone(), domain: k.domain })
 }
 
+/// Relative size δ of the coupling given to padded modes by [`couple_padded_modes`].
+pub const PADDED_COUPLING: f64 = 1e-2;
+
+/// `k` (a controller whose modes `n0..` are padded: decoupled, B_K rows and C_K columns zero)
+/// with those modes coupled: each of their B_K rows and C_K columns drawn as s·ξ, ξ ~ N(0, I),
+/// s = (δ·g·max(1, |d_i|))^½, d_i the mode's diagonal entry and g the size of the order-n0
+/// controller (‖D_K‖_F, else ‖B_K‖_F‖C_K‖_F / max(1, ‖A_K‖_F), else 1). Each new mode then adds
+/// about δ·g to K's gain, C_K,i B_K,iᵀ/(s − d_i).
+///
+/// Why: a padded mode is a saddle of the design problem. Tzw and the spectra depend on its B_K
+/// row and C_K column only through their product, whose gradient vanishes when both are 0, so
+/// no local search from the padded controller ever uses the mode (docs/ALGORITHMS.md §8.2);
+/// with the coupling it starts off the saddle, at nearly the padded controller's objective.
+pub fn couple_padded_modes(k: &Controller, n0: usize, delta: f64, rng: &mut dyn RngCore) -> Controller {
+    let nk = k.order();
+    let frob = |m: faer::MatRef<'_, f64>| m.norm_l2();
+    let sub = |m: &Mat<f64>, r: usize, c: usize| m.as_ref().submatrix(0, 0, r, c).to_owned();
+    let (dk, bk0, ck0, ak0) = (
+        frob(k.dk.as_ref()),
+        frob(sub(&k.bk, n0, k.inputs()).as_ref()),
+        frob(sub(&k.ck, k.outputs(), n0).as_ref()),
+        frob(sub(&k.ak, n0, n0).as_ref()),
+    );
+    let g = if dk > 0.0 {
+        dk
+    } else if bk0 * ck0 > 0.0 {
+        bk0 * ck0 / ak0.max(1.0)
+    } else {
+        1.0
+    };
+    let mut out = k.clone();
+    for i in n0..nk {
+        let s = (delta * g * k.ak[(i, i)].abs().max(1.0)).sqrt();
+        for j in 0..k.inputs() {
+            let xi: f64 = StandardNormal.sample(&mut *rng);
+            out.bk[(i, j)] = s * xi;
+        }
+        for j in 0..k.outputs() {
+            let xi: f64 = StandardNormal.sample(&mut *rng);
+            out.ck[(j, i)] = s * xi;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn coupled_padding_keeps_the_order_below_and_couples_each_new_mode() {
+        let k1 = Controller {
+            ak: Mat::from_fn(1, 1, |_, _| -2.0),
+            bk: Mat::from_fn(1, 2, |_, j| 1.0 + j as f64),
+            ck: Mat::from_fn(2, 1, |i, _| 0.5 - i as f64),
+            dk: Mat::from_fn(2, 2, |i, j| if i == j { 3.0 } else { 4.0 }),
+            domain: crate::lti::TimeDomain::Continuous,
+        };
+        let padded = pad_controller(&k1, 3, -5.0).unwrap();
+        let c = couple_padded_modes(&padded, 1, PADDED_COUPLING, &mut ChaCha8Rng::seed_from_u64(3));
+        // A_K, D_K and the order-1 part untouched
+        assert_eq!(c.ak, padded.ak);
+        assert_eq!(c.dk, padded.dk);
+        assert_eq!(c.bk.as_ref().row(0).to_owned(), k1.bk.as_ref().row(0).to_owned());
+        assert_eq!(c.ck.as_ref().col(0).to_owned(), k1.ck.as_ref().col(0).to_owned());
+        // each new mode's row and column drawn at s = (δ·‖D_K‖_F·|d|)^½ (‖D_K‖_F = √50)
+        let s = (PADDED_COUPLING * 50f64.sqrt() * 5.0).sqrt();
+        for i in 1..3 {
+            let b = c.bk.as_ref().row(i).norm_l2();
+            let cc = c.ck.as_ref().col(i).norm_l2();
+            assert!(b > 0.0 && cc > 0.0);
+            assert!(b < 5.0 * s * 2f64.sqrt() && cc < 5.0 * s * 2f64.sqrt(), "{b} {cc} {s}");
+        }
+        // seeded: the same draws again
+        let again = couple_padded_modes(&padded, 1, PADDED_COUPLING, &mut ChaCha8Rng::seed_from_u64(3));
+        assert_eq!(again.bk, c.bk);
+        assert_eq!(again.ck, c.ck);
+    }
 
     #[test]
     fn logspace_matches_matlab() {
