@@ -119,6 +119,29 @@ fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
     assert!(o_same.objective <= o1.objective * (1.0 + 1e-9));
 }
 
+/// A COMPleib plant and a controller of results/compleib stored in tests/fixtures/compleib.
+fn compleib_start(plant: &str, fixture: &str) -> (Plant, Controller) {
+    let p = Plant::load(hinfix::lti::resolve_plant(plant).unwrap()).unwrap();
+    let file = format!("{}/tests/fixtures/compleib/{fixture}", env!("CARGO_MANIFEST_DIR"));
+    let k = Controller::from_json_str(&std::fs::read_to_string(&file).unwrap(), &file).unwrap();
+    (p, k)
+}
+
+/// The COMPleib campaign's design options (strong, ε = 1e-3, its stall rule) at `order` and
+/// `seed`, with an evaluation budget (the same path on every machine) in place of its CPU one.
+fn from_a_compleib_start(order: usize, seed: u64, maxevals: usize) -> DesignOptions {
+    DesignOptions {
+        order,
+        eps: 1e-3,
+        seed,
+        cpumax: f64::INFINITY,
+        maxevals: Some(maxevals),
+        stall_starts: 10,
+        stall_rtol: 1e-4,
+        ..Default::default()
+    }
+}
+
 /// COMPleib's NN10 has ‖Tzw‖∞ = 0 for every controller, so under strong stabilisation
 /// f_h = ε‖K‖∞ falls towards the closed loop's stability boundary and local searches end with
 /// α(A_cl) ≈ −1e-13, inside the verification margin. Such an end point must not displace a
@@ -128,19 +151,8 @@ fn warm_start_from_a_lower_order_does_not_increase_the_objective() {
 /// a controller that is stable with the margin, as the independent check sees it.
 #[test]
 fn an_end_point_inside_the_verification_margin_never_displaces_a_stabilising_controller() {
-    let p = Plant::load(hinfix::lti::resolve_plant("NN10").unwrap()).unwrap();
-    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/compleib/NN10_order2_strong.json");
-    let k2 = Controller::from_json_str(&std::fs::read_to_string(file).unwrap(), file).unwrap();
-    let opts = DesignOptions {
-        order: 3,
-        eps: 1e-3,
-        seed: 2,
-        cpumax: f64::INFINITY,
-        maxevals: Some(60_000),
-        stall_starts: 10,
-        stall_rtol: 1e-4,
-        ..Default::default()
-    };
+    let (p, k2) = compleib_start("NN10", "NN10_order2_strong.json");
+    let opts = from_a_compleib_start(3, 2, 60_000);
     assert!(hinfix::design::stabilises(&hinfix::design::Problem::single(p.clone()), &opts, &k2).is_ok());
     let o = Design::for_plant(&p, &opts).init(Some(&k2)).run().unwrap();
     assert!(matches!(o.status, DesignStatus::Converged | DesignStatus::Stopped), "{:?}", o.status);
@@ -163,19 +175,8 @@ fn an_end_point_inside_the_verification_margin_never_displaces_a_stabilising_con
 /// saddle too: 0.00971 without, 0.00984 with).
 #[test]
 fn a_chained_start_of_a_higher_order_leaves_the_padded_saddle() {
-    let p = Plant::load(hinfix::lti::resolve_plant("ROC5").unwrap()).unwrap();
-    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/compleib/ROC5_order1_strong.json");
-    let k1 = Controller::from_json_str(&std::fs::read_to_string(file).unwrap(), file).unwrap();
-    let opts = DesignOptions {
-        order: 2,
-        eps: 1e-3,
-        seed: 0,
-        cpumax: f64::INFINITY,
-        maxevals: Some(3_000),
-        stall_starts: 10,
-        stall_rtol: 1e-4,
-        ..Default::default()
-    };
+    let (p, k1) = compleib_start("ROC5", "ROC5_order1_strong.json");
+    let opts = from_a_compleib_start(2, 0, 3_000);
     let o = Design::for_plant(&p, &opts).chained(Some(&k1)).run().unwrap();
     assert!(o.gamma < 0.0104, "γ = {} (the padded start's is 0.010483)", o.gamma);
     assert!(o.alpha_k.unwrap() < 0.0);
