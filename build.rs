@@ -2,6 +2,8 @@
 //! journal record, `campaign::provenance`). Outside a git checkout (a source tarball, a crate
 //! download) `git` fails and the commit is simply unknown; the build never fails because of it.
 //! `HINFIX_GIT_COMMIT` set at build time overrides (for packagers building from an export).
+//! A build whose sources (src/, build.rs, Cargo.toml, Cargo.lock) differ from HEAD records
+//! `<commit>+dirty`: its records then say that they do not come from that commit's code.
 use std::process::Command;
 
 fn git(args: &[&str]) -> Option<String> {
@@ -17,7 +19,24 @@ fn main() {
     let toplevel = git(&["rev-parse", "--show-toplevel"]).and_then(|d| std::fs::canonicalize(d).ok());
     let commit = match std::env::var("HINFIX_GIT_COMMIT") {
         Ok(c) if !c.trim().is_empty() => Some(c.trim().to_string()),
-        _ if manifest.is_some() && manifest == toplevel => git(&["rev-parse", "HEAD"]),
+        _ if manifest.is_some() && manifest == toplevel => git(&["rev-parse", "HEAD"]).map(|c| {
+            // Sources that differ from HEAD: the commit alone would misname the binary.
+            let dirty = git(&[
+                "status",
+                "--porcelain",
+                "--untracked-files=no",
+                "--",
+                "src",
+                "build.rs",
+                "Cargo.toml",
+                "Cargo.lock",
+            ]);
+            if dirty.is_some() {
+                format!("{c}+dirty")
+            } else {
+                c
+            }
+        }),
         _ => None,
     };
     if commit.is_some() {
@@ -31,6 +50,10 @@ fn main() {
             if std::path::Path::new(&p).exists() {
                 println!("cargo:rerun-if-changed={p}");
             }
+        }
+        // and when the sources change, for the `+dirty` mark
+        for p in ["src", "build.rs", "Cargo.toml", "Cargo.lock"] {
+            println!("cargo:rerun-if-changed={p}");
         }
     } else {
         println!("cargo:rerun-if-changed=build.rs");
