@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use hinfix::lti::{
-    closed_loop, closed_loop_hinf_grad, hinf_norm, matrix_from_json, Controller, HinfNorm, HinfParams, Plant,
-    StateSpace, DEFAULT_HINF_TOL,
+    closed_loop, closed_loop_hinf_grad, hinf_norm, hinf_norm_checked, matrix_from_json, Controller, HinfNorm,
+    HinfParams, Plant, StateSpace, TimeDomain, DEFAULT_HINF_TOL,
 };
 
 mod common;
@@ -53,6 +53,38 @@ fn nn5_with_first_order_controller_finds_the_peak_near_zero() {
 fn ac12_with_third_order_controller_finds_the_higher_peak() {
     // σmax of this loop is evaluated to about 1e-8 in its own (unbalanced) coordinates
     assert_closed_loop_reaches_peak("ac12", 2.3958726299370354e-4, 18.425426879431075, 1e-10, 1e-7);
+}
+
+/// COMPleib AC12 with a third-order plain controller of the COMPleib campaign (results/compleib,
+/// n_K = 3) that makes ‖Tzw‖∞ tiny against the loop's data: 1.147e-7 with ‖C‖ = 1e3 and
+/// ‖A‖ = 5.8e3 (σmax(D) = 2.6e-8). The Hamiltonian of the level-set test then has blocks of size
+/// ‖C‖²/γ ≈ 1e13 and loses its eigenvalues near the crossings: the norm reported 9.42e-8, a
+/// value attained at a mode frequency, 18 % low. What verification uses,
+/// `lti::hinf_norm_checked`, evaluates σmax on a log grid of the loop's band and computes the
+/// norm again from a grid point above it. Reference: 40-digit mpmath, a golden-section search on
+/// σmax(T(iω)) of the closed loop built in that arithmetic: 1.14703221e-7 at 5.742409 rad/s
+/// (SLICOT's AB13DD, python-control 0.10.2: 1.1428e-7, itself 0.4 % low); double-precision
+/// σmax near there agrees to about 1e-6.
+#[test]
+fn ac12_with_a_tiny_norm_is_checked_on_a_grid() {
+    let plant = Plant::load(fixture("ac12.json")).unwrap();
+    let k = Controller::load(fixture("ac12_tiny_controller.json")).unwrap();
+    let cl = closed_loop(&plant, &k).unwrap();
+    let (peak, peak_freq) = (1.14703221e-7, 5.742409);
+    assert!((sigma_direct(&cl, peak_freq) - peak).abs() <= 1e-7 * peak);
+    let h = hinf_norm_checked(TimeDomain::Continuous, &cl);
+    // σmax carries a rounding error of about 1e-6 (relative) here: the loop's 1e-7 is what is
+    // left after much larger terms cancel
+    assert!(h.value >= peak * (1.0 - 2e-6) && h.value <= peak * (1.0 + 2e-6), "{h:?}");
+    assert!((sigma_direct(&cl, h.peak_freq) - h.value).abs() <= 2e-6 * h.value, "{h:?}");
+    // a loop whose level-set test is right is not changed by the check, bit for bit
+    let roc8 = closed_loop(
+        &Plant::load(fixture("roc8.json")).unwrap(),
+        &Controller::load(fixture("roc8_controller.json")).unwrap(),
+    )
+    .unwrap();
+    let plain = hinf_norm(&roc8, &HinfParams::default()).unwrap();
+    assert_eq!(hinf_norm_checked(TimeDomain::Continuous, &roc8), plain);
 }
 
 /// COMPleib ROC8 with a second-order controller of the COMPleib campaign (plain, results/compleib,

@@ -18,7 +18,7 @@
 //! met, and γ finite.
 
 use crate::lti::{
-    closed_loop, controller_hinf_grad, hinf_norm_in, near_peak_frequencies, verified_stability, Controller,
+    closed_loop, controller_hinf_grad, hinf_norm_checked, near_peak_frequencies, verified_stability, Controller,
     ControllerErrorKind, HinfNorm, HinfParams, LtiError, Plant, TimeDomain, VerifiedStability, DEFAULT_HINF_TOL,
     NORM_TIE_RTOL,
 };
@@ -219,7 +219,7 @@ pub fn evaluate_plant(plant: &Plant, k: &Controller) -> Evaluation {
 fn plant_evaluation(plant: &Plant, k: &Controller) -> PlantEvaluation {
     let closed_loop = closed_loop(plant, k).map(|cl| {
         let stability = verified_stability(plant.domain, cl.a.as_ref());
-        let h = hinf_norm_in(plant.domain, &cl, &HinfParams::default()).expect("no stop hook is set");
+        let h = hinf_norm_checked(plant.domain, &cl);
         // in rad/s (a discrete norm's θ is in rad/sample)
         LoopEvaluation {
             stability,

@@ -71,8 +71,8 @@ pub use norms::hinf::{
     MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use norms::sigma::{
-    frequency_band, near_peak_frequencies, sigma_curve, NORM_TIE_RTOL, SIGMA_BASE_POINTS, SIGMA_MAX_POINTS,
-    SIGMA_STEP_RTOL,
+    frequency_band, hinf_norm_checked, near_peak_frequencies, sigma_curve, NORM_TIE_RTOL, SIGMA_BASE_POINTS,
+    SIGMA_MAX_POINTS, SIGMA_STEP_RTOL,
 };
 pub use norms::stability_radius::{closed_loop_inverse_stability_radius_grad, inverse_stability_radius};
 pub use synthesis::balanced_truncation::{
