@@ -233,6 +233,60 @@ fn golden_max(fr: &mut AxisResponse, a: f64, b: f64) -> (f64, f64) {
     }
 }
 
+/// Points of the log-spaced grid on which [`hinf_norm_checked`] checks a norm.
+pub const NORM_CHECK_POINTS: usize = 200;
+/// A grid value above the norm by more than this (relative) is a missed peak.
+pub const NORM_CHECK_RTOL: f64 = 1e-8;
+
+/// ‖sys‖∞ in `domain` ([`hinf_norm_in`](super::domain::hinf_norm_in), peak frequency in its
+/// units), checked against σmax on [`NORM_CHECK_POINTS`] log-spaced frequencies of the
+/// [`frequency_band`]: if one is above the norm by more than [`NORM_CHECK_RTOL`], the level-set
+/// test missed that peak, and the norm is computed again from it (a hint, whose peak is climbed);
+/// the larger of that and the grid's value is returned. Every value is an attained σmax, so the
+/// check can only raise a norm that was too low. What verification and reports use
+/// (`design::evaluate`); the optimiser's norms do without it.
+///
+/// Why: a loop whose ‖Tzw‖∞ is tiny against its data — a plain design of COMPleib's AC12 of
+/// order 3, γ = 1.147e-7 with ‖C_cl‖ = 1e3 and ‖A_cl‖ = 5.8e3 — makes the Hamiltonian of the
+/// level-set test so large (blocks of size ‖C‖²/γ) that its eigenvalues near the crossings are
+/// lost, and the norm came out at 9.42e-8, a value attained at a mode frequency, 18 % low
+/// (SLICOT's AB13DD: 1.1428e-7; σmax in 40-digit arithmetic and in double precision at the peak,
+/// 5.742 rad/s: 1.14703e-7; `tests/hinf_regression.rs`).
+pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
+    use super::hinf::HinfParams;
+    let h = super::domain::hinf_norm_in(domain, sys, &HinfParams::default()).expect("no stop hook is set");
+    if !h.value.is_finite() || sys.order() == 0 {
+        return h;
+    }
+    let Some(mut fr) = AxisResponse::new(domain, sys) else { return h };
+    let band = frequency_band(domain, &[sys], &[]);
+    let (l0, l1) = (band.0.log10(), band.1.log10());
+    let n = NORM_CHECK_POINTS;
+    let (mut s_top, mut w_top) = (f64::NEG_INFINITY, f64::NAN);
+    for i in 0..n {
+        let w = 10f64.powf(l0 + (l1 - l0) * i as f64 / (n - 1) as f64);
+        let s = fr.sigma_max(w);
+        if s > s_top {
+            (s_top, w_top) = (s, w);
+        }
+    }
+    if !(s_top > h.value * (1.0 + NORM_CHECK_RTOL)) {
+        return h;
+    }
+    // the grid's frequency in the norm's units (rad/sample in discrete time)
+    let hint = match domain {
+        TimeDomain::Continuous => w_top,
+        TimeDomain::Discrete { ts } => (w_top * ts).min(std::f64::consts::PI),
+    };
+    let again = super::domain::hinf_norm_in(domain, sys, &HinfParams { hints: &[hint], ..HinfParams::default() })
+        .expect("no stop hook is set");
+    if again.value >= s_top {
+        again
+    } else {
+        HinfNorm { value: s_top, peak_freq: hint }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -304,59 +358,5 @@ mod tests {
         assert!(peaks[2].is_infinite());
         // a tighter tolerance than the ends' distance keeps them: they are exactly 1
         assert_eq!(near_peak_frequencies(TimeDomain::Continuous, &g, &h, 1e-9).len(), 3);
-    }
-}
-
-/// Points of the log-spaced grid on which [`hinf_norm_checked`] checks a norm.
-pub const NORM_CHECK_POINTS: usize = 200;
-/// A grid value above the norm by more than this (relative) is a missed peak.
-pub const NORM_CHECK_RTOL: f64 = 1e-8;
-
-/// ‖sys‖∞ in `domain` ([`hinf_norm_in`](super::domain::hinf_norm_in), peak frequency in its
-/// units), checked against σmax on [`NORM_CHECK_POINTS`] log-spaced frequencies of the
-/// [`frequency_band`]: if one is above the norm by more than [`NORM_CHECK_RTOL`], the level-set
-/// test missed that peak, and the norm is computed again from it (a hint, whose peak is climbed);
-/// the larger of that and the grid's value is returned. Every value is an attained σmax, so the
-/// check can only raise a norm that was too low. What verification and reports use
-/// (`design::evaluate`); the optimiser's norms do without it.
-///
-/// Why: a loop whose ‖Tzw‖∞ is tiny against its data — a plain design of COMPleib's AC12 of
-/// order 3, γ = 1.147e-7 with ‖C_cl‖ = 1e3 and ‖A_cl‖ = 5.8e3 — makes the Hamiltonian of the
-/// level-set test so large (blocks of size ‖C‖²/γ) that its eigenvalues near the crossings are
-/// lost, and the norm came out at 9.42e-8, a value attained at a mode frequency, 18 % low
-/// (SLICOT's AB13DD: 1.1428e-7; σmax in 40-digit arithmetic and in double precision at the peak,
-/// 5.742 rad/s: 1.14703e-7; `tests/hinf_regression.rs`).
-pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
-    use super::hinf::HinfParams;
-    let h = super::domain::hinf_norm_in(domain, sys, &HinfParams::default()).expect("no stop hook is set");
-    if !h.value.is_finite() || sys.order() == 0 {
-        return h;
-    }
-    let Some(mut fr) = AxisResponse::new(domain, sys) else { return h };
-    let band = frequency_band(domain, &[sys], &[]);
-    let (l0, l1) = (band.0.log10(), band.1.log10());
-    let n = NORM_CHECK_POINTS;
-    let (mut s_top, mut w_top) = (f64::NEG_INFINITY, f64::NAN);
-    for i in 0..n {
-        let w = 10f64.powf(l0 + (l1 - l0) * i as f64 / (n - 1) as f64);
-        let s = fr.sigma_max(w);
-        if s > s_top {
-            (s_top, w_top) = (s, w);
-        }
-    }
-    if !(s_top > h.value * (1.0 + NORM_CHECK_RTOL)) {
-        return h;
-    }
-    // the grid's frequency in the norm's units (rad/sample in discrete time)
-    let hint = match domain {
-        TimeDomain::Continuous => w_top,
-        TimeDomain::Discrete { ts } => (w_top * ts).min(std::f64::consts::PI),
-    };
-    let again = super::domain::hinf_norm_in(domain, sys, &HinfParams { hints: &[hint], ..HinfParams::default() })
-        .expect("no stop hook is set");
-    if again.value >= s_top {
-        again
-    } else {
-        HinfNorm { value: s_top, peak_freq: hint }
     }
 }
