@@ -238,9 +238,9 @@ pub const NORM_CHECK_POINTS: usize = 200;
 /// A grid value above the norm by more than this (relative) is a missed peak.
 pub const NORM_CHECK_RTOL: f64 = 1e-8;
 
-/// ‖sys‖∞ in `domain` ([`hinf_norm_in`](super::domain::hinf_norm_in), peak frequency in its
-/// units), checked against σmax on [`NORM_CHECK_POINTS`] log-spaced frequencies of the
-/// [`frequency_band`]: if one is above the norm by more than [`NORM_CHECK_RTOL`], the level-set
+/// ‖sys‖∞ in `domain` (`hinf_norm_in`, peak frequency in its
+/// units), checked against σmax on `NORM_CHECK_POINTS` log-spaced frequencies of the
+/// [`frequency_band`]: if one is above the norm by more than `NORM_CHECK_RTOL`, the level-set
 /// test missed that peak, and the norm is computed again from it (a hint, whose peak is climbed);
 /// the larger of that and the grid's value is returned. Every value is an attained σmax, so the
 /// check can only raise a norm that was too low. What verification and reports use
