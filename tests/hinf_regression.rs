@@ -87,6 +87,26 @@ fn ac12_with_a_tiny_norm_is_checked_on_a_grid() {
     assert_eq!(hinf_norm_checked(TimeDomain::Continuous, &roc8), plain);
 }
 
+/// COMPleib AC12 with a first-order controller of the COMPleib campaign (plain, results/compleib,
+/// n_K = 1): ‖Tzw‖∞ ≈ 1.0851e-7, at ω = 0, against ‖A_cl‖_F = 5.8e3 (balanced: 63). σmax from the
+/// Hessenberg form of the unbalanced A came out 1.08474e-7, 3.4e-4 low, and the norm with it;
+/// the check's grid, in balanced coordinates, reads it. Reference: the closed loop's G(0) solved
+/// in 40-digit mpmath, σmax 1.0851159205e-7 (SLICOT's AB13DD, python-control 0.10.2:
+/// 1.0851146e-7); σmax in balanced coordinates is within 1.3e-6 of it.
+#[test]
+fn ac12_with_its_peak_at_zero_is_read_in_balanced_coordinates() {
+    let plant = Plant::load(fixture("ac12.json")).unwrap();
+    let k = Controller::load(fixture("ac12_order1_controller.json")).unwrap();
+    let cl = closed_loop(&plant, &k).unwrap();
+    let peak = 1.0851159205e-7;
+    let h = hinf_norm_checked(TimeDomain::Continuous, &cl);
+    assert!((h.value - peak).abs() <= 5e-6 * peak, "{h:?}");
+    // what the check mends: the norm in the loop's own coordinates is low (if this fails, the
+    // norm itself has been mended, and the line can go)
+    let unchecked = hinf_norm(&cl, &HinfParams::default()).unwrap();
+    assert!(unchecked.value < peak * (1.0 - 1e-4), "{unchecked:?}");
+}
+
 /// COMPleib ROC8 with a second-order controller of the COMPleib campaign (plain, results/compleib,
 /// n_K = 2): a well-scaled loop (‖A‖ = 6.4, cond(A) = 84) with a nearly unobservable mode at
 /// −1.0e-7 ± 0.44504j. σmax(T(iω)) has a broad peak 3.4926731167 at 1.787 rad/s and a spike of

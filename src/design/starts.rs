@@ -151,13 +151,13 @@ pub const PADDED_COUPLING: f64 = 1e-2;
 /// with the coupling it starts off the saddle, at nearly the padded controller's objective.
 pub fn couple_padded_modes(k: &Controller, n0: usize, delta: f64, rng: &mut dyn RngCore) -> Controller {
     let nk = k.order();
-    let frob = |m: faer::MatRef<'_, f64>| m.norm_l2();
-    let sub = |m: &Mat<f64>, r: usize, c: usize| m.as_ref().submatrix(0, 0, r, c).to_owned();
+    // ‖·‖_F of the order-n0 controller's leading blocks
+    let frob = |m: &Mat<f64>, r: usize, c: usize| m.as_ref().submatrix(0, 0, r, c).norm_l2();
     let (dk, bk0, ck0, ak0) = (
-        frob(k.dk.as_ref()),
-        frob(sub(&k.bk, n0, k.inputs()).as_ref()),
-        frob(sub(&k.ck, k.outputs(), n0).as_ref()),
-        frob(sub(&k.ak, n0, n0).as_ref()),
+        k.dk.as_ref().norm_l2(),
+        frob(&k.bk, n0, k.inputs()),
+        frob(&k.ck, k.outputs(), n0),
+        frob(&k.ak, n0, n0),
     );
     let g = if dk > 0.0 {
         dk

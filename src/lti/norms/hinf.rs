@@ -84,7 +84,7 @@ use faer::{c64, Mat};
 
 use super::hinf_hooks::{measured, note, timed, NormEvent, Step};
 use crate::lti::interrupt::{Interrupt, Interrupted};
-use crate::lti::kernels::balance::balance_if_it_pays;
+use crate::lti::kernels::balance::{balance, balance_if_it_pays};
 use crate::lti::kernels::freq_response::{FreqResponse, ResponseSlot};
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
 use crate::lti::kernels::level_set_pencil::pencil_crossings;
@@ -246,6 +246,25 @@ pub(crate) fn hinf_norm_reusing(
     params: &HinfParams<'_>,
     kept: Option<FreqResponse>,
 ) -> Result<(HinfNorm, Option<FreqResponse>), Interrupted> {
+    hinf_norm_parts(sys, params, kept).map(|p| (p.norm, p.response))
+}
+
+/// What [`hinf_norm_parts`] computed on the way to a norm.
+pub(crate) struct NormParts {
+    pub norm: HinfNorm,
+    /// The poles (`None` if the eigensolver failed).
+    pub poles: Option<Vec<c64>>,
+    /// The frequency-response evaluator, if one was made (or kept).
+    pub response: Option<FreqResponse>,
+}
+
+/// [`hinf_norm_reusing`], returning the poles as well (for a frequency band of the same
+/// system, `sigma::hinf_norm_checked`).
+pub(crate) fn hinf_norm_parts(
+    sys: &StateSpace,
+    params: &HinfParams<'_>,
+    kept: Option<FreqResponse>,
+) -> Result<NormParts, Interrupted> {
     let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
     stop.poll()?;
     measured(sys, Step::Norm, || {
@@ -256,11 +275,11 @@ pub(crate) fn hinf_norm_reusing(
         } else {
             timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
         };
-        let norm = match poles {
-            Some(poles) => hinf_norm_from(sys, &poles, &mut fr, tol, hints, stop, enough)?,
+        let norm = match &poles {
+            Some(poles) => hinf_norm_from(sys, poles, &mut fr, tol, hints, stop, enough)?,
             None => HinfNorm::UNSTABLE,
         };
-        Ok((norm, fr))
+        Ok(NormParts { norm, poles, response: fr })
     })
 }
 
@@ -452,9 +471,22 @@ fn hinf_norm_from(
 /// every badly scaled plant).
 fn balanced_realisation(sys: &StateSpace) -> Option<StateSpace> {
     let (a, d) = balance_if_it_pays(sys.a.as_ref())?;
+    Some(rescaled(sys, a, &d))
+}
+
+/// `sys` in balanced state coordinates (as [`balanced_realisation`]) wherever balancing moves A
+/// at all, whatever it gains; `None` if A is balanced already (or not finite).
+pub(crate) fn balanced_coordinates(sys: &StateSpace) -> Option<StateSpace> {
+    let (a, d) = balance(sys.a.as_ref());
+    d.iter().any(|&x| x != 1.0).then(|| rescaled(sys, a, &d))
+}
+
+/// (A_b, D⁻¹B, CD, D): `sys` in the state coordinates of the diagonal `d` whose balanced A
+/// (D⁻¹AD) is `a`.
+fn rescaled(sys: &StateSpace, a: Mat<f64>, d: &[f64]) -> StateSpace {
     let b = Mat::from_fn(sys.b.nrows(), sys.b.ncols(), |i, j| sys.b[(i, j)] / d[i]);
     let c = Mat::from_fn(sys.c.nrows(), sys.c.ncols(), |i, j| sys.c[(i, j)] * d[j]);
-    Some(StateSpace { a, b, c, d: sys.d.clone() })
+    StateSpace { a, b, c, d: sys.d.clone() }
 }
 
 /// σmax at a crossing that clearly exceeds the level: relative to the level, by

@@ -9,7 +9,10 @@
 //! (`kernels/bilinear.rs`: the two are equal, docs/ALGORITHMS.md §10.2), which keeps the
 //! Hessenberg evaluator of the continuous case.
 
-use super::hinf::HinfNorm;
+use faer::c64;
+
+use super::domain::hinf_norm_in;
+use super::hinf::{balanced_coordinates, hinf_norm_parts, HinfNorm, HinfParams};
 use crate::lti::kernels::bilinear::Cayley;
 use crate::lti::kernels::freq_response::FreqResponse;
 use crate::lti::kernels::spectral::eigenvalues;
@@ -33,6 +36,11 @@ impl AxisResponse {
                 Some(AxisResponse { fr: FreqResponse::new(&cayley.sys), discrete: Some((ts, cayley)) })
             }
         }
+    }
+
+    /// The continuous-time evaluator `fr` (one already made for a norm).
+    fn continuous(fr: FreqResponse) -> Self {
+        AxisResponse { fr, discrete: None }
     }
 
     fn sigma_max(&mut self, w: f64) -> f64 {
@@ -72,13 +80,19 @@ pub const SIGMA_STEP_RTOL: f64 = 0.02;
 /// decades; (0.1, 10) with no modes. In discrete time the band ends at the Nyquist frequency
 /// π/Ts and starts at least three decades below it.
 pub fn frequency_band(domain: TimeDomain, systems: &[&StateSpace], extra: &[f64]) -> (f64, f64) {
-    let mode_freq = |l: faer::c64| match domain {
+    let modes: Vec<c64> = systems.iter().flat_map(|s| eigenvalues(s.a.as_ref()).unwrap_or_default()).collect();
+    band_of_modes(domain, &modes, extra)
+}
+
+/// [`frequency_band`] of systems whose modes (eigenvalues of the A matrices) are known.
+fn band_of_modes(domain: TimeDomain, modes: &[c64], extra: &[f64]) -> (f64, f64) {
+    let mode_freq = |l: c64| match domain {
         TimeDomain::Continuous => l.norm(),
-        TimeDomain::Discrete { ts } => faer::c64::new(l.norm().ln(), l.arg()).norm() / ts,
+        TimeDomain::Discrete { ts } => c64::new(l.norm().ln(), l.arg()).norm() / ts,
     };
-    let mags = systems
+    let mags = modes
         .iter()
-        .flat_map(|s| eigenvalues(s.a.as_ref()).unwrap_or_default())
+        .copied()
         .map(mode_freq)
         .filter(|m| *m > 0.0 && m.is_finite())
         .chain(extra.iter().copied().filter(|w| *w > 0.0 && w.is_finite()));
@@ -100,6 +114,12 @@ pub fn frequency_band(domain: TimeDomain, systems: &[&StateSpace], extra: &[f64]
     }
 }
 
+/// `n` ≥ 2 frequencies spaced uniformly in log ω from `band.0` to `band.1`.
+fn log_grid(band: (f64, f64), n: usize) -> impl Iterator<Item = f64> {
+    let (l0, l1) = (band.0.log10(), band.1.log10());
+    (0..n).map(move |i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (n - 1) as f64))
+}
+
 /// The widest band [`frequency_band`] returns (rad/s): wide enough for every plant (entries and
 /// sampling times within 1e-50..1e50), narrow enough that its log-spaced grid is finite.
 const BAND_LIMITS: (f64, f64) = (1e-300, 1e300);
@@ -111,10 +131,7 @@ const BAND_LIMITS: (f64, f64) = (1e-300, 1e300);
 /// In discrete time σmax(G(e^{iωTs})); empty if the system has no bilinear image (module docs).
 pub fn sigma_curve(domain: TimeDomain, sys: &StateSpace, band: (f64, f64), extra: &[f64]) -> Vec<(f64, f64)> {
     let Some(mut fr) = AxisResponse::new(domain, sys) else { return Vec::new() };
-    let (l0, l1) = (band.0.log10(), band.1.log10());
-    let n = SIGMA_BASE_POINTS;
-    let mut pts: Vec<(f64, f64)> = (0..n)
-        .map(|i| 10f64.powf(l0 + (l1 - l0) * i as f64 / (n - 1) as f64))
+    let mut pts: Vec<(f64, f64)> = log_grid(band, SIGMA_BASE_POINTS)
         .chain(extra.iter().copied().filter(|w| *w > band.0 && *w < band.1))
         .map(|w| (w, fr.sigma_max(w)))
         .collect();
@@ -238,33 +255,53 @@ pub const NORM_CHECK_POINTS: usize = 200;
 /// A grid value above the norm by more than this (relative) is a missed peak.
 pub const NORM_CHECK_RTOL: f64 = 1e-8;
 
-/// ‖sys‖∞ in `domain` (`hinf_norm_in`, peak frequency in its
-/// units), checked against σmax on `NORM_CHECK_POINTS` log-spaced frequencies of the
-/// [`frequency_band`]: if one is above the norm by more than `NORM_CHECK_RTOL`, the level-set
-/// test missed that peak, and the norm is computed again from it (a hint, whose peak is climbed);
-/// the larger of that and the grid's value is returned. Every value is an attained σmax, so the
-/// check can only raise a norm that was too low. What verification and reports use
-/// (`design::evaluate`); the optimiser's norms do without it.
+/// ‖sys‖∞ in `domain` (`hinf_norm_in`, peak frequency in its units), checked against σmax at
+/// ω = 0 and on `NORM_CHECK_POINTS` log-spaced frequencies of the [`frequency_band`], evaluated
+/// in balanced state coordinates wherever balancing moves A (the same transfer function exactly;
+/// D⁻¹AD with D a diagonal of powers of two). If a grid value is above the norm by more than
+/// `NORM_CHECK_RTOL`, the norm missed that peak or under-read it, and it is computed again in
+/// those coordinates from that frequency (a hint, whose peak is climbed); the larger of that
+/// and the grid's value is returned. Every value is an attained σmax, so the check can only
+/// raise a norm. What verification and reports use (`design::evaluate`); the optimiser's
+/// norms do without it (a second evaluator per norm).
 ///
-/// Why: a loop whose ‖Tzw‖∞ is tiny against its data — a plain design of COMPleib's AC12 of
-/// order 3, γ = 1.147e-7 with ‖C_cl‖ = 1e3 and ‖A_cl‖ = 5.8e3 — makes the Hamiltonian of the
-/// level-set test so large (blocks of size ‖C‖²/γ) that its eigenvalues near the crossings are
-/// lost, and the norm came out at 9.42e-8, a value attained at a mode frequency, 18 % low
-/// (SLICOT's AB13DD: 1.1428e-7; σmax in 40-digit arithmetic and in double precision at the peak,
-/// 5.742 rad/s: 1.14703e-7; `tests/hinf_regression.rs`).
+/// Why, two failures of COMPleib's AC12 under plain designs, whose ‖Tzw‖∞ ≈ 1e-7 is tiny
+/// against the loop's data (‖C_cl‖ = 1e3, ‖A_cl‖ = 5.8e3):
+/// * order 3, γ = 1.147e-7: the Hamiltonian of the level-set test has blocks of size ‖C‖²/γ,
+///   its eigenvalues near the crossings are lost, and the norm came out 9.42e-8, a value attained
+///   at a mode frequency, 18 % low (SLICOT's AB13DD: 1.1428e-7; σmax in 40-digit arithmetic and
+///   in double precision at the peak, 5.742 rad/s: 1.14703e-7);
+/// * orders 1 and 2, peak at ω = 0: σmax itself, from the Hessenberg form of the unbalanced A,
+///   came out 3.4e-4 and 1.5e-3 low (1.08474e-7 against 1.08512e-7 in 40-digit arithmetic).
+///   The Hessenberg reduction mixes rows of sizes 1e-2 to 1e3; in balanced coordinates (‖A‖_F
+///   63 against 5.8e3) the same evaluator is within 1.3e-6.
+///
+/// Both in `tests/hinf_regression.rs`.
 pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
-    use super::hinf::HinfParams;
-    let h = super::domain::hinf_norm_in(domain, sys, &HinfParams::default()).expect("no stop hook is set");
+    let params = HinfParams::default();
+    // In continuous time the norm's poles give the band, and its evaluator serves the grid
+    // where the coordinates are kept.
+    let (h, parts) = match domain {
+        TimeDomain::Continuous if sys.is_finite() => {
+            let p = hinf_norm_parts(sys, &params, None).expect("no stop hook is set");
+            (p.norm, Some((p.poles, p.response)))
+        }
+        _ => (hinf_norm_in(domain, sys, &params).expect("no stop hook is set"), None),
+    };
     if !h.value.is_finite() || sys.order() == 0 {
         return h;
     }
-    let Some(mut fr) = AxisResponse::new(domain, sys) else { return h };
-    let band = frequency_band(domain, &[sys], &[]);
-    let (l0, l1) = (band.0.log10(), band.1.log10());
-    let n = NORM_CHECK_POINTS;
+    let balanced = balanced_coordinates(sys);
+    let checked = balanced.as_ref().unwrap_or(sys);
+    let (band, kept) = match parts {
+        Some((Some(poles), fr)) => (band_of_modes(domain, &poles, &[]), fr.filter(|_| balanced.is_none())),
+        _ => (frequency_band(domain, &[sys], &[]), None),
+    };
+    let Some(mut fr) = kept.map(AxisResponse::continuous).or_else(|| AxisResponse::new(domain, checked)) else {
+        return h;
+    };
     let (mut s_top, mut w_top) = (f64::NEG_INFINITY, f64::NAN);
-    for i in 0..n {
-        let w = 10f64.powf(l0 + (l1 - l0) * i as f64 / (n - 1) as f64);
+    for w in std::iter::once(0.0).chain(log_grid(band, NORM_CHECK_POINTS)) {
         let s = fr.sigma_max(w);
         if s > s_top {
             (s_top, w_top) = (s, w);
@@ -278,8 +315,7 @@ pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
         TimeDomain::Continuous => w_top,
         TimeDomain::Discrete { ts } => (w_top * ts).min(std::f64::consts::PI),
     };
-    let again = super::domain::hinf_norm_in(domain, sys, &HinfParams { hints: &[hint], ..HinfParams::default() })
-        .expect("no stop hook is set");
+    let again = hinf_norm_in(domain, checked, &HinfParams { hints: &[hint], ..params }).expect("no stop hook is set");
     if again.value >= s_top {
         again
     } else {
