@@ -153,12 +153,8 @@ pub fn couple_padded_modes(k: &Controller, n0: usize, delta: f64, rng: &mut dyn 
     let nk = k.order();
     // ‖·‖_F of the order-n0 controller's leading blocks
     let frob = |m: &Mat<f64>, r: usize, c: usize| m.as_ref().submatrix(0, 0, r, c).norm_l2();
-    let (dk, bk0, ck0, ak0) = (
-        k.dk.as_ref().norm_l2(),
-        frob(&k.bk, n0, k.inputs()),
-        frob(&k.ck, k.outputs(), n0),
-        frob(&k.ak, n0, n0),
-    );
+    let (dk, bk0, ck0, ak0) =
+        (k.dk.as_ref().norm_l2(), frob(&k.bk, n0, k.inputs()), frob(&k.ck, k.outputs(), n0), frob(&k.ak, n0, n0));
     let g = if dk > 0.0 {
         dk
     } else if bk0 * ck0 > 0.0 {
