@@ -206,12 +206,12 @@ fn first_starts(
     let mut first = starting_points(plant, opts, starts.init, shape, nvar, vars, rng);
     let mut kinds = vec![if starts.init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
     if let Some(k) = starts.chained {
-        let padded = vars(controller_to_x(&padded_to(plant, k, shape.nk)));
+        let padded_k = padded_to(plant, k, shape.nk);
+        let padded = vars(controller_to_x(&padded_k));
         if k.order() < shape.nk {
             // the padded point is a saddle for its new modes (docs/ALGORITHMS.md §8.2); a
             // structure that fixes their coupling leaves nothing to couple
-            let coupled = couple_padded_modes(&padded_to(plant, k, shape.nk), k.order(), PADDED_COUPLING, rng);
-            let coupled = vars(controller_to_x(&coupled));
+            let coupled = vars(controller_to_x(&couple_padded_modes(&padded_k, k.order(), PADDED_COUPLING, rng)));
             if coupled != padded {
                 first.insert(0, coupled);
                 kinds.insert(0, StartKind::Chained);
