@@ -104,6 +104,10 @@ def _is_real(v):
     return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
 
 
+# Whole-number options are unsigned 64-bit integers in the crate.
+_U64_MAX = 2**64 - 1
+
+
 def _check_option(name, value):
     """A TypeError or ValueError, in the words of the option table, for a value of the wrong
     kind (the kind of the option's default); ranges are the crate's to check."""
@@ -118,6 +122,8 @@ def _check_option(name, value):
             raise TypeError(f"{name} must be a whole number, got {value!r}")
         if value < 0:
             raise ValueError(f"{name} must be ≥ 0, got {value}")
+        if value > _U64_MAX:
+            raise ValueError(f"{name} must be at most 2**64 - 1, got {value}")
     elif isinstance(default, float):
         if not _is_real(value):
             raise TypeError(f"{name} must be a number, got {value!r}")

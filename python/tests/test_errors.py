@@ -42,6 +42,8 @@ def test_option_errors_carry_the_crates_message(he1):
         hinfix.design(P, nmeas, ncon, -1)
     with pytest.raises(ValueError, match="must be at least 1"):
         hinfix.design(P, nmeas, ncon, 1, maxevals=0)
+    with pytest.raises(ValueError, match=r"seed must be at most 2\*\*64 - 1, got 1180591620717411303424"):
+        hinfix.design(P, nmeas, ncon, 1, seed=2**70)
     with pytest.raises(ValueError, match="cpumax"):
         hinfix.design(P, nmeas, ncon, 1, cpumax=float("nan"))
     with pytest.raises(TypeError, match="unknown design option.*nrandd"):
