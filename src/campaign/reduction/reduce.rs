@@ -25,6 +25,8 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use crate::campaign::records::record::JobRecord;
 use crate::design::{evaluate_job, Evaluation, ObjectiveKind, PlantValue, Problem, Rejection};
 use crate::lti::{Controller, Plant};
@@ -233,10 +235,13 @@ pub fn best_per_problem(records: &[JobRecord], plants: &PlantMap, problems: &Pro
         let name = plants.get(&r.plant_fingerprint).map_or(r.plant.as_str(), |p| p.name.as_str());
         (r.plant_fingerprint.as_str(), name)
     }));
+    // Each record re-verified on its own (in parallel: the verdicts, and so the tables, do not
+    // depend on the order or the thread they are computed in).
+    let verdicts: Vec<Option<Verdict>> =
+        records.par_iter().map(|r| verify_any(r, plants, problems).filter(|v| v.gamma().is_some())).collect();
     // job id → (record, verified figures) of its best record
     let mut per_job: BTreeMap<&str, (&JobRecord, Option<Verdict>)> = BTreeMap::new();
-    for r in records {
-        let verdict = verify_any(r, plants, problems).filter(|v| v.gamma().is_some());
+    for (r, verdict) in records.iter().zip(verdicts) {
         let better = |old: &Option<Verdict>| match (verdict.as_ref().and_then(Verdict::gamma), old) {
             (Some(g), Some(o)) => o.gamma().is_some_and(|o| g < o),
             (Some(_), None) => true,
