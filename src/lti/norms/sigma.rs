@@ -12,7 +12,7 @@
 use faer::c64;
 
 use super::domain::hinf_norm_in;
-use super::hinf::{balanced_coordinates, hinf_norm_parts, HinfNorm, HinfParams};
+use super::hinf::{balanced_coordinates, hinf_norm_parts, HinfNorm, HinfParams, NormParts};
 use crate::lti::kernels::bilinear::Cayley;
 use crate::lti::kernels::freq_response::FreqResponse;
 use crate::lti::kernels::spectral::eigenvalues;
@@ -284,7 +284,7 @@ pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
     let (h, parts) = match domain {
         TimeDomain::Continuous if sys.is_finite() => {
             let p = hinf_norm_parts(sys, &params, None).expect("no stop hook is set");
-            (p.norm, Some((p.poles, p.response)))
+            (p.norm, Some(p))
         }
         _ => (hinf_norm_in(domain, sys, &params).expect("no stop hook is set"), None),
     };
@@ -294,7 +294,9 @@ pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
     let balanced = balanced_coordinates(sys);
     let checked = balanced.as_ref().unwrap_or(sys);
     let (band, kept) = match parts {
-        Some((Some(poles), fr)) => (band_of_modes(domain, &poles, &[]), fr.filter(|_| balanced.is_none())),
+        Some(NormParts { poles: Some(poles), response, .. }) => {
+            (band_of_modes(domain, &poles, &[]), response.filter(|_| balanced.is_none()))
+        }
         _ => (frequency_band(domain, &[sys], &[]), None),
     };
     let Some(mut fr) = kept.map(AxisResponse::continuous).or_else(|| AxisResponse::new(domain, checked)) else {
