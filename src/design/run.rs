@@ -80,7 +80,7 @@ pub(super) fn design(
     };
     let nvar = structure.as_ref().map_or(shape.nvar(), |s| s.nfree());
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let (first, kinds) = first_starts(plant, opts, starts, shape, nvar, &vars, &mut rng);
+    let (first, kinds, given) = first_starts(plant, opts, starts, shape, nvar, &vars, &mut rng);
     // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
     // asks for them and the plant is scaled at all.
     let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
@@ -133,7 +133,7 @@ pub(super) fn design(
         problem,
         scaled,
     }
-    .run(opts, &first, &kinds, nvar)?;
+    .run(opts, &first, &kinds, given, nvar)?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
     let (final_x, ended) = how_it_ended(&res, opts, interrupted);
     let k = perf_obj.controller_at(&final_x);
@@ -191,8 +191,11 @@ fn check(
     Ok(h2)
 }
 
-/// The first starting points and their kinds, in the search's order: the chained start (if
-/// any), perturbations of the (padded) initial controller or random starts, the open-loop start
+/// The first starting points, their kinds and how many of them are given controllers, in the
+/// search's order: the given controllers themselves (the padded chained start, the padded
+/// initial controller: the search offers them to its incumbents before any local search and
+/// starts from them lowest objective first, `search` module docs), then the chained start's
+/// coupled copy, the initial controller's perturbations or random starts, the open-loop start
 /// (if asked for), the central starts. `vars` maps a controller's x to the optimiser's variables.
 fn first_starts(
     plant: &Plant,
@@ -202,9 +205,11 @@ fn first_starts(
     nvar: usize,
     vars: &dyn Fn(Vec<f64>) -> Vec<f64>,
     rng: &mut ChaCha8Rng,
-) -> (Vec<Vec<f64>>, Vec<StartKind>) {
+) -> (Vec<Vec<f64>>, Vec<StartKind>, usize) {
     let mut first = starting_points(plant, opts, starts.init, shape, nvar, vars, rng);
     let mut kinds = vec![if starts.init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
+    // `starting_points` begins with the initial controller itself, if there is one.
+    let mut given = usize::from(starts.init.is_some());
     if let Some(k) = starts.chained {
         let padded_k = padded_to(plant, k, shape.nk);
         let padded = vars(controller_to_x(&padded_k));
@@ -213,12 +218,13 @@ fn first_starts(
             // structure that fixes their coupling leaves nothing to couple
             let coupled = vars(controller_to_x(&couple_padded_modes(&padded_k, k.order(), PADDED_COUPLING, rng)));
             if coupled != padded {
-                first.insert(0, coupled);
-                kinds.insert(0, StartKind::Chained);
+                first.insert(given, coupled);
+                kinds.insert(given, StartKind::Chained);
             }
         }
         first.insert(0, padded);
         kinds.insert(0, StartKind::Chained);
+        given += 1;
     }
     if opts.open_loop_start {
         first.push(vars(controller_to_x(&open_loop_controller(plant, shape.nk))));
@@ -228,7 +234,7 @@ fn first_starts(
         first.push(vars(controller_to_x(&k)));
         kinds.push(StartKind::Central);
     }
-    (first, kinds)
+    (first, kinds, given)
 }
 
 /// The point a search returns (the best of the performance phase, else of the stabilisation

@@ -2,7 +2,9 @@
 //! until a budget or the stall rule ends it, then gradient sampling from the best point. The
 //! measurements behind its rules are in docs/ALGORITHMS.md §8, not here.
 //!
-//! Three parts, one module each:
+//! Four parts, one module each:
+//! * [`given`]: the run's given controllers (warm and chained starts) are incumbents before any
+//!   local search, and their local searches are made best first;
 //! * [`plan`]: where the local searches start — HIFOO's first starts (`nrand` random points, or
 //!   an initial controller and `nrand` perturbations of it), the open-loop start, the central
 //!   starts (twice on a scaled plant under `Alternate`), then the continued search's cycles of
@@ -14,7 +16,7 @@
 //! * [`budget`]: what ends the search and what each part may spend — `cpumax`, `maxevals`,
 //!   `max_starts`, the stall rule, and the gradient-sampling reserve.
 //!
-//! [`Search::run`] joins them: it asks the plan for the next start, runs the local search from
+//! [`Search::run`] joins them: it offers the given controllers, then asks the plan for the next start, runs the local search from
 //! it under the budget's control, offers the end point to the incumbents ([`State`]) and counts
 //! the stall, until the budget ends the search; then the incumbent's gradient sampling.
 //!
@@ -25,6 +27,7 @@
 //! load. A run ended by `cpumax` depends on the machine's speed.
 
 mod budget;
+mod given;
 mod local;
 mod plan;
 mod verified;
@@ -173,13 +176,16 @@ impl<'s> State<'s> {
     /// returns whether it improved the best f_h (stall sense). A verified point beats an
     /// unverified one whatever their f_h ([`verified`]).
     fn offer_perf(&mut self, r: &OptimResult, from: &[f64], start: usize, coords: Coords, verified: bool) -> bool {
-        let (old, old_verified) = self.perf.as_ref().map_or((f64::INFINITY, false), |b| (b.f, b.verified));
+        let (old, old_verified, old_dnorm) =
+            self.perf.as_ref().map_or((f64::INFINITY, false, f64::INFINITY), |b| (b.f, b.verified, b.dnorm));
         if old_verified && !verified {
             return false;
         }
         let upgrade = verified && !old_verified && self.perf.is_some() && r.f.is_finite();
         let better = upgrade || improves(r.f, old, self.opts.stall_rtol, 0.0);
-        if r.f.is_finite() && (upgrade || r.f < old) {
+        // A tie with a better certificate replaces (a local search that could not move its
+        // start, a given point offered uncertified: module `given`).
+        if r.f.is_finite() && (upgrade || r.f < old || (r.f == old && r.dnorm < old_dnorm)) {
             let (x, from) = (r.x.clone(), from.to_vec());
             self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from, coords, verified });
             // Cut by `maxit`, or by the search's share of a budget (`return_gs_reserve` may give
@@ -268,12 +274,14 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// Runs the whole search from the first starts `first` (module docs).
+    /// Runs the whole search from the first starts `first` (module docs), the first `given` of
+    /// them the run's given controllers ([`given`]).
     pub(crate) fn run(
         &mut self,
         opts: &DesignOptions,
         first: &[Vec<f64>],
         first_kinds: &[StartKind],
+        given: usize,
         nvar: usize,
     ) -> Result<SearchResult, DesignError> {
         let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
@@ -287,7 +295,8 @@ impl Search<'_, '_, '_> {
             full_ctl.maxevals().map_or(usize::MAX, |m| m - search_ctl.maxevals().unwrap_or(m)),
         );
         let mut rounds = GsRounds { first: first_reserve, ..Default::default() };
-        let mut plan = self.start_plan(opts.variable_scaling, first_kinds, first.len());
+        let given_order = self.offer_given(&mut st, &first[..given]);
+        let mut plan = self.start_plan(opts.variable_scaling, first_kinds, &given_order, first.len());
         // HIFOO's own first starts (random or init): the extra open-loop and central starts are
         // like the continued search, a budget may end the run before them without truncating it.
         let hifoo_starts = first_kinds

@@ -119,14 +119,22 @@ impl Search<'_, '_, '_> {
     }
 
     /// The plan of a search whose first starts have the kinds `kinds` (`n` of them; a start
-    /// without a kind is a random one). Every first start is made in the coordinates of
-    /// [`Self::coords_of`]; with `Alternate` on a scaled plant each central start is made twice,
-    /// first in x, then in x̃ (module docs, "Coordinates").
-    pub(super) fn start_plan(&self, mode: VariableScaling, kinds: &[StartKind], n: usize) -> StartPlan {
+    /// without a kind is a random one), the first `given_order.len()` of them the given
+    /// controllers, made in the order `given_order` ([`super::given`]), the others in theirs.
+    /// Every first start is made in the coordinates of [`Self::coords_of`]; with `Alternate` on a
+    /// scaled plant each central start is made twice, first in x, then in x̃ (module docs,
+    /// "Coordinates").
+    pub(super) fn start_plan(
+        &self,
+        mode: VariableScaling,
+        kinds: &[StartKind],
+        given_order: &[usize],
+        n: usize,
+    ) -> StartPlan {
         let c = self.coords_of(mode, None);
         let both = self.scaled.is_some() && mode == VariableScaling::Alternate;
         let mut first = Vec::with_capacity(2 * n);
-        for i in 0..n {
+        for i in given_order.iter().copied().chain(given_order.len()..n) {
             let kind = kinds.get(i).copied().unwrap_or(StartKind::Random);
             first.push((i, c, kind));
             if both && kind == StartKind::Central {

@@ -350,6 +350,11 @@ impl ResponseSlot {
         self.kept.take().filter(|(kept, _)| same_bits(kept, sys)).map(|(_, fr)| fr)
     }
 
+    /// Empties the slot.
+    pub(crate) fn clear(&self) {
+        self.kept.take();
+    }
+
     /// Keeps the evaluator `fr` of `sys`.
     pub(crate) fn keep(&self, sys: &StateSpace, fr: FreqResponse) {
         self.kept.set(Some((sys.clone(), fr)));

@@ -26,7 +26,7 @@
 use faer::linalg::solvers::Solve;
 use faer::{c64, Mat, MatRef};
 
-use super::hinf::{hinf_norm_reusing, HinfNorm, HinfParams};
+use super::hinf::{hinf_norm_parts, HinfNorm, HinfParams, NormParts};
 use crate::lti::error::LtiError;
 use crate::lti::kernels::freq_response::FreqResponse;
 use crate::lti::kernels::hessenberg_qr::HESSENBERG_QR_FROM;
@@ -119,8 +119,7 @@ pub(crate) fn closed_loop_hinf_grad_continuous(
     params: &HinfParams<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let kept = params.reuse.and_then(|slot| slot.take_for(&cl.sys));
-    Ok(closed_loop_grad_from(&cl, k, hinf_with_vectors(&cl.sys, params, kept)?))
+    Ok(closed_loop_grad_from(&cl, k, hinf_with_vectors(&cl.sys, params)?))
 }
 
 /// The norm and gradient of the closed loop `cl` of `k` from the norm and the vectors at its peak
@@ -151,7 +150,7 @@ pub(crate) fn grad_at_peak(
 /// nk = 0) and its gradient; [`controller_hinf_grad`](crate::lti::controller_hinf_grad) takes
 /// the controller's domain into account.
 pub(crate) fn controller_hinf_grad_continuous(k: &Controller, tol: f64) -> (HinfNorm, ControllerGradient) {
-    controller_grad_from(k, hinf_with_vectors(&controller_system(k), &HinfParams::new(tol), None))
+    controller_grad_from(k, hinf_with_vectors(&controller_system(k), &HinfParams::new(tol)))
 }
 
 /// The controller (Ak, Bk, Ck, Dk) as a system.
@@ -193,18 +192,21 @@ pub(crate) struct PeakVectors {
 }
 
 /// Norm and gradient vectors; `Ok(None)` if unstable (or not finite); `Err` once `params.stop`
-/// fires. `kept`: the evaluator of `sys` if one was made already. A value at or above
-/// `params.enough` comes without vectors (`hinf_norm_reusing`: it may be a lower bound of the
-/// norm).
+/// fires. A value at or above `params.enough` comes without vectors (it may be a lower bound of
+/// the norm). The vectors are computed in the norm's working coordinates (`hinf::Working`,
+/// x = D·x_b) and returned in `sys`'s: u and v are the same, a = D⁻¹a_b and b = D·b_b (with
+/// Z_b = D⁻¹ZD, C_b = CD and B_b = D⁻¹B, Z_b⁻ᴴC_bᵀu = D·Z⁻ᴴCᵀu and Z_b⁻¹B_b v = D⁻¹·Z⁻¹Bv).
 pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
     params: &HinfParams<'_>,
-    kept: Option<FreqResponse>,
 ) -> Result<Option<(HinfNorm, Option<PeakVectors>)>, LtiError> {
     if !sys.is_finite() {
+        if let Some(slot) = params.reuse {
+            slot.clear();
+        }
         return Ok(None);
     }
-    let (norm, fr) = hinf_norm_reusing(sys, params, kept)?;
+    let NormParts { norm, response: fr, working, .. } = hinf_norm_parts(sys, params)?;
     if !norm.value.is_finite() {
         return Ok(None);
     }
@@ -213,13 +215,25 @@ pub(crate) fn hinf_with_vectors(
     }
     params.stop.poll()?;
     let w = norm.peak_freq;
+    let ws = working.sys.as_ref();
     let vectors = || match fr {
-        Some(mut fr) if sys.order() >= HESSENBERG_QR_FROM && w.is_finite() && sys.inputs().min(sys.outputs()) > 0 => {
+        Some(mut fr) if ws.order() >= HESSENBERG_QR_FROM && w.is_finite() && ws.inputs().min(ws.outputs()) > 0 => {
             peak_vectors_hessenberg(&mut fr, w)
         }
-        _ => peak_vectors(sys, w),
+        _ => peak_vectors(ws, w),
     };
-    Ok(for_order(sys.order(), || timed(Step::Gradient, vectors)).map(|pv| (norm, Some(pv))))
+    let pv = for_order(sys.order(), || timed(Step::Gradient, vectors));
+    Ok(pv.map(|pv| (norm, Some(in_coordinates_of_sys(pv, working.scaling.as_deref())))))
+}
+
+/// The vectors `pv` of the working coordinates with diagonal `d` in those of the system itself
+/// ([`hinf_with_vectors`]); unchanged without a `d`.
+fn in_coordinates_of_sys(mut pv: PeakVectors, d: Option<&[f64]>) -> PeakVectors {
+    if let Some(d) = d {
+        pv.a.iter_mut().zip(d).for_each(|(a, &di)| *a /= di);
+        pv.b.iter_mut().zip(d).for_each(|(b, &di)| *b *= di);
+    }
+    pv
 }
 
 /// u, v, a, b at the finite frequency w (module docs) through the Hessenberg form of `fr`

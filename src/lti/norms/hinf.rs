@@ -12,8 +12,8 @@
 //!
 //! 1. Unstable (any Re λ(A) ≥ 0, exactly the HIFOO rule) or non-finite data → +∞. Where
 //!    balancing A's state coordinates pays (‖A‖_F falls by more than the factor
-//!    `kernels::balance::BALANCE_GAIN`), the level-set tests of step 4 run on the balanced
-//!    realisation, the same transfer function exactly (`balanced_realisation`).
+//!    `kernels::balance::BALANCE_GAIN`), everything below runs on the balanced realisation, the
+//!    same transfer function exactly (`Working`).
 //! 2. Lower bound γ_L = max σmax(G(iω)) over ω = ∞ (σmax(D)), ω = 0 and one test frequency per
 //!    mode, ω = |λ|·√max(¼, 1 − 2(Re λ/|λ|)²) (AB13DD's choice; for n > [`MAX_POLE_TEST_FREQS`]
 //!    only the least damped modes; from order [`HESSENBERG_QR_FROM`] on, well-damped modes only
@@ -227,59 +227,94 @@ impl<'a> HinfParams<'a> {
 /// ‖sys‖∞ and a frequency attaining it, as `params` ask ([`HinfParams`]); +∞ if the system is
 /// unstable or its data are not finite. `Err(Interrupted)` only if `params.stop` fired.
 pub fn hinf_norm(sys: &StateSpace, params: &HinfParams<'_>) -> Result<HinfNorm, Interrupted> {
-    let kept = params.reuse.and_then(|slot| slot.take_for(sys));
     if !sys.is_finite() {
+        if let Some(slot) = params.reuse {
+            slot.clear();
+        }
         return Ok(HinfNorm::UNSTABLE);
     }
-    hinf_norm_reusing(sys, params, kept).map(|(norm, _)| norm)
+    hinf_norm_parts(sys, params).map(|p| p.norm)
 }
 
-/// [`hinf_norm`] for finite data, with the poles computed here: from order
-/// [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one Hessenberg
-/// reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver (the rounding
-/// the small plants' results were obtained with). An eigensolver failure counts as unstable.
-/// `kept`: the frequency-response evaluator of `sys` if one was already made (`ResponseSlot`);
-/// the one used is returned with the norm (for the gradient's vectors at the peak,
-/// `gradient.rs`). `params.reuse` is not looked at here.
-pub(crate) fn hinf_norm_reusing(
-    sys: &StateSpace,
-    params: &HinfParams<'_>,
-    kept: Option<FreqResponse>,
-) -> Result<(HinfNorm, Option<FreqResponse>), Interrupted> {
-    hinf_norm_parts(sys, params, kept).map(|p| (p.norm, p.response))
+/// The state coordinates a norm of `sys` is computed in, and the line-search screen's σmax
+/// ([`hinf_lower_bound_sharing`]) and the gradient's vectors at the peak (`gradient.rs`) with it:
+/// `sys` balanced, (D⁻¹AD, D⁻¹B, CD, D) with D diagonal of powers of two (`kernels::balance`:
+/// the same transfer function, exactly), where balancing lowers ‖A‖_F by more than
+/// `kernels::balance::BALANCE_GAIN`; else `sys` itself, bit for bit as before (a loop that
+/// balancing improves less is left to the reports' check, `sigma::hinf_norm_checked`, which
+/// balances wherever balancing moves A: AC12's order-1 loop of `tests/hinf_regression.rs` gains
+/// 92-fold, and the norm reads its σmax at ω = 0 3.4e-4 low).
+///
+/// Why: in unbalanced coordinates both halves of the norm lose their accuracy on a badly scaled
+/// loop.
+/// * The level-set test: a closed loop of COMPleib's AC12 with a third-order controller of gain
+///   550 (‖A‖ = 6.6e3, balanced 57; ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5
+///   rad/s where they are 5.62, 5.71, 17.8 and 19.9), and the norm came out 5.6 % low.
+/// * σmax through the Hessenberg form of an unbalanced A mixes rows of very different sizes. On
+///   AC12's plain designs, whose ‖Tzw‖∞ is tiny against the loop's data, the optimiser then
+///   minimised the rounding: a first-order design (seed 2, 6 CPU s, ‖K‖∞ = 1.1e3) returned a
+///   controller whose norm it read as 2.9e-8, while it is 5.95e-5 (σmax in 40-digit arithmetic
+///   at 2.89 rad/s; SLICOT's AB13DD agrees); the level-set test at 2.9e-8 found no crossing.
+///   Before this, only the level-set test ran in balanced coordinates, and σmax was evaluated on
+///   `sys` so that one evaluator served the screen, the norm and the gradient; now all three
+///   share the balanced one.
+///
+/// Both in `tests/hinf_regression.rs`.
+pub(crate) struct Working<'s> {
+    /// The system in the working coordinates.
+    pub sys: std::borrow::Cow<'s, StateSpace>,
+    /// D, if the coordinates are balanced ones.
+    pub scaling: Option<Vec<f64>>,
+}
+
+impl<'s> Working<'s> {
+    /// The working coordinates of `sys` (finite data).
+    pub(crate) fn of(sys: &'s StateSpace) -> Self {
+        match balance_if_it_pays(sys.a.as_ref()) {
+            Some((a, d)) => Working { sys: std::borrow::Cow::Owned(rescaled(sys, a, &d)), scaling: Some(d) },
+            None => Working { sys: std::borrow::Cow::Borrowed(sys), scaling: None },
+        }
+    }
 }
 
 /// What [`hinf_norm_parts`] computed on the way to a norm.
-pub(crate) struct NormParts {
+pub(crate) struct NormParts<'s> {
     pub norm: HinfNorm,
     /// The poles (`None` if the eigensolver failed).
     pub poles: Option<Vec<c64>>,
-    /// The frequency-response evaluator, if one was made (or kept).
+    /// The frequency-response evaluator, if one was made (or kept): of `working.sys`.
     pub response: Option<FreqResponse>,
+    /// The coordinates the norm was computed in.
+    pub working: Working<'s>,
 }
 
-/// [`hinf_norm_reusing`], returning the poles as well (for a frequency band of the same
-/// system, `sigma::hinf_norm_checked`).
-pub(crate) fn hinf_norm_parts(
-    sys: &StateSpace,
-    params: &HinfParams<'_>,
-    kept: Option<FreqResponse>,
-) -> Result<NormParts, Interrupted> {
-    let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
+/// [`hinf_norm`] of finite data with what it computed on the way: the poles (for a frequency
+/// band of the same system, `sigma::hinf_norm_checked`), the frequency-response evaluator (for
+/// the gradient's vectors at the peak, `gradient.rs`) and the working coordinates. The poles:
+/// from order [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one
+/// Hessenberg reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver on
+/// `sys`'s own A (the rounding the small plants' results were obtained with). An eigensolver
+/// failure counts as unstable. The evaluator of `params.reuse` is taken if it is of the working
+/// system.
+pub(crate) fn hinf_norm_parts<'s>(sys: &'s StateSpace, params: &HinfParams<'_>) -> Result<NormParts<'s>, Interrupted> {
+    let HinfParams { tol, hints, stop, enough, reuse } = *params;
+    let working = Working::of(sys);
+    let kept = reuse.and_then(|slot| slot.take_for(&working.sys));
     stop.poll()?;
     measured(sys, Step::Norm, || {
         let mut fr = kept;
+        let w = working.sys.as_ref();
         let poles = if sys.order() >= HESSENBERG_QR_FROM {
             note(NormEvent::Large { sys, tol, hints });
-            fr.get_or_insert_with(|| FreqResponse::new(sys)).poles()
+            fr.get_or_insert_with(|| FreqResponse::new(w)).poles()
         } else {
             timed(Step::Poles, || eigenvalues(sys.a.as_ref()))
         };
         let norm = match &poles {
-            Some(poles) => hinf_norm_from(sys, poles, &mut fr, tol, hints, stop, enough)?,
+            Some(poles) => hinf_norm_from(w, poles, &mut fr, tol, hints, stop, enough)?,
             None => HinfNorm::UNSTABLE,
         };
-        Ok(NormParts { norm, poles, response: fr })
+        Ok(NormParts { norm, poles, response: fr, working })
     })
 }
 
@@ -306,8 +341,11 @@ pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, sl
     if !sys.is_finite() {
         return f64::INFINITY;
     }
+    // In the norm's working coordinates, so that the norm can take the evaluator.
+    let working = Working::of(sys);
+    let w = working.sys.as_ref();
     measured(sys, Step::LowerBound, || {
-        let mut fr = FreqResponse::new(sys);
+        let mut fr = FreqResponse::new(w);
         let mut best = Best { gamma: fr.sigma_max(f64::INFINITY), freq: f64::INFINITY };
         let mut tested = vec![0.0];
         if wanted > f64::NEG_INFINITY {
@@ -322,7 +360,7 @@ pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, sl
             let (w0, s0) = (best.freq, best.gamma);
             refine_from(&mut fr, &mut best, &tested, w0, s0, climb);
         }
-        slot.keep(sys, fr);
+        slot.keep(w, fr);
         best.gamma
     })
 }
@@ -336,7 +374,8 @@ pub(crate) fn hinf_norm_with_poles(
     params: &HinfParams<'_>,
 ) -> Result<HinfNorm, Interrupted> {
     let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
-    measured(sys, Step::Norm, || hinf_norm_from(sys, poles, &mut None, tol, hints, stop, enough))
+    let working = Working::of(sys);
+    measured(sys, Step::Norm, || hinf_norm_from(&working.sys, poles, &mut None, tol, hints, stop, enough))
 }
 
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
@@ -394,10 +433,8 @@ fn hinf_norm_from(
         return Ok(best.norm());
     }
 
-    // The level-set test on the balanced realisation where balancing pays; σmax on `sys` (its
-    // evaluator is shared with the line-search screen and the gradient, `ResponseSlot`).
-    let balanced = balanced_realisation(sys);
-    let ham = Hamiltonian::new(balanced.as_ref().unwrap_or(sys), sigma_d, poles);
+    // `sys` is in the working coordinates (balanced where balancing pays, `Working`).
+    let ham = Hamiltonian::new(sys, sigma_d, poles);
     // For `verify_stop`: the scan's points (hints and modes) and every frequency tested so far.
     let modes_scan = scan;
     let mut seen: Vec<f64> = tested;
@@ -457,25 +494,9 @@ fn hinf_norm_from(
     Ok(best.norm())
 }
 
-/// `sys` in balanced state coordinates, (D⁻¹AD, D⁻¹B, CD, D) with D diagonal of powers of two
-/// (`kernels::balance`: the same transfer function, exactly), where balancing A lowers ‖A‖_F by
-/// more than `kernels::balance::BALANCE_GAIN`; else `None` (use `sys`, bit for bit as before). The level-set test
-/// is made on it.
-///
-/// Why: in unbalanced coordinates the level-set test loses its accuracy. A closed loop of
-/// COMPleib's AC12 with a third-order controller of gain 550 (‖A‖ = 6.6e3, balanced 57;
-/// ‖Tzw‖∞ = 2.4e-4) got its crossings wrong (0, 3.66 and 16.5 rad/s where they are 5.62, 5.71,
-/// 17.8 and 19.9), and the norm came out 5.6 % low (`tests/hinf_regression.rs`). σmax itself is
-/// still evaluated on `sys`, to about 1e-8 there: the evaluator is shared with the line-search
-/// screen and the gradient (a balanced one would cost a second Hessenberg reduction per norm on
-/// every badly scaled plant).
-fn balanced_realisation(sys: &StateSpace) -> Option<StateSpace> {
-    let (a, d) = balance_if_it_pays(sys.a.as_ref())?;
-    Some(rescaled(sys, a, &d))
-}
-
-/// `sys` in balanced state coordinates (as [`balanced_realisation`]) wherever balancing moves A
-/// at all, whatever it gains; `None` if A is balanced already (or not finite).
+/// `sys` in balanced state coordinates (as [`Working::of`] makes them where balancing pays)
+/// wherever balancing moves A at all, whatever it gains; `None` if A is balanced already (or not
+/// finite).
 pub(crate) fn balanced_coordinates(sys: &StateSpace) -> Option<StateSpace> {
     let (a, d) = balance(sys.a.as_ref());
     d.iter().any(|&x| x != 1.0).then(|| rescaled(sys, a, &d))
@@ -1185,7 +1206,7 @@ mod tests {
     /// The norm does not depend on the state coordinates: badly scaled realisations
     /// (T⁻¹AT, T⁻¹B, CT with T = diag(10^k) spreading 12 decades) of stable systems, half of
     /// them with small C and D, give the norm of the well-scaled one. (The balanced path,
-    /// `balanced_realisation`, runs on every scaled one; the failure it mends is AC12's closed
+    /// `Working`, runs on every scaled one; the failure it mends is AC12's closed
     /// loop in `tests/hinf_regression.rs`, which such random realisations do not reproduce.)
     #[test]
     fn badly_scaled_realisations_have_the_same_norm() {

@@ -280,10 +280,10 @@ pub const NORM_CHECK_RTOL: f64 = 1e-8;
 pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
     let params = HinfParams::default();
     // In continuous time the norm's poles give the band, and its evaluator serves the grid
-    // where the coordinates are kept.
+    // where the coordinates agree.
     let (h, parts) = match domain {
         TimeDomain::Continuous if sys.is_finite() => {
-            let p = hinf_norm_parts(sys, &params, None).expect("no stop hook is set");
+            let p = hinf_norm_parts(sys, &params).expect("no stop hook is set");
             (p.norm, Some(p))
         }
         _ => (hinf_norm_in(domain, sys, &params).expect("no stop hook is set"), None),
@@ -293,9 +293,13 @@ pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
     }
     let balanced = balanced_coordinates(sys);
     let checked = balanced.as_ref().unwrap_or(sys);
+    // The norm's evaluator is of its working coordinates (`hinf::Working`): the balanced ones
+    // where balancing pays, which are the grid's; else `sys`, the grid's only if balancing
+    // leaves A as it is.
     let (band, kept) = match parts {
-        Some(NormParts { poles: Some(poles), response, .. }) => {
-            (band_of_modes(domain, &poles, &[]), response.filter(|_| balanced.is_none()))
+        Some(NormParts { poles: Some(poles), response, working, .. }) => {
+            let shared = working.scaling.is_some() || balanced.is_none();
+            (band_of_modes(domain, &poles, &[]), response.filter(|_| shared))
         }
         _ => (frequency_band(domain, &[sys], &[]), None),
     };

@@ -32,7 +32,7 @@ pub fn inverse_stability_radius(a: MatRef<'_, f64>, params: &HinfParams<'_>) -> 
     if a.nrows() != a.ncols() {
         return Err(LtiError::Shape { what: "A", expected: (a.nrows(), a.nrows()), got: (a.nrows(), a.ncols()) });
     }
-    Ok(hinf_with_vectors(&resolvent_system(a), &HinfParams { reuse: None, ..*params }, None)?
+    Ok(hinf_with_vectors(&resolvent_system(a), &HinfParams { reuse: None, ..*params })?
         .map_or(HinfNorm::UNSTABLE, |(norm, _)| norm))
 }
 
@@ -47,7 +47,7 @@ pub fn closed_loop_inverse_stability_radius_grad(
     params: &HinfParams<'_>,
 ) -> Result<(HinfNorm, ControllerGradient), LtiError> {
     let cl = ClosedLoop::new(plant, k)?;
-    let peak = hinf_with_vectors(&resolvent_system(cl.sys.a.as_ref()), &HinfParams { reuse: None, ..*params }, None)?;
+    let peak = hinf_with_vectors(&resolvent_system(cl.sys.a.as_ref()), &HinfParams { reuse: None, ..*params })?;
     Ok(grad_at_peak(k, peak, |pv| cl.chain_rule(&pv.a, &pv.b, None)))
 }
 
