@@ -371,27 +371,8 @@ mod tests {
     /// (column j), G_Ds = G_D. Without the carrying back these are off by the balancing's D.
     #[test]
     fn gradient_of_a_badly_scaled_realisation_is_carried_back_from_balanced_coordinates() {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
         let mut compared = 0;
-        for case in 0..20 {
-            let (n, m, p) = (5 + case % 4, 1 + case % 3, 1 + case % 2);
-            let mut a = Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
-            let shift = crate::lti::kernels::spectral::spectral_abscissa(a.as_ref()) + 0.05 + 0.1 * (case % 3) as f64;
-            for i in 0..n {
-                a[(i, i)] -= shift;
-            }
-            let b = Mat::from_fn(n, m, |_, _| rng.random_range(-1.0..1.0));
-            let c = Mat::from_fn(p, n, |_, _| rng.random_range(-1.0..1.0));
-            let d = Mat::from_fn(p, m, |_, _| rng.random_range(-0.5..0.5));
-            let sys = StateSpace { a, b, c, d };
-            let t: Vec<f64> = (0..n).map(|i| 10f64.powf(12.0 * i as f64 / (n - 1) as f64 - 6.0)).collect();
-            let scaled = StateSpace {
-                a: Mat::from_fn(n, n, |i, j| sys.a[(i, j)] * t[j] / t[i]),
-                b: Mat::from_fn(n, m, |i, j| sys.b[(i, j)] / t[i]),
-                c: Mat::from_fn(p, n, |i, j| sys.c[(i, j)] * t[j]),
-                d: sys.d.clone(),
-            };
+        for (case, (sys, scaled, t)) in super::super::hinf::badly_scaled_pairs(21, false).into_iter().enumerate() {
             assert!(super::super::hinf::Working::of(&scaled).scaling.is_some(), "case {case}: not balanced");
             let at_peak = |s: &StateSpace| {
                 let (norm, pv) = hinf_with_vectors(s, &HinfParams::default()).unwrap().unwrap();

@@ -1193,6 +1193,38 @@ fn known_peak_eigenvalues(mu: &[c64], peak_freq: f64, window: f64, eligible: imp
     near.into_iter().take(count).map(|(_, i)| i).collect()
 }
 
+/// For tests: 20 random stable systems (orders 5–8, 1–3 inputs, 1–2 outputs; with `small_cd`,
+/// C and D of size 1e-4 in every second one) with a badly scaled realisation of each,
+/// (T⁻¹AT, T⁻¹B, CT, D) for T = diag(t), t spreading 12 decades: (system, realisation, t).
+#[cfg(test)]
+pub(crate) fn badly_scaled_pairs(seed: u64, small_cd: bool) -> Vec<(StateSpace, StateSpace, Vec<f64>)> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    (0..20)
+        .map(|case| {
+            let (n, m, p) = (5 + case % 4, 1 + case % 3, 1 + case % 2);
+            let mut a = Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
+            let shift = crate::lti::kernels::spectral::spectral_abscissa(a.as_ref()) + 0.05 + 0.1 * (case % 3) as f64;
+            for i in 0..n {
+                a[(i, i)] -= shift;
+            }
+            let b = Mat::from_fn(n, m, |_, _| rng.random_range(-1.0..1.0));
+            let small = if small_cd && case % 2 == 0 { 1e-4 } else { 1.0 };
+            let c = Mat::from_fn(p, n, |_, _| small * rng.random_range(-1.0..1.0));
+            let d = Mat::from_fn(p, m, |_, _| small * rng.random_range(-0.5..0.5));
+            let sys = StateSpace { a, b, c, d };
+            let t: Vec<f64> = (0..n).map(|i| 10f64.powf(12.0 * i as f64 / (n - 1) as f64 - 6.0)).collect();
+            let scaled = StateSpace {
+                a: Mat::from_fn(n, n, |i, j| sys.a[(i, j)] * t[j] / t[i]),
+                b: Mat::from_fn(n, m, |i, j| sys.b[(i, j)] / t[i]),
+                c: Mat::from_fn(p, n, |i, j| sys.c[(i, j)] * t[j]),
+                d: sys.d.clone(),
+            };
+            (sys, scaled, t)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1204,27 +1236,7 @@ mod tests {
     /// loop in `tests/hinf_regression.rs`, which such random realisations do not reproduce.)
     #[test]
     fn badly_scaled_realisations_have_the_same_norm() {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
-        for case in 0..20 {
-            let (n, m, p) = (5 + case % 4, 1 + case % 3, 1 + case % 2);
-            let mut a = Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
-            let shift = crate::lti::kernels::spectral::spectral_abscissa(a.as_ref()) + 0.05 + 0.1 * (case % 3) as f64;
-            for i in 0..n {
-                a[(i, i)] -= shift;
-            }
-            let b = Mat::from_fn(n, m, |_, _| rng.random_range(-1.0..1.0));
-            let small = if case % 2 == 0 { 1e-4 } else { 1.0 };
-            let c = Mat::from_fn(p, n, |_, _| small * rng.random_range(-1.0..1.0));
-            let d = Mat::from_fn(p, m, |_, _| small * rng.random_range(-0.5..0.5));
-            let sys = StateSpace { a, b, c, d };
-            let t: Vec<f64> = (0..n).map(|i| 10f64.powf(12.0 * i as f64 / (n - 1) as f64 - 6.0)).collect();
-            let scaled = StateSpace {
-                a: Mat::from_fn(n, n, |i, j| sys.a[(i, j)] * t[j] / t[i]),
-                b: Mat::from_fn(n, m, |i, j| sys.b[(i, j)] / t[i]),
-                c: Mat::from_fn(p, n, |i, j| sys.c[(i, j)] * t[j]),
-                d: sys.d.clone(),
-            };
+        for (case, (sys, scaled, _)) in badly_scaled_pairs(12, true).into_iter().enumerate() {
             let want = hinf_norm(&sys, &HinfParams::default()).unwrap().value;
             let got = hinf_norm(&scaled, &HinfParams::default()).unwrap().value;
             assert!(want.is_finite() && (got / want - 1.0).abs() < 1e-8, "case {case}: {got} against {want}");
