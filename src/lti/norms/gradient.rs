@@ -200,12 +200,6 @@ pub(crate) fn hinf_with_vectors(
     sys: &StateSpace,
     params: &HinfParams<'_>,
 ) -> Result<Option<(HinfNorm, Option<PeakVectors>)>, LtiError> {
-    if !sys.is_finite() {
-        if let Some(slot) = params.reuse {
-            slot.clear();
-        }
-        return Ok(None);
-    }
     let NormParts { norm, response: fr, working, .. } = hinf_norm_parts(sys, params)?;
     if !norm.value.is_finite() {
         return Ok(None);

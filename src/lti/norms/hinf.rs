@@ -227,12 +227,6 @@ impl<'a> HinfParams<'a> {
 /// ‖sys‖∞ and a frequency attaining it, as `params` ask ([`HinfParams`]); +∞ if the system is
 /// unstable or its data are not finite. `Err(Interrupted)` only if `params.stop` fired.
 pub fn hinf_norm(sys: &StateSpace, params: &HinfParams<'_>) -> Result<HinfNorm, Interrupted> {
-    if !sys.is_finite() {
-        if let Some(slot) = params.reuse {
-            slot.clear();
-        }
-        return Ok(HinfNorm::UNSTABLE);
-    }
     hinf_norm_parts(sys, params).map(|p| p.norm)
 }
 
@@ -282,16 +276,24 @@ pub(crate) struct NormParts<'s> {
     pub working: Working<'s>,
 }
 
-/// [`hinf_norm`] of finite data with what it computed on the way: the poles (for a frequency
+/// [`hinf_norm`] with what it computed on the way: the poles (for a frequency
 /// band of the same system, `sigma::hinf_norm_checked`), the frequency-response evaluator (for
 /// the gradient's vectors at the peak, `gradient.rs`) and the working coordinates. The poles:
 /// from order [`HESSENBERG_QR_FROM`] on from the frequency response's Hessenberg form (one
 /// Hessenberg reduction serves both, `FreqResponse::poles`), below it by faer's eigensolver on
 /// `sys`'s own A (the rounding the small plants' results were obtained with). An eigensolver
 /// failure counts as unstable. The evaluator of `params.reuse` is taken if it is of the working
-/// system.
+/// system. Data that are not finite are unstable, with nothing computed (and `params.reuse`
+/// emptied: its evaluator is of another system).
 pub(crate) fn hinf_norm_parts<'s>(sys: &'s StateSpace, params: &HinfParams<'_>) -> Result<NormParts<'s>, Interrupted> {
     let HinfParams { tol, hints, stop, enough, reuse } = *params;
+    if !sys.is_finite() {
+        if let Some(slot) = reuse {
+            slot.clear();
+        }
+        let working = Working { sys: std::borrow::Cow::Borrowed(sys), scaling: None };
+        return Ok(NormParts { norm: HinfNorm::UNSTABLE, poles: None, response: None, working });
+    }
     let working = Working::of(sys);
     let kept = reuse.and_then(|slot| slot.take_for(&working.sys));
     stop.poll()?;

@@ -282,7 +282,7 @@ pub fn hinf_norm_checked(domain: TimeDomain, sys: &StateSpace) -> HinfNorm {
     // In continuous time the norm's poles give the band, and its evaluator serves the grid
     // where the coordinates agree.
     let (h, parts) = match domain {
-        TimeDomain::Continuous if sys.is_finite() => {
+        TimeDomain::Continuous => {
             let p = hinf_norm_parts(sys, &params).expect("no stop hook is set");
             (p.norm, Some(p))
         }
