@@ -158,6 +158,45 @@ fn a_run_is_never_worse_than_its_best_given_controller() {
     }
 }
 
+/// A chained start that is not the run's first search (`chained_first(false)`, every seed but
+/// the first of a campaign's order chaining) is still an incumbent from the outset: the same
+/// BDT2 design, given the fast protocol's 0.5673 controller as its chained start only, returns
+/// nothing above it although the budget ends the run in its own first local search, and the
+/// chained start's local search is planned after the run's own first starts (kind `chained`,
+/// recorded at its place in the plan). With `chained_first(true)` it is the first local search.
+#[test]
+fn a_chained_start_made_last_is_still_an_incumbent_from_the_outset() {
+    let p = plant("BDT2");
+    let good = given_fixture("BDT2_order2_eps1e-2_seed1.json");
+    let opts = DesignOptions {
+        order: 2,
+        eps: 1e-3,
+        seed: 1,
+        cpumax: f64::INFINITY,
+        maxevals: Some(100),
+        ..Default::default()
+    };
+    let bound = 0.5673 * (1.0 + 1e-4);
+    for first in [true, false] {
+        let o = Design::for_plant(&p, &opts).chained(Some(&good)).chained_first(first).run().unwrap();
+        assert!(
+            o.objective <= bound,
+            "chained_first {first}: objective {} above the chained start's 0.5673",
+            o.objective
+        );
+        assert_eq!(o.search.best_start_kind, Some(StartKind::Chained));
+        // the run's own first starts: nrand random ones, the open-loop start, the central ones
+        let own = opts.nrand + 1;
+        if first {
+            assert_eq!(o.search.best_start, 0);
+        } else {
+            assert!(o.search.best_start >= own, "chained start at {} of the plan", o.search.best_start);
+            assert!(o.search.starts < o.search.best_start, "its local search was made ({} starts)", o.search.starts);
+        }
+        check_recomputed(&p, &o);
+    }
+}
+
 /// A COMPleib plant and a controller of results/compleib stored in tests/fixtures/compleib.
 fn compleib_start(plant: &str, fixture: &str) -> (Plant, Controller) {
     let p = Plant::load(hinfix::lti::resolve_plant(plant).unwrap()).unwrap();

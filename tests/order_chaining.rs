@@ -1,6 +1,7 @@
 //! Order chaining (`order_chaining = true`, campaigns/FORMAT.md): on a small real-design
 //! campaign under an evaluation budget (deterministic), every job of an order starts from the
-//! best verified controller of the order below at its ε, chosen by (γ, job id); it never ends
+//! best verified controller of the order below at its ε, chosen by (γ, job id) (the first seed's
+//! job making its local search first, the others after their own first starts); it never ends
 //! above that controller's objective; the best-γ table is non-increasing in n_K; and a resumed
 //! run and a run in two shards journal the very records of one sitting.
 
@@ -76,6 +77,8 @@ fn chained_jobs_start_from_the_best_of_the_order_below_and_tables_do_not_rise() 
 
     for j in &jobs {
         let r = &whole[&j.id];
+        // the first seed's job makes its chained start's local search first, the others last
+        assert_eq!(j.leads_chain, j.options.seed == 0, "{}", j.label());
         if j.chain_from.is_empty() {
             assert_eq!(r.chained_from, None, "{}", j.label());
             continue;

@@ -36,6 +36,7 @@ pub struct Design<'a> {
     opts: &'a DesignOptions,
     init: Option<&'a Controller>,
     chained: Option<&'a Controller>,
+    chained_first: bool,
     structure: Option<&'a Structure>,
     observer: Option<&'a mut dyn DesignObserver>,
     cancel: Option<Arc<AtomicBool>>,
@@ -56,7 +57,16 @@ impl<'a> Design<'a> {
     }
 
     fn with_problem(problem: Cow<'a, Problem>, opts: &'a DesignOptions) -> Self {
-        Design { problem, opts, init: None, chained: None, structure: None, observer: None, cancel: None }
+        Design {
+            problem,
+            opts,
+            init: None,
+            chained: None,
+            chained_first: true,
+            structure: None,
+            observer: None,
+            cancel: None,
+        }
     }
 
     /// An initial controller of order ≤ `opts.order`: a lower order is padded with decoupled
@@ -69,15 +79,27 @@ impl<'a> Design<'a> {
 
     /// One more initial controller of order ≤ `opts.order` (a campaign's order chaining passes
     /// the best controller of the order below, `campaign::jobs`), padded as [`Design::init`]'s
-    /// and projected onto the structure. It is the **first** local search of the run (kind
-    /// [`StartKind::Chained`](super::StartKind::Chained), no perturbations of it), so that no
-    /// budget can end the run before it: the run then never returns a controller whose
-    /// objective is above the padded controller's, which (same ε) is the objective of `k`
-    /// itself. If `k`'s order is below `opts.order`, the second local search starts from the
-    /// padded controller with its new modes coupled (`starts::couple_padded_modes`,
-    /// docs/ALGORITHMS.md §8.2: the padded point is a saddle for them). `None`: no chained start.
+    /// and projected onto the structure. The padded controller, if it verifies, is an incumbent
+    /// before any local search (`design::search` module `given`): the run never returns a
+    /// controller whose objective is above the padded controller's, which (same ε) is the
+    /// objective of `k` itself, however soon a budget ends it. A local search starts from it
+    /// (kind [`StartKind::Chained`](super::StartKind::Chained), no perturbations of it), and, if
+    /// `k`'s order is below `opts.order`, another from the padded controller with its new modes
+    /// coupled (`starts::couple_padded_modes`, docs/ALGORITHMS.md §8.2: the padded point is a
+    /// saddle for them); these come first or last as [`Design::chained_first`] says. `None`: no
+    /// chained start.
     pub fn chained(mut self, k: Option<&'a Controller>) -> Self {
         self.chained = k;
+        self
+    }
+
+    /// Whether the chained start's local searches ([`Design::chained`]) are the run's first
+    /// (`true`, the default; among the given controllers, lowest objective first) or come after
+    /// all its own first starts (`false`: a campaign's order chaining asks this of every seed but
+    /// the first, so that its seeds stay independent searches, `campaign::jobs`). Either way the
+    /// chained start is an incumbent from the outset.
+    pub fn chained_first(mut self, first: bool) -> Self {
+        self.chained_first = first;
         self
     }
 
@@ -118,7 +140,7 @@ impl<'a> Design<'a> {
     /// stabilisable (strong objective) or an initial controller that does not fit. γ, ‖K‖∞ and
     /// the abscissas of the outcome are recomputed from the returned controller.
     pub fn run(self) -> Result<DesignOutcome, DesignError> {
-        let Design { problem, opts, init, chained, structure, observer, cancel } = self;
+        let Design { problem, opts, init, chained, chained_first, structure, observer, cancel } = self;
         let mut none = NoDesignObserver;
         let obs: &mut dyn DesignObserver = match observer {
             Some(o) => o,
@@ -128,7 +150,7 @@ impl<'a> Design<'a> {
         if let Some(flag) = cancel.or_else(|| obs.cancel_flag()) {
             ctl = ctl.with_cancel(flag);
         }
-        let starts = super::run::Starts { init, chained };
+        let starts = super::run::Starts { init, chained, chained_first };
         super::run::design(&problem, opts, starts, structure, &ctl, obs)
     }
 }

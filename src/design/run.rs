@@ -30,7 +30,7 @@ use super::problem::{
     nan_max, plant_part, plant_values, problem_gamma, H2Feedthrough, PlantValue, Problem, PENALTY_WEIGHT,
 };
 use super::scaling::variable_scaling;
-use super::search::{ScaledObjectives, Search, SearchResult};
+use super::search::{FirstStarts, ScaledObjectives, Search, SearchResult};
 use super::starts::{
     couple_padded_modes, open_loop_controller, pad_controller, padding_diagonal, perturbed_starts, random_starts,
     PADDED_COUPLING,
@@ -40,10 +40,12 @@ use super::structure::Structure;
 /// The given starting controllers of a run: `init` (with its perturbations, in place of the
 /// random starts) and `chained` (the first local search), each of order ≤ `opts.order`
 /// ([`Design::init`](super::Design::init), [`Design::chained`](super::Design::chained)).
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 pub(super) struct Starts<'a> {
     pub init: Option<&'a Controller>,
     pub chained: Option<&'a Controller>,
+    /// Whether `chained`'s local searches come first ([`Design::chained_first`](super::Design::chained_first)).
+    pub chained_first: bool,
 }
 
 /// The design of `problem` ([`Design::run`](super::Design::run), whose docs say what each
@@ -80,7 +82,7 @@ pub(super) fn design(
     };
     let nvar = structure.as_ref().map_or(shape.nvar(), |s| s.nfree());
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let (first, kinds, given) = first_starts(plant, opts, starts, shape, nvar, &vars, &mut rng);
+    let first = first_starts(plant, opts, starts, shape, nvar, &vars, &mut rng);
     // Local searches in plant-scaled variables x̃ (x = d ∘ x̃, `design::scaling`), if the mode
     // asks for them and the plant is scaled at all.
     let scaling: Option<Rc<[f64]>> = match opts.variable_scaling {
@@ -133,7 +135,7 @@ pub(super) fn design(
         problem,
         scaled,
     }
-    .run(opts, &first, &kinds, given, nvar)?;
+    .run(opts, &first, nvar)?;
     let interrupted = adapter.interrupted() || ctl.cancelled() || res.summary.stop == SearchStop::Interrupted;
     let (final_x, ended) = how_it_ended(&res, opts, interrupted);
     let k = perf_obj.controller_at(&final_x);
@@ -196,7 +198,9 @@ fn check(
 /// initial controller: the search offers them to its incumbents before any local search and
 /// starts from them lowest objective first, `search` module docs), then the chained start's
 /// coupled copy, the initial controller's perturbations or random starts, the open-loop start
-/// (if asked for), the central starts. `vars` maps a controller's x to the optimiser's variables.
+/// (if asked for), the central starts. Without `starts.chained_first` the search makes the chained
+/// starts' local searches last (`search` module docs). `vars` maps a controller's x to the
+/// optimiser's variables.
 fn first_starts(
     plant: &Plant,
     opts: &DesignOptions,
@@ -205,7 +209,7 @@ fn first_starts(
     nvar: usize,
     vars: &dyn Fn(Vec<f64>) -> Vec<f64>,
     rng: &mut ChaCha8Rng,
-) -> (Vec<Vec<f64>>, Vec<StartKind>, usize) {
+) -> FirstStarts {
     let mut first = starting_points(plant, opts, starts.init, shape, nvar, vars, rng);
     let mut kinds = vec![if starts.init.is_some() { StartKind::Init } else { StartKind::Random }; first.len()];
     // `starting_points` begins with the initial controller itself, if there is one.
@@ -234,7 +238,7 @@ fn first_starts(
         first.push(vars(controller_to_x(&k)));
         kinds.push(StartKind::Central);
     }
-    (first, kinds, given)
+    FirstStarts { points: first, kinds, given, chained_first: starts.chained_first }
 }
 
 /// The point a search returns (the best of the performance phase, else of the stabilisation

@@ -51,7 +51,8 @@ pub struct JobStarts<'a> {
     /// Its `warm_from` predecessor's controller (warm start, ε-continuation): the initial
     /// controller, with its perturbations.
     pub warm: Option<&'a Controller>,
-    /// The best controller of its `chain_from` jobs (order chaining): one more start, the first.
+    /// The best controller of its `chain_from` jobs (order chaining): one more start, an
+    /// incumbent from the outset ([`Job::leads_chain`]: its local search the first).
     pub chained: Option<&'a Controller>,
 }
 
@@ -89,7 +90,13 @@ pub fn design_job(
         Some(p) => crate::design::Design::new(p, &job.options),
         None => crate::design::Design::for_plant(&job.plant, &job.options),
     };
-    design.init(starts.warm).chained(starts.chained).structure(job.structure.as_deref()).observe(obs).run()
+    design
+        .init(starts.warm)
+        .chained(starts.chained)
+        .chained_first(job.leads_chain)
+        .structure(job.structure.as_deref())
+        .observe(obs)
+        .run()
 }
 
 /// What [`Coordinator::claim`] found.

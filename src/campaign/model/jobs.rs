@@ -26,7 +26,11 @@
 //! at every ε, whatever `warm_start` and `eps_continuation` do. Its [`Job::chain_from`] lists
 //! every job of that order and ε (one per seed, in seed order); the scheduler starts the job only
 //! when all of them have finished and passes the controller of the best of them
-//! (`campaign::chain`: least re-verified γ, ties by job id), padded as `--init` pads. The list
+//! (`campaign::chain`: least re-verified γ, ties by job id), padded as `--init` pads. It is an
+//! incumbent of every such job from the outset, so no job ends above it; the job of the first seed
+//! ([`Job::leads_chain`]) makes its local search first, every other seed after its own first
+//! starts, so that the seeds stay independent searches rather than all refining the same start
+//! (`design::search` module `given`). The list
 //! enters the job id (absent when empty, so the ids of campaigns without the key do not change):
 //! what a job starts from is decided by its id's inputs alone, the same in one sitting, resumed or
 //! sharded.
@@ -100,6 +104,10 @@ pub struct Job {
     /// Order chaining (module docs): the jobs of the order below at the same ε, of which the best
     /// verified controller is one more start; empty without `order_chaining`.
     pub chain_from: Vec<JobId>,
+    /// Order chaining: whether its seed is the first of its problem's seeds, whose job makes its
+    /// chained start's local search first (module docs). Not in the id: the id's inputs decide it
+    /// (`chain_from` is in seed order, and each of its ids holds its seed).
+    pub leads_chain: bool,
     /// The runner the id was made for.
     pub runner: RunnerTag,
 }
@@ -291,6 +299,7 @@ pub fn expand(c: &Campaign, runner: RunnerTag) -> Vec<Job> {
                         options,
                         warm_from,
                         chain_from,
+                        leads_chain: si == 0,
                         runner,
                     });
                 }

@@ -91,6 +91,17 @@ pub(crate) struct ScaledObjectives<'r, 'o> {
     pub d: Rc<[f64]>,
 }
 
+/// The first starts of a search (module docs), as `design::run` makes them: the points
+/// (controller parameters), their kinds, how many of them (at the front) are the run's given
+/// controllers ([`given`]), and whether a chained start's local searches come first (else after
+/// the run's own first starts, `given` module docs).
+pub(crate) struct FirstStarts {
+    pub points: Vec<Vec<f64>>,
+    pub kinds: Vec<StartKind>,
+    pub given: usize,
+    pub chained_first: bool,
+}
+
 /// What the search produced.
 #[derive(Debug, Clone)]
 pub(crate) struct SearchResult {
@@ -274,16 +285,14 @@ impl Search<'_, '_, '_> {
         }
     }
 
-    /// Runs the whole search from the first starts `first` (module docs), the first `given` of
-    /// them the run's given controllers ([`given`]).
+    /// Runs the whole search from the first starts `starts` (module docs).
     pub(crate) fn run(
         &mut self,
         opts: &DesignOptions,
-        first: &[Vec<f64>],
-        first_kinds: &[StartKind],
-        given: usize,
+        starts: &FirstStarts,
         nvar: usize,
     ) -> Result<SearchResult, DesignError> {
+        let FirstStarts { points: first, kinds: first_kinds, given, chained_first } = starts;
         let reserve = if opts.gradient_sampling { 1.0 - GS_RESERVE } else { 1.0 };
         let mut search_ctl = self.ctl.sub_budget(reserve, reserve);
         let mut st = State::new(opts);
@@ -295,8 +304,10 @@ impl Search<'_, '_, '_> {
             full_ctl.maxevals().map_or(usize::MAX, |m| m - search_ctl.maxevals().unwrap_or(m)),
         );
         let mut rounds = GsRounds { first: first_reserve, ..Default::default() };
-        let given_order = self.offer_given(&mut st, &first[..given]);
-        let mut plan = self.start_plan(opts.variable_scaling, first_kinds, &given_order, first.len());
+        let given_values = self.given_values(&mut st, &first[..*given]);
+        let given_order = given::lowest_first(&given_values);
+        let mut plan = self.start_plan(opts.variable_scaling, first_kinds, &given_order, first.len(), *chained_first);
+        self.offer_given(&mut st, &first[..*given], &given_values, &plan);
         // HIFOO's own first starts (random or init): the extra open-loop and central starts are
         // like the continued search, a budget may end the run before them without truncating it.
         let hifoo_starts = first_kinds
@@ -379,7 +390,7 @@ impl Search<'_, '_, '_> {
         truncated: bool,
         gs_ran: bool,
     ) -> SearchResult {
-        let (k, kinds, coords) = (plan.made(), plan.kinds, plan.coords);
+        let k = plan.made();
         let [s0, s1, s2] = st.stats;
         let mut phases = vec![s0];
         if st.stabilised {
@@ -407,8 +418,8 @@ impl Search<'_, '_, '_> {
         let summary = SearchSummary {
             starts: k,
             best_start,
-            best_start_kind: kinds.get(best_start).copied(),
-            best_start_scaled: coords.get(best_start) == Some(&Coords::Scaled),
+            best_start_kind: plan.kind_at(best_start),
+            best_start_scaled: plan.coords_at(best_start) == Some(Coords::Scaled),
             cpu_to_best_s: reached.map_or(0.0, |r| r.cpu_s),
             evals_to_best: reached.map_or(0, |r| r.evals),
             stop,

@@ -3,7 +3,9 @@
 //! 1. The first starts: as HIFOO 3.5, `nrand` standard-normal points, or an initial controller
 //!    and `nrand` perturbations of it ([`crate::design::starts`]); then the open-loop start K = 0
 //!    (`open_loop_start`) and the central-controller starts (`central_gammas`). They are always
-//!    made (unless a budget ends the run first).
+//!    made (unless a budget ends the run first). The given controllers' local searches (a warm
+//!    start, a chained start, [`super::given`]) come first, lowest objective first, except that a
+//!    chained start that is not to be first (`chained_first` false) comes after all the others.
 //! 2. If none of them was stabilised and gradient sampling is on: gradient sampling on f_s from
 //!    the point with the smallest f_s (HIFOO's fallback, [`super::local`]).
 //! 3. The continued search (`stall_starts > 0`): further local searches, cycling through one
@@ -74,6 +76,23 @@ pub(super) enum NextStart {
 }
 
 impl StartPlan {
+    /// The position in the plan of the local search from first start `i` (`i` itself if it has
+    /// none).
+    pub(super) fn position_of(&self, i: usize) -> usize {
+        self.first.iter().position(|s| s.0 == i).unwrap_or(i)
+    }
+
+    /// The kind of local search number `k`: of the one made, else of the first start planned
+    /// there (a given point is an incumbent before its local search is made, module `given`).
+    pub(super) fn kind_at(&self, k: usize) -> Option<StartKind> {
+        self.kinds.get(k).or_else(|| self.first.get(k).map(|s| &s.2)).copied()
+    }
+
+    /// The coordinates of local search number `k`, as [`Self::kind_at`].
+    pub(super) fn coords_at(&self, k: usize) -> Option<Coords> {
+        self.coords.get(k).or_else(|| self.first.get(k).map(|s| &s.1)).copied()
+    }
+
     /// Local searches made (or begun) so far.
     pub(super) fn made(&self) -> usize {
         self.kinds.len()
@@ -120,7 +139,9 @@ impl Search<'_, '_, '_> {
 
     /// The plan of a search whose first starts have the kinds `kinds` (`n` of them; a start
     /// without a kind is a random one), the first `given_order.len()` of them the given
-    /// controllers, made in the order `given_order` ([`super::given`]), the others in theirs.
+    /// controllers, made in the order `given_order` ([`super::given`]), the others in theirs;
+    /// without `chained_first`, the chained starts' local searches are made after all the others
+    /// (in their own order).
     /// Every first start is made in the coordinates of [`Self::coords_of`]; with `Alternate` on a
     /// scaled plant each central start is made twice, first in x, then in x̃ (module docs,
     /// "Coordinates").
@@ -130,6 +151,7 @@ impl Search<'_, '_, '_> {
         kinds: &[StartKind],
         given_order: &[usize],
         n: usize,
+        chained_first: bool,
     ) -> StartPlan {
         let c = self.coords_of(mode, None);
         let both = self.scaled.is_some() && mode == VariableScaling::Alternate;
@@ -140,6 +162,11 @@ impl Search<'_, '_, '_> {
             if both && kind == StartKind::Central {
                 first.push((i, Coords::Scaled, kind));
             }
+        }
+        if !chained_first {
+            let (chained, own): (Vec<_>, Vec<_>) = first.into_iter().partition(|s| s.2 == StartKind::Chained);
+            first = own;
+            first.extend(chained);
         }
         StartPlan {
             first,

@@ -41,6 +41,14 @@ impl Search<'_, '_, '_> {
         stabilises(self.problem, st.opts, &self.perf_obj.controller_at(x)).is_ok()
     }
 
+    /// f_h at `x` (controller parameters), evaluated once outside a local search and counted
+    /// with the performance phase's evaluations.
+    pub(super) fn perf_value(&mut self, st: &mut State<'_>, x: &[f64]) -> f64 {
+        let mut g = vec![0.0; x.len()];
+        st.stats[1].evals += 1;
+        self.perf_obj.eval(x, &mut g)
+    }
+
     /// The end point `r` (controller parameters) of an f_h local search that started from
     /// `from`, made to verify where it can (module docs): unchanged if it verifies, else
     /// replaced by its pull-back towards `from` if `from` verifies. Returns whether `r`, as it
@@ -63,9 +71,7 @@ impl Search<'_, '_, '_> {
             }
         }
         let x = point(lo);
-        let mut g = vec![0.0; x.len()];
-        let f = self.perf_obj.eval(&x, &mut g);
-        st.stats[1].evals += 1;
+        let f = self.perf_value(st, &x);
         if !f.is_finite() {
             return false;
         }
