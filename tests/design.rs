@@ -128,6 +128,21 @@ fn given_fixture(name: &str) -> Controller {
     Controller::from_json_str(&std::fs::read_to_string(&file).unwrap(), &file).unwrap()
 }
 
+/// The given-start cases' design: BDT2 at order 2, ε = 1e-3, seed 1, 100 evaluations (the budget
+/// ends the run inside its first local search); the fast protocol's order-2 controller of
+/// ε = 1e-2 (objective 0.5673 at ε = 1e-3) and the bound on the run's objective it gives.
+fn bdt2_given_case() -> (Plant, Controller, DesignOptions, f64) {
+    let opts = DesignOptions {
+        order: 2,
+        eps: 1e-3,
+        seed: 1,
+        cpumax: f64::INFINITY,
+        maxevals: Some(100),
+        ..Default::default()
+    };
+    (plant("BDT2"), given_fixture("BDT2_order2_eps1e-2_seed1.json"), opts, 0.5673 * (1.0 + 1e-4))
+}
+
 /// A run returns nothing worse than its best given controller, however soon its budget ends
 /// (src/design/search/given.rs). BDT2 at order 2, ε = 1e-3, given the fast protocol's order-2
 /// controller of ε = 1e-2 (γ = 0.5673, ‖K‖∞ = 56.73: objective 0.5673 at ε = 1e-3) and the best
@@ -138,18 +153,8 @@ fn given_fixture(name: &str) -> Controller {
 /// outset and its local search is made first.
 #[test]
 fn a_run_is_never_worse_than_its_best_given_controller() {
-    let p = plant("BDT2");
-    let good = given_fixture("BDT2_order2_eps1e-2_seed1.json");
+    let (p, good, opts, bound) = bdt2_given_case();
     let worse = given_fixture("BDT2_order1_eps1e-3_best.json");
-    let opts = DesignOptions {
-        order: 2,
-        eps: 1e-3,
-        seed: 1,
-        cpumax: f64::INFINITY,
-        maxevals: Some(100),
-        ..Default::default()
-    };
-    let bound = 0.5673 * (1.0 + 1e-4);
     for (init, chained, kind) in [(&good, &worse, StartKind::Init), (&worse, &good, StartKind::Chained)] {
         let o = Design::for_plant(&p, &opts).init(Some(init)).chained(Some(chained)).run().unwrap();
         assert!(o.objective <= bound, "{kind:?}: objective {} above the better given start's 0.5673", o.objective);
@@ -166,17 +171,7 @@ fn a_run_is_never_worse_than_its_best_given_controller() {
 /// recorded at its place in the plan). With `chained_first(true)` it is the first local search.
 #[test]
 fn a_chained_start_made_last_is_still_an_incumbent_from_the_outset() {
-    let p = plant("BDT2");
-    let good = given_fixture("BDT2_order2_eps1e-2_seed1.json");
-    let opts = DesignOptions {
-        order: 2,
-        eps: 1e-3,
-        seed: 1,
-        cpumax: f64::INFINITY,
-        maxevals: Some(100),
-        ..Default::default()
-    };
-    let bound = 0.5673 * (1.0 + 1e-4);
+    let (p, good, opts, bound) = bdt2_given_case();
     for first in [true, false] {
         let o = Design::for_plant(&p, &opts).chained(Some(&good)).chained_first(first).run().unwrap();
         assert!(
