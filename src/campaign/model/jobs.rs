@@ -22,18 +22,17 @@
 //! still needs nothing but its spec and its predecessor, and chains can be sharded).
 //!
 //! Order chaining: with `order_chaining = true`, every job of the i-th order of a problem (i > 0,
-//! orders ascending) also starts from the best controller of the (i−1)-th order at the same ε —
-//! at every ε, whatever `warm_start` and `eps_continuation` do. Its [`Job::chain_from`] lists
-//! every job of that order and ε (one per seed, in seed order); the scheduler starts the job only
-//! when all of them have finished and passes the controller of the best of them
-//! (`campaign::chain`: least re-verified γ, ties by job id), padded as `--init` pads. It is an
-//! incumbent of every such job from the outset, so no job ends above it; the job of the first seed
-//! ([`Job::leads_chain`]) makes its local search first, every other seed after its own first
-//! starts, so that the seeds stay independent searches rather than all refining the same start
-//! (`design::search` module `given`). The list
-//! enters the job id (absent when empty, so the ids of campaigns without the key do not change):
-//! what a job starts from is decided by its id's inputs alone, the same in one sitting, resumed or
-//! sharded.
+//! orders ascending) also starts from the best controller of the (i−1)-th order at the same ε — at
+//! every ε, whatever `warm_start` and `eps_continuation` do. Its [`Job::chain_from`] lists every
+//! job of that order and ε (one per seed, in seed order); the scheduler starts the job only when
+//! all of them have finished and passes the controller of the best of them (`campaign::chain`:
+//! least re-verified γ, ties by job id), padded as `--init` pads. It is an incumbent of every such
+//! job from the outset, so no job ends above it; the job of the first seed ([`Job::leads_chain`])
+//! makes its local search first, every other seed after its own first starts, so that the seeds
+//! stay independent searches rather than all refining the same start (`design::search` module
+//! `given`). The list enters the job id (absent when empty, so the ids of campaigns without the key
+//! do not change): what a job starts from is decided by its id's inputs alone, the same in one
+//! sitting, resumed or sharded.
 
 use std::fmt;
 use std::sync::Arc;

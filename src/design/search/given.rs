@@ -16,14 +16,14 @@
 //! A run whose given points are unstable, or that has at most one given point, makes its local
 //! searches in the order it always did.
 //!
-//! A chained start that is not its run's first search ([`super::FirstStarts::chained_first`] false: in a
-//! campaign, every seed but the first of an order's jobs) is still an incumbent from the outset,
-//! but its local search and its coupled copy's come after the run's own first starts. The best
-//! controller of the order below is the same for every seed, so each seed that searched from it
-//! first spent its budget on the same local search: in the fast protocol the four seeds of
-//! BDT2's order 3 ended within 0.4 % of one another at every ε, and seven of the eight jobs of
-//! its orders 3 and 4 at ε = 1e-6 at the same 0.5360. One seed still refines the chained start first; the others search
-//! as independent replicates, each never worse than the order below.
+//! A chained start that is not its run's first search ([`super::FirstStarts::chained_first`] false:
+//! in a campaign, every seed but the first of an order's jobs) is still an incumbent from the
+//! outset, but its local search and its coupled copy's come after the run's own first starts. The
+//! best controller of the order below is the same for every seed, so each seed that searched from
+//! it first spent its budget on the same local search: in the fast protocol the four seeds of
+//! BDT2's order 3 ended within 0.4 % of one another at every ε, and seven of the eight jobs of its
+//! orders 3 and 4 at ε = 1e-6 at the same 0.5360. One seed still refines the chained start first;
+//! the others search as independent replicates, each never worse than the order below.
 
 use super::plan::StartPlan;
 use super::{Best, Coords, Search, State};
