@@ -180,7 +180,8 @@ fn a_chained_start_made_last_is_still_an_incumbent_from_the_outset() {
             o.objective
         );
         assert_eq!(o.search.best_start_kind, Some(StartKind::Chained));
-        // the run's own first starts: nrand random ones, the open-loop start, the central ones
+        // the run's own first starts come before it: at least the nrand random ones and the
+        // open-loop start (then the central ones)
         let own = opts.nrand + 1;
         if first {
             assert_eq!(o.search.best_start, 0);

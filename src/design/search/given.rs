@@ -40,10 +40,18 @@ impl Search<'_, '_, '_> {
     }
 
     /// Offers the given points `given`, of f_h `values` ([`Self::given_values`]), to the
-    /// incumbents (module docs), lowest f_h first (ties in the given order). A given point is
-    /// recorded as found by the local search of `plan` that starts from it.
-    pub(super) fn offer_given(&self, st: &mut State<'_>, given: &[Vec<f64>], values: &[f64], plan: &StartPlan) {
-        for i in lowest_first(values) {
+    /// incumbents (module docs) in the order `order` ([`lowest_first`] of `values`: on a tie the
+    /// first offered stays). A given point is recorded as found by the local search of `plan`
+    /// that starts from it.
+    pub(super) fn offer_given(
+        &self,
+        st: &mut State<'_>,
+        given: &[Vec<f64>],
+        values: &[f64],
+        order: &[usize],
+        plan: &StartPlan,
+    ) {
+        for &i in order {
             let f = values[i];
             if f.is_finite() && st.perf.as_ref().is_none_or(|b| f < b.f) {
                 let x = given[i].clone();

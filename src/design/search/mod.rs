@@ -307,7 +307,7 @@ impl Search<'_, '_, '_> {
         let given_values = self.given_values(&mut st, &first[..*given]);
         let given_order = given::lowest_first(&given_values);
         let mut plan = self.start_plan(opts.variable_scaling, first_kinds, &given_order, first.len(), *chained_first);
-        self.offer_given(&mut st, &first[..*given], &given_values, &plan);
+        self.offer_given(&mut st, &first[..*given], &given_values, &given_order, &plan);
         // HIFOO's own first starts (random or init): the extra open-loop and central starts are
         // like the continued search, a budget may end the run before them without truncating it.
         let hifoo_starts = first_kinds

@@ -260,8 +260,13 @@ impl<'s> Working<'s> {
     pub(crate) fn of(sys: &'s StateSpace) -> Self {
         match balance_if_it_pays(sys.a.as_ref()) {
             Some((a, d)) => Working { sys: std::borrow::Cow::Owned(rescaled(sys, a, &d)), scaling: Some(d) },
-            None => Working { sys: std::borrow::Cow::Borrowed(sys), scaling: None },
+            None => Working::unscaled(sys),
         }
+    }
+
+    /// `sys`'s own coordinates.
+    fn unscaled(sys: &'s StateSpace) -> Self {
+        Working { sys: std::borrow::Cow::Borrowed(sys), scaling: None }
     }
 }
 
@@ -291,8 +296,12 @@ pub(crate) fn hinf_norm_parts<'s>(sys: &'s StateSpace, params: &HinfParams<'_>) 
         if let Some(slot) = reuse {
             slot.clear();
         }
-        let working = Working { sys: std::borrow::Cow::Borrowed(sys), scaling: None };
-        return Ok(NormParts { norm: HinfNorm::UNSTABLE, poles: None, response: None, working });
+        return Ok(NormParts {
+            norm: HinfNorm::UNSTABLE,
+            poles: None,
+            response: None,
+            working: Working::unscaled(sys),
+        });
     }
     let working = Working::of(sys);
     let kept = reuse.and_then(|slot| slot.take_for(&working.sys));
