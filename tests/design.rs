@@ -564,7 +564,7 @@ fn ac10_order1_default_search_with_scaled_cycles_gets_far_below_the_unscaled_one
 fn variable_scaling_modes_are_bit_identical_on_a_plant_with_alike_channels() {
     let p = plant("HE1");
     assert!(variable_scaling(&p, ControllerShape::for_plant(&p, 1)).is_none());
-    let base = DesignOptions { order: 1, eps: 1e-3, seed: 3, cpumax: 1e6, maxevals: Some(2000), ..Default::default() };
+    let base = DesignOptions { order: 1, eps: 1e-3, seed: 3, cpumax: 1e6, maxevals: Some(5000), ..Default::default() };
     let runs: Vec<_> = [VariableScaling::Off, VariableScaling::Alternate, VariableScaling::Always]
         .map(|mode| Design::for_plant(&p, &DesignOptions { variable_scaling: mode, ..base.clone() }).run())
         .into_iter()

@@ -499,6 +499,25 @@ impl Objective for DesignObjective<'_> {
         self.eval_unless(x, g, f64::INFINITY)
     }
 
+    /// ε where the controller's term ε·‖K‖∞ (ε·α(Ak) when stabilising) sets f at `x`, else 1:
+    /// the certificate then weighs that term's gradient as ∇‖K‖∞, not ε∇‖K‖∞
+    /// (docs/ALGORITHMS.md §7.3). A problem of several plants, or a point no longer cached: 1.
+    fn gradient_unit(&self, x: &[f64]) -> f64 {
+        if !self.strong || self.problem.is_some() || !(self.eps > 0.0) {
+            return 1.0;
+        }
+        let Some(c) = self.cache.borrow().lookup(x) else { return 1.0 };
+        let controller_sets_f = match self.phase {
+            ObjectivePhase::Performance => self.eps * c.k_hinf > c.gamma,
+            ObjectivePhase::Stabilisation => self.eps * c.alpha_k > c.alpha_cl,
+        };
+        if controller_sets_f {
+            self.eps
+        } else {
+            1.0
+        }
+    }
+
     /// In the performance phase, a trial point whose cheap lower bound
     /// (`performance_lower_bound`: σmax(Tzw) at ω = ∞ and up the last peak, ε‖K‖∞) already
     /// reaches `threshold` is rejected

@@ -531,7 +531,9 @@ macro_rules! design_option_table {
                     format!("must be in 1..={}, got {v}", $crate::design::MAX_ITERATIONS)
                 }),
                 doc "BFGS iterations per start and phase";
-            /// Stop BFGS when the certificate dnorm ≤ normtol (HIFOO passes 1e-3).
+            /// Stop BFGS when the certificate dnorm ≤ normtol (HIFOO passes 1e-3); each gradient
+            /// is taken in the unit of the term that set f at its point (ε for the controller's
+            /// term of the strong objective, docs/ALGORITHMS.md §7.3).
             #[serde(with = "serde_f64_or_string")]
             normtol: f64 = 1e-3,
                 key layered, flag "",

@@ -135,8 +135,8 @@ impl Solver for Bfgs<'_> {
         for i in 0..n {
             h[i * n + i] = 1.0;
         }
-        let bundle = GradBundle::new(self.opts.ngrad_for(n), x0, &g);
-        let dnorm = dot(&g, &g).sqrt();
+        let bundle = GradBundle::new(self.opts.ngrad_for(n), x0, &g, ev.gradient_unit(x0));
+        let dnorm = bundle.dnorm();
         Ok(BfgsState {
             x: x0.to_vec(),
             f,
@@ -169,12 +169,13 @@ impl Solver for Bfgs<'_> {
             // B s = t·B p = −t·g exactly, since p = −H g and H is B⁻¹ (used only for damping).
             let bs: Vec<f64> = s.g.iter().map(|v| -ls.t * v).collect();
             let pnorm = dot(&p, &p).sqrt();
+            let unit = ev.gradient_unit(&ls.x);
             if ls.t * pnorm > self.opts.evaldist {
-                s.bundle.reset(&ls.x, &ls.g);
+                s.bundle.reset(&ls.x, &ls.g, unit);
             } else {
-                s.bundle.push(&ls.x, &ls.g);
+                s.bundle.push(&ls.x, &ls.g, unit);
             }
-            s.dnorm = if s.bundle.len() == 1 { dot(&ls.g, &ls.g).sqrt() } else { s.bundle.min_norm().dnorm };
+            s.dnorm = s.bundle.dnorm();
             s.x = ls.x;
             s.f = ls.f;
             s.g = ls.g;

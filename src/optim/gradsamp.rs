@@ -57,9 +57,11 @@ pub struct GradSampState {
     pub nu: f64,
     /// ‖d‖ of the last sampled bundle.
     pub dnorm: f64,
-    /// Points and gradients of the last sampled bundle.
+    /// Points and gradients of the last sampled bundle, and the gradients' units
+    /// ([`Objective::gradient_unit`], for the certificate only).
     xs: Vec<Vec<f64>>,
     gs: Vec<Vec<f64>>,
+    units: Vec<f64>,
 }
 
 solver_state!(GradSampState);
@@ -108,6 +110,7 @@ impl Solver for GradSamp<'_> {
             dnorm,
             xs: vec![x0.to_vec()],
             gs: vec![g],
+            units: vec![ev.gradient_unit(x0)],
         })
     }
 
@@ -116,6 +119,7 @@ impl Solver for GradSamp<'_> {
         let m = self.opts.ngrad_for(n);
         let mut xs = vec![s.x.clone()];
         let mut gs = vec![s.g.clone()];
+        let mut units = vec![ev.gradient_unit(&s.x)];
         let mut gj = vec![0.0; n];
         for _ in 0..m {
             let mut xj = self.sample_ball(&s.x, s.sampling_radius);
@@ -131,6 +135,7 @@ impl Solver for GradSamp<'_> {
                 }
             }
             if ok {
+                units.push(ev.gradient_unit(&xj));
                 xs.push(xj);
                 gs.push(gj.clone());
             }
@@ -140,6 +145,7 @@ impl Solver for GradSamp<'_> {
         s.dnorm = qp.dnorm;
         s.xs = xs;
         s.gs = gs;
+        s.units = units;
         let d = qp.d;
         let dn = qp.dnorm;
         if dn <= self.opts.target_opt && s.sampling_radius <= self.opts.samprad_opt {
@@ -181,7 +187,8 @@ impl Solver for GradSamp<'_> {
     }
 
     fn result(&self, ev: &mut Evaluator<'_>, s: GradSampState, termination: Termination, iters: usize) -> OptimResult {
-        let (dnorm, evaldist) = certificate_at(&s.x, &s.g, &s.xs, &s.gs);
+        let unit = ev.gradient_unit(&s.x);
+        let (dnorm, evaldist) = certificate_at((&s.x, &s.g, unit), &s.xs, &s.gs, &s.units);
         OptimResult {
             x: s.x,
             f: s.f,

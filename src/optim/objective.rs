@@ -19,6 +19,20 @@ pub trait Objective {
         let _ = threshold;
         self.eval(x, g)
     }
+    /// The unit of the gradient that [`Objective::eval`] returned at `x`, a point it has just
+    /// evaluated; used by the optimality certificate only, which takes each gradient of its
+    /// bundle as g / unit (`bundle` module). Default 1: HANSO's certificate.
+    ///
+    /// For an objective that is a max of terms of very different weights, f = max(f₁, ε·f₂),
+    /// return the weight of the term that sets f at `x` (ε where ε·f₂ > f₁). Zero lies in the
+    /// convex hull of some gradients exactly when it lies in the hull of any positive multiples of
+    /// them, so what is stationary does not change; but the smallest vector of the hull of
+    /// {∇f₁, ε∇f₂} is at most ε‖∇f₂‖ — below an absolute tolerance merely because ε is small —
+    /// while that of {∇f₁, ∇f₂} is small only where the two terms' gradients nearly cancel.
+    fn gradient_unit(&self, x: &[f64]) -> f64 {
+        let _ = x;
+        1.0
+    }
 }
 
 /// Adapts a closure `FnMut(x, g) -> f` with a fixed dimension into an [`Objective`].
@@ -80,6 +94,16 @@ impl<'a> Evaluator<'a> {
             Some(Termination::EvalBudget)
         } else {
             None
+        }
+    }
+
+    /// [`Objective::gradient_unit`] at `x`, a positive finite number (1 otherwise).
+    pub(crate) fn gradient_unit(&self, x: &[f64]) -> f64 {
+        let u = self.obj.gradient_unit(x);
+        if u.is_finite() && u > 0.0 {
+            u
+        } else {
+            1.0
         }
     }
 

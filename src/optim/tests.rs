@@ -311,3 +311,55 @@ fn options_are_validated() {
     let s = serde_json::to_string(&Termination::GradSampConverged).unwrap();
     assert_eq!(s, "\"grad_samp_converged\"");
 }
+
+/// w·‖x − c‖₁ with a small weight w; `in_units` says whether it reports w as its gradient unit.
+struct WeightedL1 {
+    c: Vec<f64>,
+    w: f64,
+    in_units: bool,
+}
+
+impl Objective for WeightedL1 {
+    fn nvar(&self) -> usize {
+        self.c.len()
+    }
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        for ((gi, xi), ci) in g.iter_mut().zip(x).zip(&self.c) {
+            *gi = self.w * (xi - ci).signum();
+        }
+        self.w * x.iter().zip(&self.c).map(|(xi, ci)| (xi - ci).abs()).sum::<f64>()
+    }
+    fn gradient_unit(&self, _x: &[f64]) -> f64 {
+        if self.in_units {
+            self.w
+        } else {
+            1.0
+        }
+    }
+}
+
+#[test]
+fn a_small_weight_does_not_certify_a_point_when_gradients_are_taken_in_their_unit() {
+    // ‖∇f‖ = w·√n = 4.5e-4 < normtol everywhere off the kinks: HANSO's absolute certificate
+    // stops at the start; in the term's own unit the gradients have norm √n, and only the kink
+    // at c (where their hull holds 0) certifies.
+    let (n, w) = (5, 2e-4);
+    let c: Vec<f64> = (0..n).map(|i| 0.3 * i as f64 - 0.5).collect();
+    let x0 = vec![1.0; n];
+    let opts = hanso_opts(1e-3, 1e-3, 1000, false);
+    let run = |in_units: bool| {
+        let mut obj = WeightedL1 { c: c.clone(), w, in_units };
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let ctl = RunControl::new(f64::INFINITY);
+        hanso(&mut obj, std::slice::from_ref(&x0), &opts, &mut rng, &ctl, &mut NoObserver).expect("finite start").best
+    };
+    let f0 = WeightedL1 { c: c.clone(), w, in_units: false }.eval(&x0, &mut vec![0.0; n]);
+    let absolute = run(false);
+    show("weighted l1, absolute", &absolute);
+    assert_eq!(absolute.termination, Termination::Certified);
+    assert_eq!(absolute.f, f0, "certified at the start");
+    let in_units = run(true);
+    show("weighted l1, in units", &in_units);
+    assert!(in_units.f <= 1e-3 * f0, "f = {:e} from {f0:e}", in_units.f);
+    assert!(in_units.dnorm <= 1e-3, "the certificate is in the term's unit: dnorm {:e}", in_units.dnorm);
+}
