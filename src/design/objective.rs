@@ -301,7 +301,7 @@ impl<'p> DesignObjective<'p> {
         c.alpha_cl = alpha_cl;
         let k_term = if self.strong && nk > 0 { self.eps * alpha_k } else { f64::NEG_INFINITY };
         // NaN-safe max: a NaN term makes f NaN (treated like +∞ by the line search).
-        let (f, g) = if k_term.is_nan() || k_term > alpha_cl {
+        let (f, g) = if k_term.is_nan() || self.controller_term_sets_f(&c) {
             (k_term, g_k.map(|g| scale(g, self.eps)))
         } else {
             (alpha_cl, g_cl)
@@ -370,7 +370,7 @@ impl<'p> DesignObjective<'p> {
             c.f = f64::INFINITY;
             return (c, None);
         }
-        if k_term.0 > gamma {
+        if self.controller_term_sets_f(&c) {
             c.f = k_term.0;
             (c, k_term.1.map(|g| scale(g, self.eps)))
         } else {
@@ -397,6 +397,17 @@ impl DesignObjective<'_> {
                 }
             }
         }
+    }
+
+    /// Whether the controller's term of the strong objective sets f at a point of components `c`:
+    /// ε‖K‖∞ > ‖Tzw‖∞ in the performance phase, ε·α(Ak) > α(A_cl) when stabilising (false for
+    /// order 0, whose α(Ak) is NaN, and without `strong`).
+    fn controller_term_sets_f(&self, c: &Components) -> bool {
+        self.strong
+            && match self.phase {
+                ObjectivePhase::Performance => self.eps * c.k_hinf > c.gamma,
+                ObjectivePhase::Stabilisation => self.eps * c.alpha_k > c.alpha_cl,
+            }
     }
 
     /// The closed loops' stability measure at `k`: the plant's, or the largest of a problem's.
@@ -507,11 +518,7 @@ impl Objective for DesignObjective<'_> {
             return 1.0;
         }
         let Some(c) = self.cache.borrow().lookup(x) else { return 1.0 };
-        let controller_sets_f = match self.phase {
-            ObjectivePhase::Performance => self.eps * c.k_hinf > c.gamma,
-            ObjectivePhase::Stabilisation => self.eps * c.alpha_k > c.alpha_cl,
-        };
-        if controller_sets_f {
+        if self.controller_term_sets_f(&c) {
             self.eps
         } else {
             1.0
