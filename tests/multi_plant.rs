@@ -128,6 +128,31 @@ fn an_active_bound_is_met() {
     assert!(v[0].value < 0.1297, "plant 1 should gain from the slack: {v:?}");
 }
 
+/// The abscissa objective under strong stabilisation minimises the closed loop's margin: its
+/// values are negative, so the controller's term is ε·α(Ak), not ε‖K‖∞ (which, positive, always
+/// set f_p and made the design minimise ‖K‖∞ on the stability boundary: α(A_cl) = −1.4e-11 on
+/// HE1 n_K = 1). The reported objective is max(α(A_cl), ε·α(Ak)) of the returned controller; a
+/// problem with an H∞ plant keeps ε‖K‖∞.
+#[test]
+fn the_abscissa_objective_with_a_stable_controller_minimises_the_margin() {
+    let problem = Problem { terms: vec![term(op(1), PlantObjective::Abscissa, 1.0, None)] };
+    assert!(problem.controller_term_is_abscissa());
+    let o = design(&problem, &opts(1, 0, 2000), None).unwrap();
+    let alpha_k = o.alpha_k.expect("order 1");
+    assert!(o.alpha_cl < -0.1 && alpha_k < 0.0, "α(A_cl) = {}, α(Ak) = {alpha_k}", o.alpha_cl);
+    assert_eq!(o.gamma, o.alpha_cl);
+    assert_eq!(o.objective, o.alpha_cl.max(1e-3 * alpha_k));
+    assert!(!o.controller_norm_active);
+    let static_gain = design(&problem, &opts(0, 0, 1000), None).unwrap();
+    assert!(static_gain.alpha_cl < -0.1 && static_gain.objective == static_gain.alpha_cl, "{}", static_gain.alpha_cl);
+    for mixed in [
+        vec![term(op(1), PlantObjective::Abscissa, 1.0, None), term(op(3), PlantObjective::Hinf, 1.0, None)],
+        vec![term(op(1), PlantObjective::Abscissa, 1.0, Some(-0.1))],
+    ] {
+        assert!(!Problem { terms: mixed }.controller_term_is_abscissa());
+    }
+}
+
 fn run_bin(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(BIN).args(args).output().unwrap();
     (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())

@@ -334,3 +334,28 @@ fn a_trace_of_thousands_of_restarts_is_drawn_thinned_and_small() {
     assert_eq!((short.len(), short[0], *short.last().unwrap()), (MAX_POINTS_PER_RUN, long[0], long[4999]));
     check_png(&png_bytes(&fig, Path::new("c.png")).unwrap(), "many restarts");
 }
+
+/// A plant whose performance output carries nothing (C1, D11, D12 = 0): ‖T_zw‖∞ = 0 has no place
+/// on the σ-plot's log axis. The figure used to take it as the axis's lower end, and the tick
+/// walk from log10(0) ran over 2³¹ decades (memory until the process died); now the peak is not
+/// marked, the axis spans the controller's curve, and the figure renders.
+#[test]
+fn a_closed_loop_with_zero_norm_draws_its_sigma_plot() {
+    use hinfix::campaign::plot::SigmaFigure;
+    use hinfix::lti::{Controller, Plant};
+    let plant = Plant::from_json_str(
+        r#"{"name":"zeroz","dims":{"n":2,"m1":1,"m2":1,"p1":1,"p2":1},"A":[[0.5,1],[0,-1]],"B1":[[1],[0]],"B2":[[0],[1]],"C1":[[0,0]],"C2":[[1,1]],"D11":[[0]],"D12":[[0]],"D21":[[1]],"D22":[[0]]}"#,
+        "zeroz.json",
+    )
+    .unwrap();
+    let mut k = Controller::zeros(0, 1, 1);
+    k.dk[(0, 0)] = -3.0; // u = -3 y: A + B2·DK·C2 = [[0.5, 1], [-3, -4]], stable
+    let fig = SigmaFigure::new(&plant, &k, "zero".into()).unwrap();
+    assert_eq!(fig.peak.0, 0.0);
+    assert_eq!(fig.peak_point(), None);
+    check_svg(&svg_text(&fig, Path::new("sigma_zero.svg")).unwrap(), "zero-norm σ-plot");
+    check_png(&png_bytes(&fig, Path::new("sigma_zero.png")).unwrap(), "zero-norm σ-plot");
+    for (lo, hi) in [(0.0, 1.0), (-1.0, 1.0), (1.0, f64::INFINITY), (f64::NAN, 1.0), (2.0, 1.0)] {
+        assert!(log_ticks(lo, hi).is_empty(), "log_ticks({lo}, {hi})");
+    }
+}

@@ -496,7 +496,7 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     }
     if o.controller_norm_active {
         s += &format!(
-            "note:     ε‖K‖∞ = {} ≥ ‖Tzw‖∞: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets γ go lower)\n",
+            "note:     ε‖K‖∞ = {} ≥ {gamma_name}: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets {gamma_name} go lower)\n",
             fmt_num(opts.eps * o.k_hinf, 6)
         );
     }

@@ -6,7 +6,10 @@
 //! performance:    f_p = max( max_{j ∈ U} w_j·g_j, ε‖K‖∞ ) + μ Σ_{j ∈ B} max(0, w_j·g_j − b_j)
 //! ```
 //!
-//! (plain mode: without the ε terms; s = α, or ρ − 1 in discrete time). The gradient is that of
+//! (plain mode: without the ε terms; s = α, or ρ − 1 in discrete time). Where every plant of U
+//! has the abscissa objective, f_p's controller term is ε·s(Ak) instead of ε‖K‖∞
+//! ([`Problem::controller_term_is_abscissa`]): the g_j are then negative, and a positive ε‖K‖∞
+//! would always be the max (none for a static gain, whose Ak is empty). The gradient is that of
 //! the active term of each max (ties: the first plant, then the plants before the controller)
 //! plus μ·w_j·∇g_j of every violated bound (at w_j·g_j = b_j exactly: none, an element of the
 //! Clarke subdifferential). f_p = +∞ off the controllers that stabilise every plant (g_j = +∞ for
@@ -143,7 +146,12 @@ pub(crate) fn performance(
             c.f = f64::INFINITY;
             return Ok((c, None));
         }
-        maxed.push((eps * norm.value, Some(scaled(&g, eps))));
+        if !problem.controller_term_is_abscissa() {
+            maxed.push((eps * norm.value, Some(scaled(&g, eps))));
+        } else if k.order() > 0 {
+            let (a, g) = controller_stability_grad(k);
+            maxed.push((eps * a, Some(scaled(&g, eps))));
+        }
     }
     let (top, mut grad) = match arg_max(maxed) {
         (v, _) if v == f64::NEG_INFINITY => (0.0, Some(scaled(k, 0.0))), // every plant bounded, plain: feasibility only

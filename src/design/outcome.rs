@@ -253,13 +253,15 @@ pub struct DesignOutcome {
     /// Spectral abscissa of Ak (None for order 0).
     #[serde(default, with = "serde_opt_f64_or_string")]
     pub alpha_k: Option<f64>,
-    /// Final objective: max(γ, ε‖K‖∞) (strong) or γ (plain).
+    /// Final objective: max(γ, ε‖K‖∞) (strong) or γ (plain); a problem's f_p
+    /// (docs/ALGORITHMS.md §14.1: ε·s(Ak) in place of ε‖K‖∞ where every minimised plant has the
+    /// abscissa objective).
     #[serde(with = "serde_f64_or_string")]
     pub objective: f64,
     /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞) (at least
     /// ‖Tzw‖∞ within [`crate::lti::NORM_TIE_RTOL`], 0.1 %): the controller-norm penalty, not
     /// the closed loop, sets the objective (strong stabilisation only; a smaller ε would let γ go
-    /// lower).
+    /// lower). Never where the controller's term is ε·s(Ak) (an abscissa problem).
     #[serde(default)]
     pub controller_norm_active: bool,
     /// Optimality certificate of the final point, if the optimisation phase ran.

@@ -275,6 +275,17 @@ impl Problem {
         &self.terms[0].plant
     }
 
+    /// Whether the strong objective's controller term is ε·s(Ak) rather than ε‖K‖∞: when every
+    /// minimised plant's objective is the stability measure (`abscissa`), whose values are
+    /// negative where the performance phase lives. ε‖K‖∞ > 0 would then always set f_p, and the
+    /// design would minimise ‖K‖∞ on the stability boundary instead of the closed loop's margin
+    /// (docs/ALGORITHMS.md §14.1). False where every plant has a bound (f_p is then ε‖K‖∞ plus
+    /// the penalties: the smallest controller that meets the bounds).
+    pub fn controller_term_is_abscissa(&self) -> bool {
+        let mut minimised = self.terms.iter().filter(|t| t.bound.is_none()).peekable();
+        minimised.peek().is_some() && minimised.all(|t| t.objective == PlantObjective::Abscissa)
+    }
+
     /// Whether this is the single-plant H∞ problem: one plant, H∞, weight 1, no bound.
     pub fn is_single_hinf(&self) -> bool {
         matches!(self.terms.as_slice(), [t] if t.objective == PlantObjective::Hinf && t.weight == 1.0 && t.bound.is_none())

@@ -285,7 +285,7 @@ fn outcome_figures(
         None => Vec::new(),
         Some(p) => {
             let values = plant_values(p, k, opts.hinf_tol);
-            problem_figures(&mut fig, &values, opts);
+            problem_figures(&mut fig, p, &values, opts);
             values
         }
     };
@@ -316,7 +316,8 @@ fn outcome(
         alpha_cl: fig.alpha_cl,
         alpha_k: fig.alpha_k,
         objective: fig.objective,
-        controller_norm_active: controller_norm_active(opts, fig.gamma, fig.k_hinf),
+        controller_norm_active: !problem.controller_term_is_abscissa()
+            && controller_norm_active(opts, fig.gamma, fig.k_hinf),
         certificate,
         iterations: phases.iter().map(|p| p.iters).sum(),
         evaluations: phases.iter().map(|p| p.evals).sum(),
@@ -418,12 +419,16 @@ fn verified_status(
 
 /// A problem's figures in place of the first plant's ([`design`]): γ the largest weighted value
 /// of the unbounded plants (of all if each has a bound), α(A_cl) the largest, the objective
-/// max(γ, ε‖K‖∞) plus the penalty of violated bounds.
-fn problem_figures(fig: &mut Figures, values: &[PlantValue], opts: &DesignOptions) {
+/// max(γ, ε‖K‖∞) (ε·s(Ak) in place of ε‖K‖∞ where [`Problem::controller_term_is_abscissa`]) plus
+/// the penalty of violated bounds.
+fn problem_figures(fig: &mut Figures, problem: &Problem, values: &[PlantValue], opts: &DesignOptions) {
     let (free_max, violation) = plant_part(values);
     fig.gamma = problem_gamma(values);
     fig.alpha_cl = values.iter().map(|v| v.alpha_cl).fold(f64::NEG_INFINITY, nan_max);
     let k_term = match opts.objective {
+        ObjectiveKind::Strong if problem.controller_term_is_abscissa() => {
+            fig.alpha_k.map_or(f64::NEG_INFINITY, |a| opts.eps * a)
+        }
         ObjectiveKind::Strong => opts.eps * fig.k_hinf,
         ObjectiveKind::Plain => f64::NEG_INFINITY,
     };

@@ -141,7 +141,12 @@ pub fn spans_decades(lo: f64, hi: f64) -> bool {
 /// Tick positions for a log axis over `[lo, hi]` (0 < lo < hi) that label the whole range, not
 /// only its powers of ten: 1, 2, 5 × 10ᵏ, or every integer multiple 1…9 × 10ᵏ when that gives fewer
 /// than four ticks (γ from 2.5 to 40 got one label, 10, from plotters' own choice); at most ~12.
+/// No ticks for a range that is not such an interval (a zero, negative, reversed or non-finite
+/// end has no decades to walk: `log10(0)` would make the walk run over 2³¹ of them).
 pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
+        return Vec::new();
+    }
     let within = |mults: &[f64]| -> Vec<f64> {
         let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
         (k0..=k1)

@@ -53,11 +53,12 @@ impl SigmaFigure {
     }
 
     /// Where the peak is drawn: its frequency, moved to the grid's nearer end when it is 0 or
-    /// +∞; `None` when there is nothing to mark (no finite peak, no grid, or a grid whose ends
-    /// are not an interval of positive frequencies).
+    /// +∞; `None` when there is nothing to mark (no finite positive peak — a zero ‖T_zw‖∞ has no
+    /// place on the log axis —, no grid, or a grid whose ends are not an interval of positive
+    /// frequencies).
     pub fn peak_point(&self) -> Option<(f64, f64)> {
         let (g, w) = self.peak;
-        if !g.is_finite() || w.is_nan() {
+        if !(g > 0.0 && g.is_finite()) || w.is_nan() {
             return None;
         }
         let (w0, w1) = (self.closed_loop.first()?.0, self.closed_loop.last()?.0);
