@@ -205,6 +205,10 @@ fn a_two_plant_run_journals_each_plants_value() {
         tex.contains("one controller for several plants") && tex.contains("1 & strong & HE1\\_op3 & hinf & 2.000 &"),
         "{tex}"
     );
+    // γ is the problem's largest weighted value, not an H∞ norm: the caption says so, and
+    // points to the plants' table
+    assert!(tex.contains("value $\\gamma$ of the problem") && tex.contains("\\ref{tab:hinfix-HE1-HE1-op3-"), "{tex}");
+    assert!(!tex.contains("closed-loop $H_\\infty$ norm $\\gamma$"), "{tex}");
     common::latex_structure(&tex).unwrap();
     let best = std::fs::read_to_string(dir.join("two/best.csv")).unwrap();
     assert!(best.lines().nth(1).is_some_and(|l| l.starts_with("HE1+HE1_op3,")), "{best}");

@@ -241,6 +241,7 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
         plain: vec![],
         paper: vec![(1, 0.00035), (2, 0.00035)],
         full_order: Some((1e-6, FullOrderSource::Computed)),
+        problem: false,
     };
     assert!(pa.log_axis());
     let he1 = GammaOrderFigure {
@@ -249,6 +250,7 @@ fn gamma_vs_order_uses_a_log_axis_only_when_values_span_decades() {
         plain: vec![],
         paper: vec![(1, 0.1235)],
         full_order: Some((0.0737, FullOrderSource::Paper)),
+        problem: false,
     };
     assert!(!he1.log_axis());
     let p = Path::new("g.png");
@@ -272,6 +274,7 @@ fn gamma_vs_order_labels_its_whole_range_and_the_bound() {
         plain: vec![(1, 3.0), (2, 2.55)],
         paper: vec![],
         full_order: Some((2.5, FullOrderSource::Computed)),
+        problem: false,
     };
     assert!(fig.log_axis());
     let svg = svg_text(&fig, Path::new("g.svg")).unwrap();

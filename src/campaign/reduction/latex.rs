@@ -303,8 +303,18 @@ pub fn campaign_table(p: &str, fp: &str, rows: &[&BestRow], f: Option<&FullOrder
             ("spectral radius $\\rho(A_K)$", format!(" (discrete time, $T_s = {}$~s)", crate::numeric::readable(ts)))
         }
     };
+    // A problem's γ (several plants, or another objective, weight or bound) is not one plant's
+    // ‖Tzw‖∞: its plants' table follows this one.
+    let measure = if rows.iter().any(|r| !r.plants.is_empty()) {
+        format!(
+            "value $\\gamma$ of the problem (the largest $w_j g_j$ of its plants without a bound: Table~\\ref{{tab:hinfix-{}-plants}})",
+            label_key(p)
+        )
+    } else {
+        "closed-loop $H_\\infty$ norm $\\gamma$".to_string()
+    };
     let caption = format!(
-        "{}{domain}: closed-loop $H_\\infty$ norm $\\gamma$ of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and {radius}, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.",
+        "{}{domain}: {measure} of the best re-verified controller of each order $n_K$ found by {}; $\\varepsilon$ and seed of the job that found it, its $\\|K\\|_\\infty$ and {radius}, and the CPU seconds that job took to reach it. Objective strong: $K$ stable; plain: $K$ may be unstable.",
         escape(p),
         about_text(about)
     );

@@ -27,6 +27,10 @@ pub struct GammaOrderFigure {
     pub paper: Vec<(usize, f64)>,
     /// The full-order bound γ_opt (None if unknown), and where it comes from.
     pub full_order: Option<(f64, FullOrderSource)>,
+    /// Whether γ is a problem's value — the largest w_j·g_j of its plants without a bound
+    /// (several plants, or another objective, weight or bound: plants.csv) — rather than one
+    /// plant's ‖T_zw‖∞: the y axis says so.
+    pub problem: bool,
 }
 
 impl GammaOrderFigure {
@@ -58,17 +62,24 @@ impl GammaOrderFigure {
             .build_cartesian_2d(x, y)
             .map_err(msg)?;
         let mut mesh = chart.configure_mesh();
-        styled_mesh(mesh.x_desc("controller order n_K").y_desc("γ = ‖T_zw‖∞"), 16)
-            .x_labels(kmax - kmin + 3)
-            .x_label_formatter(&|v| {
-                if (v - v.round()).abs() < 1e-9 && *v >= 0.0 {
-                    format!("{}", v.round())
-                } else {
-                    String::new()
-                }
-            })
-            .draw()
-            .map_err(msg)?;
+        styled_mesh(
+            mesh.x_desc("controller order n_K").y_desc(if self.problem {
+                "γ = max w_j·g_j over the plants without a bound"
+            } else {
+                "γ = ‖T_zw‖∞"
+            }),
+            16,
+        )
+        .x_labels(kmax - kmin + 3)
+        .x_label_formatter(&|v| {
+            if (v - v.round()).abs() < 1e-9 && *v >= 0.0 {
+                format!("{}", v.round())
+            } else {
+                String::new()
+            }
+        })
+        .draw()
+        .map_err(msg)?;
         if let Some((g, source)) = self.full_order {
             let label = match source {
                 FullOrderSource::Paper => format!("full-order bound {} (paper's value)", tick(g)),

@@ -141,8 +141,11 @@ pub fn gamma_order_figures(
                 .map(|r| (r.order, r.gamma))
                 .collect();
             paper.sort_by_key(|x| x.0);
-            let full_order = full.iter().find(|f| f.plant == p && f.gamma.is_finite()).map(|f| (f.gamma, f.source));
-            GammaOrderFigure { plant: p.to_string(), ours, plain, paper, full_order }
+            // A problem's γ is not one plant's ‖Tzw‖∞: no full-order H∞ bound beside it.
+            let problem = best.iter().any(|r| r.plant == p && !r.plants.is_empty());
+            let full_order =
+                full.iter().find(|f| f.plant == p && f.gamma.is_finite() && !problem).map(|f| (f.gamma, f.source));
+            GammaOrderFigure { plant: p.to_string(), ours, plain, paper, full_order, problem }
         })
         .collect()
 }
