@@ -96,6 +96,12 @@ fn bad_values_are_errors_at_their_key() {
         (&format!("{THREE}structure = \"nope.json\"\norders = [1]\n"), 6, "structure file"),
         (&format!("{THREE}orders = [9]\n"), 6, "order"),
         ("plants = [\"HE1_op1.json\", \"../../plants/REA2.json\"]\norders = [1]\n", 5, "plants: plant 2 (REA2)"),
+        // one problem under two names (strong and plain): the report's rows could keep one
+        (
+            &format!("{THREE}name = \"s\"\norders = [1]\n[[problem]]\n{THREE}name = \"p\"\nobjective = \"plain\"\norders = [1]\n"),
+            9,
+            "is the problem at line 5 under another name (\"p\", there \"s\")",
+        ),
     ];
     for (body, line, word) in cases {
         let e = err(body);

@@ -176,6 +176,20 @@ pub enum SpecProblem {
     /// More than [`MAX_JOBS`] jobs.
     #[error("the campaign expands to more than {MAX_JOBS} jobs (orders × eps × seeds, summed over problems)")]
     TooManyJobs,
+    /// A problem is an earlier problem (same plants, objectives, weights, bounds and structure:
+    /// one fingerprint, one row per order and objective in the report) under another name.
+    #[error(
+        "this problem is the problem at line {first_line} under another name ({name:?}, there {first_name:?}): their \
+         jobs share the report's rows, which carry one name; give both the same name"
+    )]
+    RenamedProblem {
+        /// The line of the earlier problem.
+        first_line: usize,
+        /// Its name.
+        first_name: String,
+        /// This problem's name.
+        name: String,
+    },
     /// A problem makes a job an earlier problem makes.
     #[error("this problem repeats a job of the problem at line {first_line} (plant {plant}, order {order}, ε {eps}, seed {seed})")]
     RepeatedJob {
@@ -885,9 +899,24 @@ fn check_job_count(problems: &[Problem], raw: &[RawProblem], src: &Source) -> Re
     Ok(())
 }
 
-/// Step 5: expand the jobs; two problems that produce the same job would run it twice under one
-/// id.
+/// Step 5: one problem under two names is refused (the report's rows are per problem, with one
+/// name); then expand the jobs: two problems that produce the same job would run it twice under
+/// one id.
 fn check_unique_jobs(campaign: &Campaign) -> Result<(), SpecError> {
+    for (i, p) in campaign.problems.iter().enumerate() {
+        if let Some(first) = campaign.problems[..i].iter().find(|q| q.fingerprint == p.fingerprint && q.name != p.name)
+        {
+            return Err(SpecError {
+                file: campaign.file.clone(),
+                location: p.location,
+                message: SpecProblem::RenamedProblem {
+                    first_line: first.location.line,
+                    first_name: first.name.clone(),
+                    name: p.name.clone(),
+                },
+            });
+        }
+    }
     let jobs = super::jobs::expand(campaign, super::jobs::RunnerTag::Design);
     let mut seen = std::collections::HashMap::new();
     for j in &jobs {

@@ -114,6 +114,18 @@ pub fn file_part_among(name: &str, all: &[&str]) -> String {
     format!("{}-{hash}", &part[..part.len().min(MAX_FILE_PART - 9)])
 }
 
+/// The file part of a problem's plant `j` among its plant names `all`: [`file_part_among`], with
+/// the plant's 1-based position appended when another plant of the problem has the same name
+/// (two plant files may carry one `name`; each plant's σ-plot keeps its own file).
+fn problem_plant_part(j: usize, all: &[&str]) -> String {
+    let part = file_part_among(all[j], all);
+    if all.iter().filter(|n| **n == all[j]).count() > 1 {
+        format!("{part}-{}", j + 1)
+    } else {
+        part
+    }
+}
+
 /// The γ-vs-order figure of each plant in `best` (the full-order bound as the report has it:
 /// computed, else `reference`'s, else `library`'s).
 pub fn gamma_order_figures(
@@ -243,7 +255,7 @@ pub fn write_plots(
                         t.plant.name,
                         t.objective.name()
                     );
-                    let file = format!("sigma_{tag}_{}", file_part_among(&t.plant.name, &names));
+                    let file = format!("sigma_{tag}_{}", problem_plant_part(j, &names));
                     let made = sigma_figure(&t.plant, k, what).and_then(|fig| write_png_and_svg(&fig, &dir.join(file)));
                     keep(made, &mut out);
                 }
@@ -279,5 +291,9 @@ mod tests {
         assert!(!a.eq_ignore_ascii_case(&b), "{a} {b}");
         assert_eq!(file_part_among("HE1", &all), "HE1");
         assert_eq!(file_part_among("Case", &["Case", "HE1"]), "Case");
+        // a problem's plants of one name are told apart by their positions
+        let same = ["HEX", "HE1", "HEX"];
+        let parts: Vec<String> = (0..3).map(|j| problem_plant_part(j, &same)).collect();
+        assert_eq!(parts, ["HEX-1", "HE1", "HEX-3"]);
     }
 }
