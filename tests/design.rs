@@ -629,3 +629,16 @@ fn ac10_central_start_in_scaled_variables_is_the_best_start() {
     assert_eq!((s.best_start, s.best_start_kind, s.best_start_scaled), (2, Some(StartKind::Central), true), "{s:?}");
     assert!(o.gamma < 11.5904, "γ = {}", o.gamma);
 }
+
+/// A design whose BFGS matrix would not fit in memory is refused before anything is allocated:
+/// CM4 (240 states) at order 142 has 142² + 142·(m + p) + m·p > `MAX_VARIABLES` free variables
+/// (an order-400 design of a 400-state plant asked for 207 GB and aborted the process); the
+/// error names the option and the count.
+#[test]
+fn a_design_too_large_for_bfgs_is_refused_at_once() {
+    let p = plant("CM4");
+    let o = DesignOptions { order: 142, maxevals: Some(10), ..Default::default() };
+    let e = Design::for_plant(&p, &o).run().expect_err("too many variables");
+    let text = e.to_string();
+    assert!(text.starts_with("invalid design option `order`: 142 gives") && text.contains("more than 20000"), "{text}");
+}

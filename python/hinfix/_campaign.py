@@ -22,6 +22,8 @@ def run_campaign(path: str | os.PathLike, results: str | os.PathLike | None = No
     and order). Ctrl-C stops the run cleanly (finished jobs stay journaled; the same call
     resumes) and raises KeyboardInterrupt."""
     results = "results" if results is None else results
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1 or threads > 256):
+        raise ValueError(f"run_campaign: threads must be a whole number in 1..=256, found {threads!r}")
     text = _hinfix.run_campaign(os.fspath(path), os.fspath(results), threads, bool(progress))
     return loads(text)
 

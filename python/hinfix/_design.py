@@ -161,7 +161,11 @@ def options_json(order, strong, given):
     return json.dumps({k: _json_value(v) for k, v in opts.items()})
 
 
-def _init_matrices(init):
+def _init_matrices(init, dt):
+    """The four matrices of ``init``; a ``StateSpace`` with states must be in the plant's time
+    domain (sampling time ``dt``, 0: continuous): its matrices mean another controller in the
+    other one (a discrete pole 0.5 read as continuous is unstable). python-control's ``dt=None``
+    (no time base) and a static gain fit either."""
     if init is None:
         return None
     if isinstance(init, (tuple, list)):
@@ -169,6 +173,11 @@ def _init_matrices(init):
             raise ValueError(f"init as matrices needs (Ak, Bk, Ck, Dk), got {len(init)}")
         return [as_matrix(m, n) for m, n in zip(init, ("Ak", "Bk", "Ck", "Dk"))]
     K = system(init, "init")
+    if K.nstates > 0 and K.dt is not None and sampling_time(K, "init") != dt:
+        def domain(ts):
+            return "continuous time" if ts == 0 else f"discrete time (dt = {ts:g} s)"
+        raise ValueError(f"init is in {domain(sampling_time(K, 'init'))} but the plant is in {domain(dt)}: "
+                         "give the controller in the plant's time domain")
     return [as_matrix(m, n) for m, n in zip((K.A, K.B, K.C, K.D), ("Ak", "Bk", "Ck", "Dk"))]
 
 
@@ -331,7 +340,7 @@ def design(P: PlantLike, nmeas: int | Sequence[int] | None, ncon: int | Sequence
         progress = None
     elif not callable(progress):
         raise TypeError(f"progress must be True, False or a callable, got {progress!r}")
-    (ak, bk, ck, dk), text, used = _hinfix.design(terms, opts, _init_matrices(init), s_json, s_path, progress)
+    (ak, bk, ck, dk), text, used = _hinfix.design(terms, opts, _init_matrices(init, plants[0][2]), s_json, s_path, progress)
     out = loads(text)
     status = out["status"]["kind"]
     gamma, k_hinf = _float(out["gamma"]), _float(out["k_hinf"])
@@ -339,7 +348,7 @@ def design(P: PlantLike, nmeas: int | Sequence[int] | None, ncon: int | Sequence
     stabilised = status not in ("not_stabilised", "interrupted") and math.isfinite(gamma)
     sys0, _, dt, nm0, nc0 = plants[0]
     K = controller(ak, bk, ck, dk, sys0, nm0, nc0, dt)
-    loops = [(p.lft(K) if p is not None else _statespace_lft(mats, K, dt)) for p, mats, dt, _, _ in plants]
+    loops = [_closed_loop(p, mats, dt, K, (ak, bk, ck, dk)) for p, mats, dt, _, _ in plants]
     info = DesignResult(
         gamma=gamma,
         k_hinf=k_hinf,
@@ -365,8 +374,20 @@ def design(P: PlantLike, nmeas: int | Sequence[int] | None, ncon: int | Sequence
     return K, info
 
 
-def _statespace_lft(mats, K, dt):
-    """P.lft(K) of a plant given as its nine matrices."""
-    from ._plant import statespace
-    P, _, _ = statespace(mats, dt=dt)
-    return P.lft(K)
+def _closed_loop(P, mats, dt, K, k_matrices):
+    """``P.lft(K)`` (of the plant's nine matrices when it came as matrices); where python-control
+    refuses it — its well-posedness test depends on the scale of Dk, and a plant without w or z
+    channels is no python-control system — the crate's closed loop, the one the design measured
+    (``_hinfix.closed_loop``), with P's w inputs and z outputs as its names when P has them."""
+    try:
+        if P is None:
+            from ._plant import statespace
+            P, _, _ = statespace(mats, dt=dt)
+        return P.lft(K)
+    except ValueError:  # control.ControlDimension is a ValueError too
+        pass
+    a, b, c, d = _hinfix.closed_loop(list(mats), list(k_matrices), dt)
+    names = {}
+    if P is not None and hasattr(P, "input_labels"):
+        names = {"inputs": list(P.input_labels[:b.shape[1]]), "outputs": list(P.output_labels[:c.shape[0]])}
+    return control.ss(a, b, c, d, dt, **names)

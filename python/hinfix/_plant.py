@@ -76,6 +76,12 @@ def blocks(P, nmeas=None, ncon=None):
         for given, actual, name in ((nmeas, mats[4].shape[0], "nmeas"), (ncon, mats[2].shape[1], "ncon")):
             if given is not None and given != actual:
                 raise ValueError(f"{name} = {given} does not match the matrices ({actual})")
+        # as for a StateSpace plant: T_zw needs a disturbance w and a performance output z (the
+        # closed loop would be no python-control system)
+        for count, what in ((mats[1].shape[1], "B1 has no column: no disturbance input w"),
+                            (mats[3].shape[0], "C1 has no row: no performance output z")):
+            if count == 0:
+                raise ValueError(f"a plant given as matrices: {what} (a plant needs at least one)")
         return mats, 0.0
     P = system(P, "P")
     if nmeas is None or ncon is None:

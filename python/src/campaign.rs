@@ -9,7 +9,7 @@ use serde_json::{json, Value};
 
 use hinfix::campaign::{
     campaign_dir, design_job, expand, journals_in, read_journal, records_for, report, run_jobs, trace_observers,
-    Campaign, ExecuteOptions, ProgressDisplay, Reporter, RunnerTag,
+    Campaign, ExecuteOptions, ProgressDisplay, Reporter, RunnerTag, MAX_THREADS,
 };
 
 use crate::errors::{bad_input, failure};
@@ -31,8 +31,10 @@ pub fn run_campaign(
     progress: bool,
 ) -> PyResult<String> {
     let campaign = Campaign::load(&path).map_err(|e| bad_input("run_campaign", e))?;
-    if threads == Some(0) {
-        return Err(bad_input("run_campaign", "threads must be at least 1"));
+    if let Some(t) = threads.filter(|t| !(1..=MAX_THREADS).contains(t)) {
+        // as the campaign file's `threads` and `campaign run --threads`: a pool of 10⁶ OS threads
+        // took longer to build than any run
+        return Err(bad_input("run_campaign", format!("threads must be in 1..={MAX_THREADS}, found {t}")));
     }
     let jobs = expand(&campaign, RunnerTag::Design);
     let dir = campaign_dir(&results, &campaign.name);

@@ -259,3 +259,19 @@ pub fn default_options() -> PyResult<String> {
     }
     serde_json::to_string(&all).map_err(|e| failure("default_options", e))
 }
+
+/// `closed_loop(plant, k, dt)` → (A, B, C, D) of the loop of the nine plant matrices and the
+/// controller's four (Ak, Bk, Ck, Dk): the crate's `lti::closed_loop`, the loop every design
+/// measures. `design` uses it where python-control's `P.lft(K)` refuses a loop the crate forms:
+/// its well-posedness test of [[I, −D22], [−Dk, I]] depends on the scale of Dk (it failed for
+/// |Dk| ≈ 1e8 with D22 = 0), and a plant without w or z channels is not a python-control system.
+#[pyfunction]
+#[pyo3(signature = (plant, k, dt = 0.0))]
+#[allow(clippy::type_complexity)]
+pub fn closed_loop<'py>(py: Python<'py>, plant: Vec<In<'_>>, k: Vec<In<'_>>, dt: f64) -> PyResult<Matrices<'py>> {
+    let plant = plant_from("plant", plant, dt)?;
+    let k = controller_from(&k, plant.domain)?;
+    k.check_fits(&plant).map_err(|e| bad_input("closed_loop", e))?;
+    let cl = hinfix::lti::closed_loop(&plant, &k).map_err(|e| bad_input("closed_loop", e))?;
+    Ok([&cl.a, &cl.b, &cl.c, &cl.d].into_iter().map(|m| to_numpy(py, m.as_ref())).collect())
+}

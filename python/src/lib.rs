@@ -27,6 +27,7 @@ fn _hinfix(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design::design, m)?)?;
     m.add_function(wrap_pyfunction!(design::option_names, m)?)?;
     m.add_function(wrap_pyfunction!(design::default_options, m)?)?;
+    m.add_function(wrap_pyfunction!(design::closed_loop, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(norms::hinfnorm, m)?)?;
     m.add_function(wrap_pyfunction!(norms::full_order_gamma, m)?)?;

@@ -74,3 +74,32 @@ def test_full_order_gamma_bounds_every_design():
     g = hinfix.full_order_gamma(P, nmeas, ncon)
     _, info = hinfix.design(P, nmeas, ncon, 2, **BUDGET)
     assert 0 < g["gamma_lower"] <= g["gamma"] <= info.gamma
+
+
+def test_a_loop_python_control_calls_ill_posed_is_still_returned():
+    """python-control's ``P.lft(K)`` tests well-posedness with a rank test that depends on the
+    scale of Dk: on this plant (entries ~1e3, D22 = 0, so every loop is well posed) it raised
+    "LFT not well-posed" for 18 of 20 seeds and the finished design was lost. The result now
+    carries the crate's closed loop there; it is checked against the loop formed by hand, and
+    ``gamma`` is its norm."""
+    A = np.array([[80.20817989616481, 1244.083075225369, 891.8531344299718],
+                  [1034.1750098082157, 432.85164586420393, 1030.5871063739778],
+                  [1668.7016889260426, 295.6408939017518, 562.2171781542359]])
+    B = np.array([[0.710076038816121, -1.8760239629142539, 0.02516714505144321],
+                  [0.5416650371418806, 0.8767859300100186, -0.1990332029363526],
+                  [1.0962602292585673, -0.519899111456324, -0.05724492253130305]])
+    C = np.array([[1.8007004087531693, -1.233798418982251, 0.03555955675896325],
+                  [-0.03532268714920173, 0.01981001654947119, -0.42536269935863463]])
+    G = control.ss(A, B, C, np.zeros((2, 3)))
+    for seed in range(4):
+        K, info = hinfix.design(G, 1, 2, 2, strong=False, maxevals=150, seed=seed)
+        # by hand (D22 = 0): x' = A x + B1 w + B2 u, z = C1 x, y = C2 x, u = Ck xk + Dk y
+        B1, B2, C1, C2 = B[:, :1], B[:, 1:], C[:1, :], C[1:, :]
+        Acl = np.block([[A + B2 @ K.D @ C2, B2 @ K.C], [K.B @ C2, K.A]])
+        Bcl = np.vstack([B1, np.zeros((2, 1))])
+        Ccl = np.hstack([C1, np.zeros((1, 2))])
+        CL = info.closed_loop
+        assert np.allclose(CL.A, Acl, rtol=1e-12, atol=1e-9 * np.abs(Acl).max())
+        assert np.allclose(CL.B, Bcl) and np.allclose(CL.C, Ccl) and np.allclose(CL.D, 0)
+        if info.stabilised:
+            assert relerr(info.gamma, linfnorm(control.ss(Acl, Bcl, Ccl, np.zeros((1, 1))))) <= 1e-8, seed

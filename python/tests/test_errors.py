@@ -28,6 +28,34 @@ def test_partition_errors(he1):
         hinfix.design(control.tf([1], [1, 1]), 1, 1, 0)
     with pytest.raises(ValueError, match=r"P has 1 input: a plant needs at least two, a control u"):
         hinfix.design(control.ss(np.zeros((1, 1)), np.ones((1, 1)), np.ones((2, 1)), np.zeros((2, 1))), 1, 1, 0)
+    # the same rule for a plant given as its nine matrices (the design ran, then the result was
+    # lost to python-control's dimension error)
+    mats = [-np.eye(2), np.zeros((2, 0)), np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 2)),
+            np.zeros((1, 0)), np.ones((1, 1)), np.zeros((1, 0)), np.zeros((1, 1))]
+    with pytest.raises(ValueError, match="B1 has no column: no disturbance input w"):
+        hinfix.design(mats, None, None, 1, maxevals=100)
+
+
+def test_an_init_in_the_other_time_domain_is_refused(he1):
+    P, nmeas, ncon = he1
+    k = control.ss([[0.5]], np.ones((1, nmeas)), np.ones((ncon, 1)), np.zeros((ncon, nmeas)), dt=0.1)
+    with pytest.raises(ValueError, match=r"init is in discrete time \(dt = 0.1 s\) but the plant is in continuous time"):
+        hinfix.design(P, nmeas, ncon, 1, init=k, maxevals=100)
+    Pd = control.c2d(P, 0.2)
+    with pytest.raises(ValueError, match=r"init is in discrete time \(dt = 0.1 s\) but the plant is in discrete time \(dt = 0.2 s\)"):
+        hinfix.design(Pd, nmeas, ncon, 1, init=k, maxevals=100)
+    kc = control.ss([[-0.5]], np.ones((1, nmeas)), np.ones((ncon, 1)), np.zeros((ncon, nmeas)))
+    with pytest.raises(ValueError, match="init is in continuous time but the plant is in discrete time"):
+        hinfix.design(Pd, nmeas, ncon, 1, init=kc, maxevals=100)
+    # a static gain, and a controller in the plant's own domain, are taken
+    hinfix.design(P, nmeas, ncon, 1, init=kc, maxevals=100)
+    hinfix.design(Pd, nmeas, ncon, 0, init=control.ss([], [], [], np.zeros((ncon, nmeas))), maxevals=100)
+
+
+def test_threads_of_run_campaign_are_in_range(tmp_path):
+    for bad in (0, -1, 257, 10**6, 2.0, True):
+        with pytest.raises(ValueError, match=r"run_campaign: threads must be a whole number in 1..=256"):
+            hinfix.run_campaign(tmp_path / "none.toml", tmp_path, threads=bad)
 
 
 def test_option_errors_carry_the_crates_message(he1):

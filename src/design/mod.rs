@@ -70,7 +70,7 @@ pub use problem::{
     plant_part, plant_value, plant_values, problem_gamma, H2Feedthrough, PlantObjective, PlantTerm, PlantValue,
     Problem, ProblemError, UnknownObjective, BOUND_RTOL, MAX_BOUND, MAX_WEIGHT, MIN_WEIGHT, PENALTY_WEIGHT,
 };
-pub use run::{strongly_stabilisable, validate};
+pub use run::{strongly_stabilisable, validate, MAX_VARIABLES};
 pub use scaling::{channel_scales, variable_scaling, MAX_UNSCALED_SPREAD};
 pub use search::{ALTERNATE_PERIOD, GS_RESERVE, GS_RESERVE_FACTOR, TIME_TO_BEST_RTOL};
 pub use structure::{Structure, StructureError};

@@ -69,8 +69,21 @@ pub(super) fn design(
     let h2 = check(problem, opts, starts, structure)?;
     let plant = problem.first();
     let shape = ControllerShape::for_plant(plant, opts.order);
-    if free_variables(shape, structure, h2.as_ref()) == 0 {
-        return Ok(fixed_design(problem, opts, shape, structure, h2.as_ref()));
+    match free_variables(shape, structure, h2.as_ref()) {
+        0 => return Ok(fixed_design(problem, opts, shape, structure, h2.as_ref())),
+        n if n > MAX_VARIABLES => {
+            return Err(opt_err(
+                "order",
+                format!(
+                    "{} gives {n} free controller variables on {}, more than {MAX_VARIABLES}: BFGS keeps a dense \
+                     {n} × {n} inverse-Hessian approximation ({:.0} GB); lower the order, or fix entries with a structure",
+                    opts.order,
+                    plant.name,
+                    (n as f64).powi(2) * 8e-9
+                ),
+            ))
+        }
+        _ => {}
     }
     let h2 = h2.map(Rc::new);
     let structure: Option<Rc<Structure>> = structure.map(|s| Rc::new(s.clone()));
@@ -327,6 +340,13 @@ fn outcome(
         plants,
     }
 }
+
+/// The most free controller variables a design takes: BFGS (`optim::bfgs`) keeps a dense
+/// inverse-Hessian approximation of nvar² numbers, 3.2 GB at this size, allocated before any
+/// budget is looked at (an order-400 controller of a 400-state plant asked for 207 GB and the
+/// process was aborted). The method is for low orders: the largest design of the shipped
+/// campaigns has a few hundred variables.
+pub const MAX_VARIABLES: usize = 20_000;
 
 /// The design's free variables: the structure's free entries (every entry without one), Dk's
 /// counted as the dimension of the H2 feedthrough set when the h2 objective constrains Dk (a
