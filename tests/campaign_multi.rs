@@ -206,6 +206,8 @@ fn a_two_plant_run_journals_each_plants_value() {
         "{plants_csv}"
     );
     assert!(lines[1].starts_with("HE1+HE1_op3,1,strong,") && lines[1].contains(",HE1,hinf,1,none,"), "{plants_csv}");
+    // no bound: `bound_met` is none (the journal's null), not true
+    assert_eq!(lines[1].split(',').nth(10), Some("none"), "{plants_csv}");
     let tex = std::fs::read_to_string(dir.join("two/tables.tex")).unwrap();
     assert!(
         tex.contains("one controller for several plants") && tex.contains("1 & strong & HE1\\_op3 & hinf & 2.000 &"),

@@ -387,9 +387,13 @@ impl PlantValue {
         self.weight * self.value
     }
 
-    /// Whether its bound holds to [`BOUND_RTOL`] (true without a bound; false when w·g is NaN).
+    /// Whether its bound holds to [`BOUND_RTOL`] (true without a bound; false when w·g is NaN,
+    /// and for the abscissa objective on an unstable loop, g ≥ 0, which the objective counts as
+    /// +∞ — docs/ALGORITHMS.md §14.1 — whatever the bound: α = 0.21 under a bound 1 is no loop
+    /// the bound admits).
     pub fn bound_met(&self) -> bool {
-        self.bound.is_none_or(|b| self.weighted() <= b + BOUND_RTOL * b.abs())
+        let unstable = self.objective == PlantObjective::Abscissa && !(self.value < 0.0);
+        self.bound.is_none_or(|b| !unstable && self.weighted() <= b + BOUND_RTOL * b.abs())
     }
 
     /// With the field [`PlantValue::bound_met`] set from the values.
@@ -485,5 +489,23 @@ mod tests {
         assert_eq!(met, [None, None, Some(false), Some(true)]);
         assert_eq!(serde_json::to_value(&values[2]).unwrap()["bound_met"], serde_json::json!(false));
         assert_eq!(plant_part(&values[2..]).0, f64::NEG_INFINITY);
+    }
+
+    /// The abscissa objective's bound is never met by an unstable loop (g ≥ 0 counts as +∞),
+    /// whatever the bound; a stable loop is judged by its value.
+    #[test]
+    fn an_unstable_loop_never_meets_an_abscissa_bound() {
+        let v = |value: f64, bound: f64| PlantValue {
+            plant: "P".into(),
+            objective: PlantObjective::Abscissa,
+            weight: 1.0,
+            bound: Some(bound),
+            value,
+            alpha_cl: value,
+            bound_met: None,
+        };
+        assert!(!v(0.2107, 1.0).bound_met() && !v(0.0, 1.0).bound_met() && !v(f64::NAN, 1.0).bound_met());
+        assert!(v(-0.5, -0.1).bound_met() && !v(-0.05, -0.1).bound_met());
+        assert_eq!(v(0.2107, 1.0).with_bound_verdict().bound_met, Some(false));
     }
 }

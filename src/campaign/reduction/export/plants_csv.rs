@@ -31,8 +31,9 @@ pub struct Row {
     value: String,
     /// w_j·g_j.
     weighted: String,
-    /// Whether w_j·g_j ≤ b_j (true without a bound).
-    bound_met: bool,
+    /// Whether w_j·g_j ≤ b_j: `true`, `false`, or `none` without a bound (the journal's `null`;
+    /// `true` there read as a bound that holds).
+    bound_met: &'static str,
     /// The closed loop's stability measure (α, or ρ − 1 in discrete time).
     alpha_cl: String,
 }
@@ -57,7 +58,11 @@ impl CsvFile for PlantsCsv {
                 bound: v.bound.map_or_else(|| "none".to_string(), csv_num),
                 value: csv_num(v.value),
                 weighted: csv_num(v.weighted()),
-                bound_met: v.bound_met(),
+                bound_met: match (v.bound, v.bound_met()) {
+                    (None, _) => "none",
+                    (Some(_), true) => "true",
+                    (Some(_), false) => "false",
+                },
                 alpha_cl: csv_num(v.alpha_cl),
             })
             .collect()
