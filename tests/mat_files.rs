@@ -208,3 +208,34 @@ fn a_campaign_may_name_a_mat_plant_and_gets_the_same_job_ids() {
     assert_eq!(from_mat.len(), 4);
     assert_eq!(from_mat, ids(&Path::new(env!("CARGO_MANIFEST_DIR")).join("plants/HE1.json")));
 }
+
+/// A cut, padded-out or doubly-defined MAT-file is an error that says so: `matfile` stopped at a
+/// damaged element and returned the variables before it (a truncated plant read as "matrix `D22`
+/// is missing", trailing garbage was accepted), and of two variables of one name it kept the
+/// last (a second `A` silently replaced the plant's).
+#[test]
+fn truncated_damaged_and_repeated_variables_are_named() {
+    let p = he1_json();
+    let good = plant_to_mat(&p);
+    assert!(read_mat_vars(&good).is_ok());
+    let cut = &good[..good.len() - 4];
+    let e = read_mat_vars(cut).unwrap_err().to_string();
+    assert!(e.contains("truncated or damaged file: the element at byte") && e.contains("remain"), "{e}");
+    let mut trailing = good.clone();
+    trailing.extend_from_slice(&[14, 0, 0, 0, 0xe8, 3, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8]); // miMATRIX of 1000 bytes, 8 given
+    let e = read_mat_vars(&trailing).unwrap_err().to_string();
+    assert!(e.contains("claims 1000 bytes, 8 remain"), "{e}");
+    let mut stray = good.clone();
+    stray.extend_from_slice(&[0, 0, 0]);
+    let e = read_mat_vars(&stray).unwrap_err().to_string();
+    assert!(e.contains("3 stray bytes after the last element"), "{e}");
+    let minus = faer::Mat::<f64>::from_fn(4, 4, |i, j| if i == j { -5.0 } else { 0.0 });
+    let mut vars: Vec<(&str, faer::MatRef<'_, f64>)> =
+        ["A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22"].into_iter().zip(p.matrices()).collect();
+    vars.push(("A", minus.as_ref()));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dup.mat");
+    std::fs::write(&path, hinfix::lti::write_mat(&vars, "dup")).unwrap();
+    let e = Plant::load(&path).unwrap_err().to_string();
+    assert!(e.contains("dup.mat") && e.contains("variable `A` appears twice"), "{e}");
+}

@@ -89,7 +89,16 @@ pub(crate) fn read_mat_vars_with_text(bytes: &[u8], text: &[&str]) -> Result<BTr
     }
     let plain = super::mat_inflate::inflate_elements(bytes, super::mat_inflate::MAX_MAT_INFLATED_BYTES)
         .map_err(MatReadError::Format)?;
-    let classes = variable_classes(&plain);
+    let classes = variable_classes(&plain)?;
+    if let Some(name) =
+        classes.iter().enumerate().find_map(|(i, (n, _))| classes[..i].iter().any(|(m, _)| m == n).then_some(n))
+    {
+        // `matfile` keeps both and the last one won: a plant's `A` was silently the second one
+        return Err(MatReadError::Variable {
+            name: name.clone(),
+            problem: "appears twice in the file; a name may hold only one matrix".into(),
+        });
+    }
     for (name, class) in classes.iter().cloned() {
         let allowed = class == MX_CHAR_CLASS && text.contains(&name.as_str());
         if !allowed && !(MX_DOUBLE_CLASS..=MX_UINT64_CLASS).contains(&class) {
@@ -134,9 +143,11 @@ pub(crate) fn read_mat_vars_with_text(bytes: &[u8], text: &[&str]) -> Result<BTr
 }
 
 /// The (name, array class) of every top-level variable of an uncompressed level-5 file (after
-/// `mat_inflate`), in either byte order; elements that cannot be parsed are left to `matfile`,
-/// which reports them.
-fn variable_classes(plain: &[u8]) -> Vec<(String, u8)> {
+/// `mat_inflate`), in either byte order; elements whose inside cannot be parsed are left to
+/// `matfile`, which reports them. An element that claims more bytes than the file has left, or
+/// a partial element header at its end, is a truncated or damaged file (`matfile` stopped there
+/// and returned the variables before it, so a cut file read as a file with missing matrices).
+fn variable_classes(plain: &[u8]) -> Result<Vec<(String, u8)>, MatReadError> {
     let big = plain.get(126..128) == Some(b"MI");
     let u32_at = |b: &[u8], i: usize| -> Option<u32> {
         let w: [u8; 4] = b.get(i..i.checked_add(4)?)?.try_into().ok()?;
@@ -155,9 +166,18 @@ fn variable_classes(plain: &[u8]) -> Vec<(String, u8)> {
     };
     let mut out = Vec::new();
     let mut pos = 128;
-    while let (Some(ty), Some(len)) = (u32_at(plain, pos), u32_at(plain, pos + 4)) {
+    let truncated = |what: String| MatReadError::Format(format!("truncated or damaged file: {what}"));
+    while pos < plain.len() {
+        let (Some(ty), Some(len)) = (u32_at(plain, pos), u32_at(plain, pos + 4)) else {
+            return Err(truncated(format!("{} stray bytes after the last element", plain.len() - pos)));
+        };
         let len = len as usize;
-        let Some(body) = plain.get(pos + 8..(pos + 8).saturating_add(len)) else { break };
+        let Some(body) = plain.get(pos + 8..(pos + 8).saturating_add(len)) else {
+            return Err(truncated(format!(
+                "the element at byte {pos} claims {len} bytes, {} remain",
+                plain.len().saturating_sub(pos + 8)
+            )));
+        };
         if ty == MI_MATRIX {
             let parsed = (|| {
                 let (flags, next) = sub(body, 0)?;
@@ -171,7 +191,7 @@ fn variable_classes(plain: &[u8]) -> Vec<(String, u8)> {
         }
         pos += 8 + len.div_ceil(8) * 8;
     }
-    out
+    Ok(out)
 }
 
 /// A MATLAB array class as the error messages name it.
