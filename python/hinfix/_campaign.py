@@ -95,7 +95,13 @@ def read_results(folder: str | os.PathLike) -> Results:
     best_csv = os.path.join(folder, "best.csv")
     if os.path.isfile(best_csv):
         with open(best_csv, newline="") as f:
-            best = [{k: _cell(v) for k, v in row.items()} for row in csv.DictReader(f)]
+            reader = csv.DictReader(f)
+            for row in reader:
+                if None in row or None in row.values():  # more, or fewer, cells than the header
+                    raise ValueError(f"{best_csv}: line {reader.line_num} does not have the header's "
+                                     f"{len(reader.fieldnames)} cells: the file is damaged (`campaign report` "
+                                     "writes it again from the journal)")
+                best.append({k: _cell(v) for k, v in row.items()})
     return Results(folder, read["records"], best)
 
 

@@ -141,6 +141,8 @@ def options_json(order, strong, given):
         raise TypeError(f"order must be a whole number ≥ 0, got {order!r}")
     if order < 0:
         raise ValueError(f"order must be ≥ 0, got {order}")
+    if order > 2**32:  # beyond any plant's order (the crate then says "exceeds the plant order")
+        raise ValueError(f"order {order} is larger than any plant's order")
     if "objective" in given:
         raise TypeError("use strong=True/False instead of objective= for the strong-stabilisation objective "
                         "(objective= names each plant's objective: hinf, h2, abscissa, radius)")
@@ -242,8 +244,14 @@ def _structure(structure):
         rows = np.asarray(block, dtype=object)
         if rows.ndim != 2:
             raise ValueError(f"structure block {k} must be 2-D, got shape {rows.shape}")
-        cell = lambda x: None if x is None or (_is_real(x) and math.isnan(x)) else _json_value(x)
-        out[k] = [[cell(x) for x in row] for row in rows]
+        def cell(x, i, j):
+            if x is None or (_is_real(x) and math.isnan(x)):
+                return None
+            if not _is_real(x):
+                raise TypeError(f"structure block {k} entry ({i + 1}, {j + 1}) must be a real number, "
+                                f"None or NaN (free), got {x!r}")
+            return _json_value(x)
+        out[k] = [[cell(x, i, j) for j, x in enumerate(row)] for i, row in enumerate(rows)]
     return json.dumps(out), None
 
 

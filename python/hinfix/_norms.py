@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from . import _hinfix
 from ._json import loads
 from ._plant import blocks, system, sampling_time, as_matrix
@@ -15,6 +17,8 @@ def hinfnorm(sys: Any, tol: float = 1e-10) -> tuple[float, float]:
     or anything ``control.ss`` converts. An unstable system gives (inf, nan): its H∞ norm is
     infinite (unlike ``control.linfnorm``, which gives the L∞ norm). The frequency may be inf
     (continuous time, peak as ω → ∞)."""
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)):
+        raise TypeError(f"hinfnorm: tol must be a number in (0, 1), got {tol!r}")
     sys = system(sys, "sys")
     a, b, c, d = (as_matrix(m, n) for m, n in zip((sys.A, sys.B, sys.C, sys.D), "ABCD"))
     return _hinfix.hinfnorm(a, b, c, d, float(tol), sampling_time(sys, "sys"))

@@ -33,9 +33,14 @@ def system(sys, what):
     """``sys`` as a ``control.StateSpace`` (a ValueError otherwise), continuous or discrete time."""
     if not isinstance(sys, control.StateSpace):
         try:
-            sys = control.ss(sys)
+            converted = None if sys is None else control.ss(sys)
         except Exception as e:  # python-control raises several types for what it cannot convert
             raise ValueError(f"{what} must be a control.StateSpace (or convertible to one): {e}") from None
+        # control.ss makes a nonlinear system of what it does not know (None, a function, …)
+        if not isinstance(converted, control.StateSpace):
+            raise ValueError(f"{what} must be a control.StateSpace (or convertible to one, such as a "
+                             f"TransferFunction), got {type(sys).__name__}")
+        sys = converted
     sampling_time(sys, what)
     return sys
 

@@ -208,6 +208,7 @@ fn plain_words(e: &serde_json::Error) -> String {
         ("expected a boolean", "expected True or False"),
         ("floating point", "number"),
         ("invalid type: ", ""),
+        ("data did not match any variant of untagged enum NumOrStr", "expected a number, \"inf\", \"-inf\" or \"nan\""),
     ]
     .iter()
     .fold(text, |t, (rust, plain)| t.replace(rust, plain))

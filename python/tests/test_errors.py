@@ -107,3 +107,29 @@ def test_initial_controller_errors(he1):
         hinfix.design(P, nmeas, ncon, 1, init=([[-1.0]], [[1.0, 2.0]], [[1.0], [1.0]], [[0.0], [0.0]]))
     with pytest.raises(ValueError, match="initial controller"):
         hinfix.design(P, nmeas, ncon, 1, init=control.ss([], [], [], np.zeros((3, 3))))
+
+
+def test_unclear_inputs_get_messages_that_name_them(he1, tmp_path):
+    P, nmeas, ncon = he1
+    # None is no system (python-control made a nonlinear system of it, and the error spoke of
+    # an attribute or of "0 outputs")
+    with pytest.raises(ValueError, match="sys must be a control.StateSpace .* got NoneType"):
+        hinfix.hinfnorm(None)
+    with pytest.raises(ValueError, match="P must be a control.StateSpace .* got NoneType"):
+        hinfix.design(None, 1, 1, 1)
+    for tol in ("a", None):
+        with pytest.raises(TypeError, match="hinfnorm: tol must be a number in"):
+            hinfix.hinfnorm(P, tol=tol)
+    with pytest.raises(TypeError, match=r"structure block AK entry \(1, 1\) must be a real number"):
+        hinfix.design(P, nmeas, ncon, 1, structure={"AK": [[1 + 2j]]}, maxevals=10)
+    with pytest.raises(ValueError, match=r"option `hop_scales`: expected a number"):
+        hinfix.design(P, nmeas, ncon, 1, hop_scales=[[0.1]], maxevals=10)
+    with pytest.raises(ValueError, match="order 10+ is larger than any plant's order"):
+        hinfix.design(P, nmeas, ncon, 10**30)
+    # a damaged best.csv (the report writes it whole; someone cut it)
+    res = tmp_path / "c"
+    res.mkdir()
+    (res / "runs.jsonl").write_text("")
+    (res / "best.csv").write_text("plant,order,objective,gamma\nHE1,1\n")
+    with pytest.raises(ValueError, match=r"best.csv: line 2 does not have the header's 4 cells"):
+        hinfix.read_results(res)
