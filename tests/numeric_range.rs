@@ -113,5 +113,5 @@ fn check_calls_a_loop_within_the_margin_unstable() {
     let out = Command::new(BIN).args(["check", "--plant"]).arg(&plant).arg("--controller").arg(&k).output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(4), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("UNSTABLE (stable means α < −1.0e-12)"), "{stdout}");
+    assert!(stdout.contains("UNSTABLE (stable means α < −1.000000e-12)"), "{stdout}");
 }

@@ -60,7 +60,7 @@ def test_threads_of_run_campaign_are_in_range(tmp_path):
 
 def test_option_errors_carry_the_crates_message(he1):
     P, nmeas, ncon = he1
-    with pytest.raises(ValueError, match="ε must be finite and positive"):
+    with pytest.raises(ValueError, match="ε must be a number from 1e-50 to 1e50"):
         hinfix.design(P, nmeas, ncon, 1, eps=-1.0)
     with pytest.raises(TypeError, match="nrand must be a whole number, got '3'"):
         hinfix.design(P, nmeas, ncon, 1, nrand="3")

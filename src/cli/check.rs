@@ -93,7 +93,13 @@ pub fn run(a: CheckArgs) -> anyhow::Result<ExitCode> {
         k.check_fits(plant)
             .with_context(|| format!("controller {} on plant {}", a.controller.display(), plant.name))?;
     }
-    let reports = plants.iter().map(|p| evaluate(p, &k)).collect::<anyhow::Result<Vec<_>>>()?;
+    let reports = plants
+        .iter()
+        .map(|p| {
+            evaluate(p, &k)
+                .with_context(|| format!("checking the controller {} on the plant {}", a.controller.display(), p.name))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let all_stable = reports.iter().all(CheckReport::closed_loop_stable);
     let exit = if all_stable { ExitCode::SUCCESS } else { ExitCode::from(super::EXIT_NOT_STABILISED) };
     if let [plant] = plants.as_slice() {
@@ -230,7 +236,7 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
         s += &format!("{}, frequencies in rad/s up to the Nyquist frequency\n", r.domain);
     }
     s += &format!(
-        "closed loop: {name}(A_cl) = {:+.6e}   {} (stable means {bound}{:.1e})\n",
+        "closed loop: {name}(A_cl) = {:+.6e}   {} (stable means {bound}{:.6e})\n",
         alpha_cl,
         yes_no(r.closed_loop_stable()),
         r.margin_cl
@@ -247,7 +253,7 @@ fn human(plant: &Plant, k: &Controller, r: &CheckReport) -> String {
     match r.alpha_k {
         Some(a) => {
             s += &format!(
-                "controller:  {name}(Ak)    = {:+.6e}   {} (stable means {bound}{:.1e})\n",
+                "controller:  {name}(Ak)    = {:+.6e}   {} (stable means {bound}{:.6e})\n",
                 quantity(a).1,
                 yes_no(r.controller_stable()),
                 r.margin_k
@@ -273,6 +279,7 @@ fn peak_text(r: &CheckReport) -> String {
     };
     match r.peak_freqs.as_slice() {
         _ if r.peak_freq.is_nan() => "—".to_string(),
+        _ if r.gamma == 0.0 => "— (σmax(Tzw) = 0 at every frequency)".to_string(),
         [] | [_] if r.peak_freq.is_infinite() => "ω → ∞".to_string(),
         [] | [_] => format!("ω = {} rad/s", one(r.peak_freq)),
         [init @ .., last] => format!(
@@ -309,6 +316,10 @@ mod tests {
         r.peak_freqs = vec![0.72];
         r.peak_freq = 0.72;
         assert_eq!(peak_text(&r), "ω = 0.720000 rad/s");
+        // T_zw ≡ 0: no peak to name (every frequency was listed, about 200 of them)
+        r.gamma = 0.0;
+        r.peak_freqs = vec![];
+        assert_eq!(peak_text(&r), "— (σmax(Tzw) = 0 at every frequency)");
     }
 
     #[test]

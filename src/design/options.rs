@@ -283,9 +283,11 @@ macro_rules! design_option_table {
             #[serde(with = "serde_f64_or_string")]
             eps: f64 = 1e-3,
                 key "eps", flag "--eps",
-                accepts "finite, > 0",
-                check |v: &f64| require(v.is_finite() && *v > 0.0, || {
-                    format!("ε must be finite and positive (> 0), got {v}")
+                accepts "from 1e-50 to 1e50",
+                // the range of a plant's weight (`MIN_WEIGHT`, `MAX_WEIGHT`): ε = 1e308 made
+                // ε·α(Ak) overflow, and the run returned Ak = −5e307 with a garbage closed loop
+                check |v: &f64| require((super::MIN_WEIGHT..=super::MAX_WEIGHT).contains(v), || {
+                    format!("ε must be a number from 1e-50 to 1e50, got {}", crate::numeric::readable(*v))
                 }),
                 doc "weight ε of ‖K‖∞ in max(‖Tzw‖∞, ε‖K‖∞) and of α(A_K)";
             /// Seed of the run's random number generator.

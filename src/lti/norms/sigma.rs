@@ -176,10 +176,11 @@ pub fn sigma_curve(domain: TimeDomain, sys: &StateSpace, band: (f64, f64), extra
 /// of a stable `sys`, with `norm.peak_freq` in rad/s), ascending: ω = 0 and ω = +∞ (σmax(D))
 /// — in discrete time the Nyquist frequency — when they qualify, and each local maximum of the
 /// [`sigma_curve`] on the system's [`frequency_band`], refined by golden-section search in log
-/// ω; `norm.peak_freq` is always one of them. Empty for an unstable system.
+/// ω; `norm.peak_freq` is always one of them. Empty for an unstable system and for G ≡ 0.
 pub fn near_peak_frequencies(domain: TimeDomain, sys: &StateSpace, norm: &HinfNorm, rtol: f64) -> Vec<f64> {
     let peak = norm.value;
-    if !peak.is_finite() {
+    // no peak of an infinite norm, nor of T ≡ 0 (every frequency would be "within rtol" of 0)
+    if !(peak.is_finite() && peak > 0.0) {
         return Vec::new();
     }
     let level = peak * (1.0 - rtol);
@@ -400,5 +401,15 @@ mod tests {
         assert!(peaks[2].is_infinite());
         // a tighter tolerance than the ends' distance keeps them: they are exactly 1
         assert_eq!(near_peak_frequencies(TimeDomain::Continuous, &g, &h, 1e-9).len(), 3);
+        // G ≡ 0 has no peak (every frequency is "within rtol" of 0)
+        let zero = ss(
+            Mat::from_fn(2, 2, |i, j| if i == j { -1.0 } else { 0.0 }),
+            Mat::zeros(2, 1),
+            Mat::zeros(1, 2),
+            Mat::zeros(1, 1),
+        );
+        let h0 = hinf_norm(&zero, &HinfParams::default()).unwrap();
+        assert_eq!(h0.value, 0.0);
+        assert!(near_peak_frequencies(TimeDomain::Continuous, &zero, &h0, NORM_TIE_RTOL).is_empty());
     }
 }
