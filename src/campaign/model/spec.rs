@@ -1178,7 +1178,12 @@ objective = "plain"
     #[test]
     fn impossible_values_name_line_and_column() {
         let cases: &[(&str, usize, usize, &str)] = &[
-            ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\neps = [1e-2, -1e-3]\n", 5, 7, "positive"),
+            (
+                "name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\neps = [1e-2, -1e-3]\n",
+                5,
+                7,
+                "ε must be a number from 1e-50 to 1e50, got -0.001",
+            ),
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1]\ncpumax = 0.0\n", 5, 10, "cpumax"),
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, -2]\n", 4, 10, "orders"),
             ("name = \"t\"\n[[problem]]\nplant = \"HE1\"\norders = [1, 1]\n", 4, 10, "twice"),
