@@ -50,7 +50,8 @@ pub enum LookupError {
 }
 
 /// The record of `entry` in the results folder `dir` (the folder holding `runs*.jsonl` and
-/// `best.csv`). A job journaled several times gives its first record.
+/// `best.csv`). A job journaled several times (a job run twice, journals merged) gives the
+/// record `campaign report` counts ([`one_record`]).
 pub fn find_record(dir: &Path, entry: &Entry) -> Result<JobRecord, LookupError> {
     let id = match entry {
         Entry::Job(id) => id.clone(),
@@ -65,9 +66,43 @@ pub fn find_record(dir: &Path, entry: &Entry) -> Result<JobRecord, LookupError> 
     ids.dedup();
     match ids.len() {
         0 => Err(LookupError::NotFound(format!("no job {id} in the journals of {}", dir.display()))),
-        1 => Ok(found.swap_remove(0)),
+        1 => one_record(found, dir),
         n => Err(LookupError::Ambiguous(format!("{n} jobs of {} start with {id}: give more of the id", dir.display()))),
     }
+}
+
+/// The one record of a job among its `records` (one job id, at least one record): the only one,
+/// or where they hold different controllers, the one `campaign report` counts — the smallest γ
+/// re-verified on the plant (`reduce::verify`, the first of equals), the plant taken from the
+/// library by the record's name and checked by its fingerprint. The first record was taken once:
+/// a hand-made or damaged duplicate put first was exported although the report, and best.csv,
+/// had counted the other, verified one. Where the plant is not in the library (a plant file, a
+/// problem of several plants), different controllers are an error that says so.
+fn one_record(mut records: Vec<JobRecord>, dir: &Path) -> Result<JobRecord, LookupError> {
+    let controllers: Vec<_> = records.iter().filter_map(JobRecord::controller).collect();
+    if records.len() == 1 || controllers.windows(2).all(|w| w[0] == w[1]) {
+        let first_with = records.iter().position(|r| r.controller().is_some()).unwrap_or(0);
+        return Ok(records.swap_remove(first_with));
+    }
+    let r0 = &records[0];
+    let plant = crate::lti::resolve_plant(&r0.plant)
+        .ok()
+        .and_then(|path| crate::lti::Plant::load(path).ok())
+        .filter(|p| p.fingerprint() == r0.plant_fingerprint);
+    let Some(plant) = plant else {
+        return Err(LookupError::Ambiguous(format!(
+            "job {} has {} records with different controllers in the journals of {}, and its plant {} is not in the \
+             plant library to verify them: keep the one you want in the journal",
+            r0.job_id.0,
+            records.len(),
+            dir.display(),
+            r0.plant
+        )));
+    };
+    let gammas: Vec<f64> =
+        records.iter().map(|r| super::reduce::verify(r, &plant).gamma().unwrap_or(f64::INFINITY)).collect();
+    let best = (0..records.len()).fold(0, |b, i| if gammas[i] < gammas[b] { i } else { b });
+    Ok(records.swap_remove(best))
 }
 
 fn best_job_id(dir: &Path, plant: &str, order: usize, objective: Option<&str>) -> Result<String, LookupError> {
@@ -121,5 +156,28 @@ mod tests {
         let e = best_job_id(dir.path(), "P", 3, None).unwrap_err().to_string();
         assert!(e.contains("no row for plant P, n_K = 3") && e.contains("P n_K=2"), "{e}");
         assert!(matches!(find_record(dir.path(), &Entry::Job("nope".into())), Err(LookupError::NotFound(_))));
+    }
+
+    /// A job journaled twice with different controllers gives the record the report counts (the
+    /// verified one), not the first: here an unstable copy (AK = 5) comes first.
+    #[test]
+    fn a_job_recorded_twice_gives_its_verified_record() {
+        let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report/runs.jsonl");
+        let line = std::fs::read_to_string(fixture).unwrap().lines().next().unwrap().to_string();
+        let mut bad: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert_eq!(bad["plant"], "HE1");
+        let nk = bad["controller"]["AK"].as_array().unwrap().len();
+        bad["controller"]["AK"] = serde_json::json!((0..nk)
+            .map(|i| (0..nk).map(|j| if i == j { 5.0 } else { 0.0 }).collect::<Vec<_>>())
+            .collect::<Vec<_>>());
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("runs.jsonl"), format!("{bad}\n{line}\n")).unwrap();
+        let id = bad["job_id"].as_str().unwrap().to_string();
+        let got = find_record(dir.path(), &Entry::Job(id[..8].to_string())).unwrap();
+        let want: JobRecord = serde_json::from_str(&line).unwrap();
+        assert_eq!(got.controller(), want.controller());
+        // the same controller twice: simply that record
+        std::fs::write(dir.path().join("runs.jsonl"), format!("{line}\n{line}\n")).unwrap();
+        assert_eq!(find_record(dir.path(), &Entry::Job(id)).unwrap().controller(), want.controller());
     }
 }
