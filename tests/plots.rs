@@ -362,3 +362,40 @@ fn a_closed_loop_with_zero_norm_draws_its_sigma_plot() {
         assert!(log_ticks(lo, hi).is_empty(), "log_ticks({lo}, {hi})");
     }
 }
+
+/// A convergence figure is drawn only from the trace of the run that journaled the row's record:
+/// another job's trace under the best job's file name (or a trace left from an earlier run of the
+/// job) is skipped with the reason, and the figure an earlier plot made for the row is removed
+/// (index.html would link it under this row's ε and seed).
+#[test]
+fn a_trace_of_another_run_is_not_drawn_as_the_rows_convergence() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("c.toml");
+    std::fs::write(&file, "name = \"p\"\n[defaults]\neps = [1e-3]\nseeds = 1\ncpumax = 1.0\nnrand = 1\nspend_budget = false\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n").unwrap();
+    let results = dir.path().join("r");
+    let run = |args: &[&str]| {
+        let out = Command::new(BIN)
+            .args(args)
+            .arg(&file)
+            .arg("--results")
+            .arg(&results)
+            .env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "campaign {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+    };
+    run(&["run", "--no-progress"]);
+    run(&["plot"]);
+    let plots = results.join("p/plots");
+    assert!(plots.join("convergence_HE1_nK2.svg").is_file());
+    let best = std::fs::read_to_string(results.join("p/best.csv")).unwrap();
+    let ids: Vec<String> = best.lines().skip(1).map(|l| l.split(',').nth(4).unwrap().to_string()).collect();
+    assert_eq!(ids.len(), 2, "{best}");
+    let traces = results.join("p/traces");
+    std::fs::copy(traces.join(format!("{}.mcap", ids[0])), traces.join(format!("{}.mcap", ids[1]))).unwrap();
+    let said = run(&["plot"]);
+    assert!(said.contains(&format!("is the trace of job {}, not of this job", ids[0])), "{said}");
+    assert!(!plots.join("convergence_HE1_nK2.svg").exists() && !plots.join("convergence_HE1_nK2.png").exists());
+    assert!(plots.join("convergence_HE1_nK1.svg").is_file() && plots.join("sigma_HE1_nK2.svg").is_file());
+}

@@ -550,10 +550,33 @@ pub struct TraceIteration {
     pub elapsed_cpu_s: f64,
 }
 
+/// The result message of a trace: the job it is of and the γ its run returned (`None` when the
+/// trace has no result message).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceResult {
+    /// The job id.
+    pub job_id: String,
+    /// γ of the returned controller, as the run journaled it.
+    pub gamma: f64,
+}
+
 /// Every iteration message of a trace, in order.
 pub fn read_iterations(path: &Path) -> Result<Vec<TraceIteration>, TraceError> {
+    read_run(path).map(|(iterations, _)| iterations)
+}
+
+/// [`read_iterations`] with the trace's [`TraceResult`]: whoever draws a trace beside a journal
+/// record checks with it that the trace is of that record's run (a rerun journals the job
+/// again, and a trace left from an earlier run keeps its name).
+pub fn read_run(path: &Path) -> Result<(Vec<TraceIteration>, Option<TraceResult>), TraceError> {
     let mut out = Vec::new();
+    let mut result = None;
     each_message(path, |topic, _, v| {
+        if topic == RESULT_TOPIC {
+            result = v["job_id"]
+                .as_str()
+                .map(|id| TraceResult { job_id: id.to_string(), gamma: f64_from_json(&v["gamma"]) });
+        }
         if topic == ITER_TOPIC {
             out.push(TraceIteration {
                 phase: v["phase"].as_str().unwrap_or("?").to_string(),
@@ -564,7 +587,7 @@ pub fn read_iterations(path: &Path) -> Result<Vec<TraceIteration>, TraceError> {
             });
         }
     })?;
-    Ok(out)
+    Ok((out, result))
 }
 
 /// Reads a trace and summarises it.

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use super::compare::full_order_rows;
 use super::reduce::{best_per_problem, verify, verify_problem, BestRow, PlantMap, ProblemMap, Verdict};
 use super::report::ReportError;
-use crate::campaign::execution::trace::{read_iterations, TraceError};
+use crate::campaign::execution::trace::{read_run, TraceError, TraceIteration};
 use crate::campaign::leaves::library_index::LibraryIndex;
 use crate::campaign::leaves::reference::{RefMethod, ReferenceRow};
 use crate::campaign::records::record::JobRecord;
@@ -208,19 +208,6 @@ pub fn write_plots(
             row.eps.unwrap_or(f64::NAN),
             row.seed.unwrap_or(0)
         );
-        let trace = campaign_dir.join("traces").join(format!("{job}.mcap"));
-        if trace.is_file() {
-            match read_iterations(&trace) {
-                Ok(iterations) if !iterations.is_empty() => {
-                    let fig = ConvergenceFigure { title: format!("convergence: {title}"), iterations };
-                    keep(write_png_and_svg(&fig, &dir.join(format!("convergence_{tag}"))), &mut out);
-                }
-                Ok(_) => out.skipped.push(format!("{}: no iterations in the trace", trace.display())),
-                Err(e) => out.skipped.push(format!("convergence of {tag}: {e}")),
-            }
-        } else {
-            out.skipped.push(format!("convergence of {tag}: no trace {}", trace.display()));
-        }
         let fp = &row.plant_fingerprint;
         // The job's record that re-verified best (the one the row reports), not merely the
         // first record of the job id: a duplicate may carry another controller.
@@ -237,6 +224,22 @@ pub fn write_plots(
             out.skipped.push(format!("σ-plot of {tag}: no re-verified controller of job {job}"));
             continue;
         };
+        let trace = campaign_dir.join("traces").join(format!("{job}.mcap"));
+        let convergence = dir.join(format!("convergence_{tag}"));
+        match convergence_of(&trace, rec) {
+            Ok(iterations) => {
+                let fig = ConvergenceFigure { title: format!("convergence: {title}"), iterations };
+                keep(write_png_and_svg(&fig, &convergence), &mut out);
+            }
+            Err(why) => {
+                // a figure left by an earlier plot of another best job must not stay beside
+                // this row (index.html links it under this row's ε and seed)
+                for ext in ["png", "svg"] {
+                    let _ = std::fs::remove_file(convergence.with_extension(ext));
+                }
+                out.skipped.push(format!("convergence of {tag}: {why}"));
+            }
+        }
         let Some(k) = rec.controller() else { continue };
         match problems.get(fp) {
             None => {
@@ -263,6 +266,37 @@ pub fn write_plots(
         }
     }
     Ok(out)
+}
+
+/// The iterations of the trace `path` of the run that journaled `rec`, or why there is no
+/// convergence figure: no trace, no iterations, or a trace of another run — its result message
+/// names another job, or a γ other than the record's (a job rerun journals a new record, and
+/// a trace of an earlier run of the job keeps its file name: drawn, it showed another run's
+/// search under this record's ε and seed).
+fn convergence_of(path: &Path, rec: &JobRecord) -> Result<Vec<TraceIteration>, String> {
+    if !path.is_file() {
+        return Err(format!("no trace {}", path.display()));
+    }
+    let (iterations, result) = read_run(path).map_err(|e| e.to_string())?;
+    let journaled = rec.outcome().map(|o| o.gamma);
+    match result {
+        Some(r) if r.job_id != rec.job_id.0 => {
+            return Err(format!("{} is the trace of job {}, not of this job", path.display(), r.job_id));
+        }
+        Some(r) if journaled.is_some_and(|g| !(g == r.gamma || (g.is_nan() && r.gamma.is_nan()))) => {
+            return Err(format!(
+                "{} is of another run of the job (it ended at γ = {}, the journal's record at {})",
+                path.display(),
+                r.gamma,
+                journaled.unwrap_or(f64::NAN)
+            ));
+        }
+        _ => {}
+    }
+    if iterations.is_empty() {
+        return Err(format!("{}: no iterations in the trace", path.display()));
+    }
+    Ok(iterations)
 }
 
 /// The σ-plot of `k` on `plant`.
