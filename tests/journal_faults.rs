@@ -130,3 +130,50 @@ fn traces_that_cannot_be_written_fail_the_run_and_say_so() {
     assert_eq!(ids_in(&folder.join("runs.jsonl")).len(), 2, "the results are journaled");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A journal line that carries a job's id but not its ε (hand-edited or damaged) is not counted
+/// under the ε it claims: `report` warns, naming the job and the field, and leaves it out (the
+/// row once showed an ε the campaign never ran).
+#[test]
+fn a_record_that_disagrees_with_its_job_is_named_and_not_counted() {
+    let dir = scratch("disagree");
+    let file = dir.join("c.toml");
+    std::fs::write(
+        &file,
+        "name = \"d\"\n[defaults]\neps = [1e-3]\nseeds = 2\nmaxevals = 300\nnrand = 1\n[[problem]]\nplant = \"HE1\"\norders = [1]\n",
+    )
+    .unwrap();
+    let results = dir.join("r");
+    let cmd = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_campaign"))
+            .args(args)
+            .arg(&file)
+            .arg("--results")
+            .arg(&results)
+            .env("HINFIX_PLANTS", PLANTS)
+            .output()
+            .unwrap()
+    };
+    assert!(cmd(&["run", "--no-progress", "--trace", "off"]).status.success());
+    let journal = results.join("d/runs.jsonl");
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let (first, rest) = text.split_once('\n').unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(first).unwrap();
+    v["eps"] = serde_json::json!(0.5);
+    std::fs::write(&journal, format!("{v}\n{rest}")).unwrap();
+    let out = cmd(&["report"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let id = v["job_id"].as_str().unwrap();
+    assert!(
+        err.contains(&format!("a record of job {}: eps 0.5 in the record, 0.001 in the campaign", &id[..8])),
+        "{err}"
+    );
+    let best = std::fs::read_to_string(results.join("d/best.csv")).unwrap();
+    assert!(!best.contains(",0.5,"), "{best}");
+    // one job counted (the other's record is left out): `runs` is 1
+    let head: Vec<&str> = best.lines().next().unwrap().split(',').collect();
+    let row: Vec<&str> = best.lines().nth(1).unwrap().split(',').collect();
+    let runs = head.iter().position(|h| *h == "runs").unwrap();
+    assert_eq!(row[runs], "1", "{best}");
+}

@@ -29,7 +29,9 @@ mod reduction;
 #[cfg(any(test, feature = "test-support"))]
 pub use execution::fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
 pub use execution::progress::{Display as ProgressDisplay, Reporter};
-pub use execution::run::{campaign_dir, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome};
+pub use execution::run::{
+    campaign_dir, disagreeing_records, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome,
+};
 pub use execution::scheduler::{
     design_job, execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, ExecuteError, ExecuteOptions,
     JobObserver, JobRunner, JobStarts, ObserverError, ObserverFactory, RunStats, Scheduler, Solo,

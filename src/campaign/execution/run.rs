@@ -89,10 +89,51 @@ pub fn records_by_id(records: Vec<JobRecord>) -> HashMap<JobId, JobRecord> {
     map
 }
 
-/// Every record (duplicates included) whose job is one of `jobs`.
+/// Every record (duplicates included) whose job is one of `jobs` and that agrees with it
+/// ([`disagreement`]; a record carrying a job's id but not its plant, order, ε, seed or
+/// objective is left out: [`disagreeing_records`] names them).
 pub fn records_for(jobs: &[Job], records: &[JobRecord]) -> Vec<JobRecord> {
-    let wanted: HashSet<&JobId> = jobs.iter().map(|j| &j.id).collect();
-    records.iter().filter(|r| wanted.contains(&r.job_id)).cloned().collect()
+    let wanted: HashMap<&JobId, &Job> = jobs.iter().map(|j| (&j.id, j)).collect();
+    records.iter().filter(|r| wanted.get(&r.job_id).is_some_and(|j| disagreement(j, r).is_none())).cloned().collect()
+}
+
+/// The records that carry the id of one of `jobs` but disagree with it, each with the field
+/// that differs ("job 6d7025f7: eps 0.5 in the record, 1e-6 in the campaign").
+pub fn disagreeing_records(jobs: &[Job], records: &[JobRecord]) -> Vec<String> {
+    let wanted: HashMap<&JobId, &Job> = jobs.iter().map(|j| (&j.id, j)).collect();
+    records
+        .iter()
+        .filter_map(|r| {
+            let why = disagreement(wanted.get(&r.job_id)?, r)?;
+            Some(format!("job {}: {why}", &r.job_id.0[..r.job_id.0.len().min(8)]))
+        })
+        .collect()
+}
+
+/// Why the record `r` is not the record of `job` although it carries its id: the first of its
+/// identifying fields (those the id is made of) that differs, or `None`. The id names the job;
+/// a hand-edited or damaged line that says otherwise was reported under a plant, order, ε or
+/// seed the campaign never ran.
+pub fn disagreement(job: &Job, r: &JobRecord) -> Option<String> {
+    let o = &job.options;
+    let differs =
+        |what: &str, rec: String, camp: String| Some(format!("{what} {rec} in the record, {camp} in the campaign"));
+    if r.plant_fingerprint != job.plant_fingerprint {
+        return differs("plant fingerprint", r.plant_fingerprint.clone(), job.plant_fingerprint.clone());
+    }
+    if r.order != o.order || r.options.order != o.order {
+        return differs("order", r.order.to_string(), o.order.to_string());
+    }
+    if r.eps.to_bits() != o.eps.to_bits() || r.options.eps.to_bits() != o.eps.to_bits() {
+        return differs("eps", r.eps.to_string(), o.eps.to_string());
+    }
+    if r.seed != o.seed || r.options.seed != o.seed {
+        return differs("seed", r.seed.to_string(), o.seed.to_string());
+    }
+    if r.options.objective != o.objective {
+        return differs("objective", r.options.objective.name().into(), o.objective.name().into());
+    }
+    None
 }
 
 /// Job ids with more than one record, with their counts (sorted by id).
