@@ -235,7 +235,7 @@ fn external_entries(path: &Path) -> Result<Vec<SourceEntry>, SourceError> {
     }
     let (cpu_col, stable_col, fp_col) = (col("cpu_s"), col("stable"), col("plant_fingerprint"));
     let mut out = Vec::new();
-    let mut lines: BTreeMap<(String, Option<String>, usize, &'static str), u64> = BTreeMap::new();
+    let mut lines: Vec<(String, Option<String>, usize, &'static str, u64)> = Vec::new();
     for rec in reader.records() {
         let rec = rec.map_err(csv_err)?;
         let line = rec.position().map_or(0, |p| p.line());
@@ -277,8 +277,21 @@ fn external_entries(path: &Path) -> Result<Vec<SourceEntry>, SourceError> {
             s if s.len() == 64 && s.chars().all(|c| c.is_ascii_hexdigit()) => Some(s.to_ascii_lowercase()),
             s => return Err(bad("plant_fingerprint", format!("`{s}` is not 64 hexadecimal digits"))),
         };
-        let key = (plant.clone(), fingerprint.clone(), order, objective.name());
-        if let Some(first) = lines.insert(key, line) {
+        // One plant is one fingerprint whatever its name: two rows at one order and objective
+        // are one entry twice when their fingerprints agree, or when their names agree and one
+        // gives no fingerprint (rows of one fingerprint under two names were taken as two
+        // plants, and the comparison then found one of them "missing").
+        let same = |(p, fp, k, o, _): &(String, Option<String>, usize, &str, u64)| {
+            *k == order
+                && *o == objective.name()
+                && match (fp, &fingerprint) {
+                    (Some(a), Some(b)) => a == b,
+                    _ => *p == plant,
+                }
+        };
+        let first = lines.iter().find(|e| same(e)).map(|e| e.4);
+        lines.push((plant.clone(), fingerprint.clone(), order, objective.name(), line));
+        if let Some(first) = first {
             return Err(bad(
                 "plant",
                 format!("duplicate entry: {plant}, order {order}, {} is on line {first} too", objective.name()),
@@ -289,15 +302,21 @@ fn external_entries(path: &Path) -> Result<Vec<SourceEntry>, SourceError> {
     Ok(out)
 }
 
-/// A γ cell: a positive number, or empty / `inf` for a failure (no controller found).
+/// A γ cell: a positive number, or empty / `inf` (any letter case, `+inf`, `infinity`) for a
+/// failure (no controller found). A number out of f64's range (1e999, 1e-400) is an error that
+/// quotes the cell (it was "found inf" or "found 0").
 fn parse_gamma(s: &str) -> Result<f64, String> {
-    match s {
-        "" | "inf" | "Inf" | "infinity" => Ok(f64::INFINITY),
-        _ => match s.parse::<f64>() {
-            Ok(g) if g > 0.0 && g.is_finite() => Ok(g),
-            Ok(g) => Err(format!("γ must be positive and finite (or empty/inf for a failure), found {g}")),
-            Err(_) => Err(format!("`{s}` is not a number")),
-        },
+    let word = s.strip_prefix('+').unwrap_or(s).to_ascii_lowercase();
+    if s.is_empty() || word == "inf" || word == "infinity" {
+        return Ok(f64::INFINITY);
+    }
+    match s.parse::<f64>() {
+        Ok(g) if g > 0.0 && g.is_finite() => Ok(g),
+        Ok(g) if g.is_infinite() || (g == 0.0 && s.chars().any(|c| ('1'..='9').contains(&c))) => {
+            Err(format!("`{s}` is out of the range of a double-precision number"))
+        }
+        Ok(_) => Err(format!("γ must be positive and finite (or empty/inf for a failure), found `{s}`")),
+        Err(_) => Err(format!("`{s}` is not a number")),
     }
 }
 
@@ -355,6 +374,35 @@ mod tests {
         for (text, wants) in cases {
             let e = err(text);
             assert!(wants.iter().all(|w| e.contains(w)), "{e}");
+        }
+    }
+
+    /// One fingerprint under two names, or a name once with and once without its fingerprint,
+    /// is one entry twice; `inf` in any case is a failure, a number out of range an error that
+    /// quotes it.
+    #[test]
+    fn duplicates_by_content_and_gamma_words() {
+        let fp = "4822dac1ddd3cc168d3a06071f6a15109a4f86177544dc0261c1f3c897035423";
+        let other = "e12e880ce104f5ea2933b97d1a98b321d773fc46057a0f73accf5fb8dfe1879d";
+        let head = "plant,order,objective,gamma,plant_fingerprint\n";
+        for rows in [
+            format!("HE1,1,strong,0.2,{fp}\nHEONE,1,strong,0.1,{fp}\n"),
+            format!("HE1,1,strong,0.2,{fp}\nHE1,1,strong,0.1,\n"),
+            format!("HE1,1,strong,0.2,\nHE1,1,strong,0.1,{fp}\n"),
+        ] {
+            let e = err(&format!("{head}{rows}"));
+            assert!(e.contains("line 3, column `plant`") && e.contains("duplicate") && e.contains("line 2"), "{e}");
+        }
+        // two plants of one name, told apart by their fingerprints, are two entries
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), &format!("{head}HE1,1,strong,0.2,{fp}\nHE1,1,strong,0.1,{other}\n"));
+        assert_eq!(load_source("m".into(), &p).unwrap().entries.len(), 2);
+        for word in ["", "inf", "INF", "+inf", "Infinity", "+Infinity"] {
+            assert_eq!(parse_gamma(word), Ok(f64::INFINITY), "{word}");
+        }
+        for (cell, says) in [("1e999", "out of the range"), ("1e-400", "out of the range"), ("0", "found `0`")] {
+            let e = parse_gamma(cell).unwrap_err();
+            assert!(e.contains(says) && e.contains(cell), "{cell}: {e}");
         }
     }
 
