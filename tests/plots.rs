@@ -37,24 +37,27 @@ fn check_svg(text: &str, what: &str) {
     );
 }
 
+/// `campaign <args> FILE --results DIR` with the shipped plants; it must succeed.
+fn campaign(args: &[&str], file: &Path, results: &Path) -> std::process::Output {
+    let out = Command::new(BIN)
+        .args(args)
+        .arg(file)
+        .arg("--results")
+        .arg(results)
+        .env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "campaign {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
 #[test]
 fn every_figure_kind_is_rendered_for_a_small_real_campaign() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("c.toml");
     std::fs::write(&file, "name = \"p\"\n[defaults]\neps = [1e-3]\nseeds = 1\ncpumax = 2.0\nnrand = 1\nspend_budget = false\n[[problem]]\nplant = \"REA2\"\norders = [1, 2]\n").unwrap();
     let results = dir.path().join("r");
-    let run = |args: &[&str]| {
-        let out = Command::new(BIN)
-            .args(args)
-            .arg(&file)
-            .arg("--results")
-            .arg(&results)
-            .env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"))
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "campaign {args:?}: {}", String::from_utf8_lossy(&out.stderr));
-        out
-    };
+    let run = |args: &[&str]| campaign(args, &file, &results);
     run(&["run", "--no-progress"]);
     let out = run(&["plot"]);
     let listed = String::from_utf8_lossy(&out.stdout).to_string();
@@ -374,15 +377,7 @@ fn a_trace_of_another_run_is_not_drawn_as_the_rows_convergence() {
     std::fs::write(&file, "name = \"p\"\n[defaults]\neps = [1e-3]\nseeds = 1\ncpumax = 1.0\nnrand = 1\nspend_budget = false\n[[problem]]\nplant = \"HE1\"\norders = [1, 2]\n").unwrap();
     let results = dir.path().join("r");
     let run = |args: &[&str]| {
-        let out = Command::new(BIN)
-            .args(args)
-            .arg(&file)
-            .arg("--results")
-            .arg(&results)
-            .env("HINFIX_PLANTS", concat!(env!("CARGO_MANIFEST_DIR"), "/plants"))
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "campaign {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        let out = campaign(args, &file, &results);
         format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
     };
     run(&["run", "--no-progress"]);
