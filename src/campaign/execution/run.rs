@@ -90,7 +90,7 @@ pub fn records_by_id(records: Vec<JobRecord>) -> HashMap<JobId, JobRecord> {
 }
 
 /// Every record (duplicates included) whose job is one of `jobs` and that agrees with it
-/// ([`disagreement`]; a record carrying a job's id but not its plant, order, ε, seed or
+/// (`disagreement`; a record carrying a job's id but not its plant, order, ε, seed or
 /// objective is left out: [`disagreeing_records`] names them).
 pub fn records_for(jobs: &[Job], records: &[JobRecord]) -> Vec<JobRecord> {
     let wanted: HashMap<&JobId, &Job> = jobs.iter().map(|j| (&j.id, j)).collect();

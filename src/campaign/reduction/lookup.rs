@@ -51,7 +51,7 @@ pub enum LookupError {
 
 /// The record of `entry` in the results folder `dir` (the folder holding `runs*.jsonl` and
 /// `best.csv`). A job journaled several times (a job run twice, journals merged) gives the
-/// record `campaign report` counts ([`one_record`]).
+/// record `campaign report` counts (`one_record` below).
 pub fn find_record(dir: &Path, entry: &Entry) -> Result<JobRecord, LookupError> {
     let id = match entry {
         Entry::Job(id) => id.clone(),
