@@ -162,13 +162,38 @@ fn results_entries(dir: &Path) -> Result<Vec<SourceEntry>, SourceError> {
     let best_path = dir.join("best.csv");
     let bytes = read(&best_path)?;
     let mut reader = csv::Reader::from_reader(bytes.as_slice());
-    let mut rows = Vec::new();
-    for rec in reader.deserialize::<BestRow>() {
+    let mut rows: Vec<BestRow> = Vec::new();
+    for (i, rec) in reader.deserialize::<BestRow>().enumerate() {
         let row = rec.map_err(|source| SourceError::Csv {
             path: best_path.clone(),
             line: source.position().map_or(0, |p| p.line()),
             source,
         })?;
+        // `campaign report` writes these rows; one that contradicts itself was edited or damaged
+        // (γ ≤ 0 counted as a failure, a row of 0 verified jobs with a job as solved, a second
+        // row of one entry as another plant)
+        let line = i as u64 + 2;
+        let bad = |column: &str, problem: String| SourceError::Cell {
+            path: best_path.clone(),
+            line,
+            column: column.into(),
+            problem: format!("{problem}; best.csv is damaged (`campaign report` writes it again from the journal)"),
+        };
+        if row.job_id.is_some() && !(row.gamma > 0.0 && row.gamma.is_finite()) {
+            return Err(bad("gamma", format!("a row with a verified job has γ = {}", row.gamma)));
+        }
+        if row.job_id.is_some() && row.verified == 0 {
+            return Err(bad("verified", "a row with a job counts 0 verified jobs".into()));
+        }
+        let same = |o: &BestRow| {
+            (&o.plant_fingerprint, o.order, o.objective) == (&row.plant_fingerprint, row.order, row.objective)
+        };
+        if let Some(j) = rows.iter().position(same) {
+            return Err(bad(
+                "plant",
+                format!("{} n_K = {}, {} is on line {} too", row.plant, row.order, row.objective.name(), j + 2),
+            ));
+        }
         rows.push(row);
     }
     let cpu = journal_cpu(dir)?;
@@ -403,6 +428,33 @@ mod tests {
         for (cell, says) in [("1e999", "out of the range"), ("1e-400", "out of the range"), ("0", "found `0`")] {
             let e = parse_gamma(cell).unwrap_err();
             assert!(e.contains(says) && e.contains(cell), "{cell}: {e}");
+        }
+    }
+
+    /// A results folder's best.csv that contradicts itself is refused with its line and column.
+    #[test]
+    fn a_damaged_best_csv_is_refused() {
+        use crate::campaign::reduction::reduce::BestRow;
+        let row = |gamma: f64, verified: usize| BestRow {
+            job_id: Some("j".into()),
+            gamma,
+            verified,
+            runs: 1,
+            ..BestRow::new("P".into(), "fp".into(), 1)
+        };
+        for (rows, says) in [
+            (vec![row(-0.5, 1)], "line 2, column `gamma`: a row with a verified job has γ = -0.5"),
+            (vec![row(0.5, 0)], "line 2, column `verified`"),
+            (vec![row(0.5, 1), row(0.4, 1)], "line 3, column `plant`: P n_K = 1, strong is on line 2 too"),
+        ] {
+            let d = tempfile::tempdir().unwrap();
+            let mut w = csv::Writer::from_path(d.path().join("best.csv")).unwrap();
+            for r in rows {
+                w.serialize(r).unwrap();
+            }
+            w.flush().unwrap();
+            let e = results_entries(d.path()).unwrap_err().to_string();
+            assert!(e.contains(says) && e.contains("best.csv is damaged"), "{e}");
         }
     }
 
