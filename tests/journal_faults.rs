@@ -177,3 +177,18 @@ fn a_record_that_disagrees_with_its_job_is_named_and_not_counted() {
     let runs = head.iter().position(|h| *h == "runs").unwrap();
     assert_eq!(row[runs], "1", "{best}");
 }
+
+/// A journal saved by an editor that put a UTF-8 byte-order mark at its start reads as without
+/// it (its first line was "corrupt: expected value at line 1 column 1").
+#[test]
+fn a_byte_order_mark_at_the_start_of_a_journal_is_read_past() {
+    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/report/runs.jsonl");
+    let text = std::fs::read(fixture).unwrap();
+    let plain = hinfix::campaign::parse_journal(&text, Path::new("runs.jsonl")).unwrap();
+    let with_bom = [b"\xEF\xBB\xBF".as_slice(), &text].concat();
+    let read = hinfix::campaign::parse_journal(&with_bom, Path::new("runs.jsonl")).unwrap();
+    assert!(!plain.records.is_empty());
+    assert_eq!(read.records.len(), plain.records.len());
+    assert_eq!(read.records[0].job_id, plain.records[0].job_id);
+    assert!(read.torn.is_none());
+}

@@ -179,7 +179,9 @@ pub fn read_journal(path: &Path) -> Result<JournalRead, JournalError> {
 /// Parses journal bytes (`path` names the file in errors).
 pub fn parse_journal(bytes: &[u8], path: &Path) -> Result<JournalRead, JournalError> {
     let mut out = JournalRead::default();
-    let mut offset = 0usize;
+    // a UTF-8 byte-order mark, which an editor may put at the start of a saved file, as the
+    // other JSON inputs accept it (the first line was "corrupt: expected value at column 1")
+    let mut offset = if bytes.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
     let mut line_no = 0usize;
     while offset < bytes.len() {
         line_no += 1;
