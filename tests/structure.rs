@@ -257,3 +257,23 @@ fn the_cli_designs_with_a_structure_file() {
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success() && err.contains("cli-bad.json") && err.contains("block DK"), "{err}");
 }
+
+/// A structure that fixes all of DK at a matrix for which the loop is ill posed (I − DK·D22
+/// singular) is refused before the search: every controller of it is, and the whole budget ran
+/// before the design said it could not form a closed loop.
+#[test]
+fn a_fixed_dk_that_makes_every_loop_ill_posed_is_refused_at_once() {
+    let text = std::fs::read_to_string(resolve_plant("HE1").unwrap()).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["D22"] = serde_json::json!([[1.0, 0.0]]);
+    let p = Plant::from_json_str(&v.to_string(), "he1_d22.json").unwrap();
+    let shape = ControllerShape::for_plant(&p, 0);
+    let path = temp_file("dk_singular.json", r#"{"DK": [[1.0], [0.0]]}"#);
+    let s = Structure::load(&path, shape).unwrap();
+    let e = Design::for_plant(&p, &opts(0, 0)).structure(Some(&s)).run().unwrap_err().to_string();
+    assert!(e.contains("fixes every entry of DK") && e.contains("ill posed") && e.contains("HE1"), "{e}");
+    // a DK that leaves the loop well posed designs as before
+    let fine = temp_file("dk_fine.json", r#"{"DK": [[0.5], [0.0]]}"#);
+    let s = Structure::load(&fine, shape).unwrap();
+    assert!(Design::for_plant(&p, &opts(0, 0)).structure(Some(&s)).run().is_ok());
+}

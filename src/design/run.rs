@@ -199,6 +199,7 @@ fn check(
             ));
         }
         fixed_ak_stable(s, shape, opts, plant.domain)?;
+        fixed_dk_well_posed(s, shape, problem)?;
     }
     for t in &problem.terms {
         strongly_stabilisable(&t.plant, opts)?;
@@ -454,6 +455,33 @@ fn problem_figures(fig: &mut Figures, problem: &Problem, values: &[PlantValue], 
     };
     let top = nan_max(free_max, k_term);
     fig.objective = if top == f64::NEG_INFINITY { 0.0 } else { top } + PENALTY_WEIGHT * violation;
+}
+
+/// Refuses at once a structure that fixes every entry of D_K at a matrix for which a plant's
+/// loop is ill posed (I − D_K·D22 singular, `lti::MAX_LOOP_CONDITION`): every controller of it
+/// is, and the search spent its whole budget before the closed loop could not be formed.
+fn fixed_dk_well_posed(s: &Structure, shape: ControllerShape, problem: &Problem) -> Result<(), DesignError> {
+    let ndk = shape.m * shape.p;
+    let split = shape.nvar() - ndk;
+    if ndk == 0 || s.entries()[split..].iter().any(Option::is_none) {
+        return Ok(());
+    }
+    // D_K alone decides well-posedness: the free entries may be anything (0 here)
+    let x: Vec<f64> = s.entries().iter().map(|e| e.unwrap_or(0.0)).collect();
+    for t in &problem.terms {
+        let k = shape.controller(&x).in_domain(t.plant.domain);
+        if let Err(crate::lti::LtiError::IllPosed { cond }) = closed_loop(&t.plant, &k) {
+            return Err(opt_err(
+                "structure",
+                format!(
+                    "fixes every entry of DK at a matrix for which the loop with {} is ill posed (I − DK·D22 has \
+                     condition number {cond:.3e}): no controller of this structure can be evaluated; free an entry of DK",
+                    t.plant.name
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// With the strong objective, refuses at once a structure that fixes every entry of A_K at a
