@@ -175,10 +175,11 @@ def _init_matrices(init, dt):
             raise ValueError(f"init as matrices needs (Ak, Bk, Ck, Dk), got {len(init)}")
         return [as_matrix(m, n) for m, n in zip(init, ("Ak", "Bk", "Ck", "Dk"))]
     K = system(init, "init")
-    if K.nstates > 0 and K.dt is not None and sampling_time(K, "init") != dt:
+    k_dt = sampling_time(K, "init")
+    if K.nstates > 0 and K.dt is not None and k_dt != dt:
         def domain(ts):
             return "continuous time" if ts == 0 else f"discrete time (dt = {ts:g} s)"
-        raise ValueError(f"init is in {domain(sampling_time(K, 'init'))} but the plant is in {domain(dt)}: "
+        raise ValueError(f"init is in {domain(k_dt)} but the plant is in {domain(dt)}: "
                          "give the controller in the plant's time domain")
     return [as_matrix(m, n) for m, n in zip((K.A, K.B, K.C, K.D), ("Ak", "Bk", "Ck", "Dk"))]
 

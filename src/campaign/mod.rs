@@ -30,7 +30,7 @@ mod reduction;
 pub use execution::fake::{FakeRunner, DEFAULT_PAUSE_MS, FAKE_ITERS, FAKE_RUNNER_ENV};
 pub use execution::progress::{Display as ProgressDisplay, Reporter};
 pub use execution::run::{
-    campaign_dir, disagreeing_records, duplicate_ids, journal_path, records_for, run_jobs, RunError, RunOutcome,
+    campaign_dir, duplicate_ids, journal_path, records_and_disagreements, records_for, run_jobs, RunError, RunOutcome,
 };
 pub use execution::scheduler::{
     design_job, execute, no_observers, CampaignEvent, CancelReason, Claim, Coordinator, ExecuteError, ExecuteOptions,

@@ -258,10 +258,11 @@ fn journaled(l: &Loaded, extra: &JournalArgs) -> anyhow::Result<(Vec<JobRecord>,
     let mut follower = Follower::new(dirs, files, None);
     let records = follower.poll()?;
     warn_torn(&follower.torn());
-    for why in crate::campaign::disagreeing_records(&l.jobs, &records) {
+    let (records, disagreeing) = crate::campaign::records_and_disagreements(&l.jobs, &records);
+    for why in disagreeing {
         eprintln!("warning: a record of {why} (the line is damaged or edited); not counted");
     }
-    Ok((records_for(&l.jobs, &records), follower.journals()))
+    Ok((records, follower.journals()))
 }
 
 /// `campaign status FILE`.

@@ -23,7 +23,7 @@ use crate::lti::{
 };
 
 use super::components::Components;
-use super::problem::{plant_value, PlantObjective, Problem, PENALTY_WEIGHT};
+use super::problem::{plant_value, Problem, PENALTY_WEIGHT};
 
 /// `acc += s·g`.
 fn add_scaled(acc: &mut ControllerGradient, g: &ControllerGradient, s: f64) {
@@ -119,8 +119,7 @@ pub(crate) fn performance(
         };
         // The performance phase stays among controllers that stabilise every plant (as the
         // single-plant design, where ‖Tzw‖∞ = +∞ off them): a stability measure ≥ 0 is +∞ too.
-        let unstable = t.objective == PlantObjective::Abscissa && g >= 0.0;
-        if !g.is_finite() || unstable {
+        if !g.is_finite() || t.objective.means_unstable(g) {
             c.f = if g.is_nan() { f64::NAN } else { f64::INFINITY };
             return Ok((c, None));
         }

@@ -86,6 +86,13 @@ impl PlantObjective {
         }
     }
 
+    /// Whether the value `g` of this objective means an unstable loop, which the performance
+    /// objective counts as +∞ (docs/ALGORITHMS.md §14.1): for the abscissa objective g ≥ 0 (or
+    /// NaN); the norms are +∞ there themselves.
+    pub fn means_unstable(self, g: f64) -> bool {
+        self == PlantObjective::Abscissa && !(g < 0.0)
+    }
+
     /// The quantity as a reader sees it (‖Tzw‖∞, …).
     pub fn symbol(self) -> &'static str {
         match self {
@@ -392,7 +399,7 @@ impl PlantValue {
     /// +∞ — docs/ALGORITHMS.md §14.1 — whatever the bound: α = 0.21 under a bound 1 is no loop
     /// the bound admits).
     pub fn bound_met(&self) -> bool {
-        let unstable = self.objective == PlantObjective::Abscissa && !(self.value < 0.0);
+        let unstable = self.objective.means_unstable(self.value);
         self.bound.is_none_or(|b| !unstable && self.weighted() <= b + BOUND_RTOL * b.abs())
     }
 

@@ -468,8 +468,9 @@ fn fixed_dk_well_posed(s: &Structure, shape: ControllerShape, problem: &Problem)
     }
     // D_K alone decides well-posedness: the free entries may be anything (0 here)
     let x: Vec<f64> = s.entries().iter().map(|e| e.unwrap_or(0.0)).collect();
+    let k = shape.controller(&x);
     for t in &problem.terms {
-        let k = shape.controller(&x).in_domain(t.plant.domain);
+        let k = k.clone().in_domain(t.plant.domain);
         if let Err(crate::lti::LtiError::IllPosed { cond }) = closed_loop(&t.plant, &k) {
             return Err(opt_err(
                 "structure",

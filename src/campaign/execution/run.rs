@@ -91,23 +91,24 @@ pub fn records_by_id(records: Vec<JobRecord>) -> HashMap<JobId, JobRecord> {
 
 /// Every record (duplicates included) whose job is one of `jobs` and that agrees with it
 /// (`disagreement`; a record carrying a job's id but not its plant, order, ε, seed or
-/// objective is left out: [`disagreeing_records`] names them).
+/// objective is left out: [`records_and_disagreements`] also names them).
 pub fn records_for(jobs: &[Job], records: &[JobRecord]) -> Vec<JobRecord> {
-    let wanted: HashMap<&JobId, &Job> = jobs.iter().map(|j| (&j.id, j)).collect();
-    records.iter().filter(|r| wanted.get(&r.job_id).is_some_and(|j| disagreement(j, r).is_none())).cloned().collect()
+    records_and_disagreements(jobs, records).0
 }
 
-/// The records that carry the id of one of `jobs` but disagree with it, each with the field
-/// that differs ("job 6d7025f7: eps 0.5 in the record, 1e-6 in the campaign").
-pub fn disagreeing_records(jobs: &[Job], records: &[JobRecord]) -> Vec<String> {
+/// [`records_for`], and the records that carry the id of one of `jobs` but disagree with it, each
+/// with the field that differs ("job 6d7025f7: eps 0.5 in the record, 1e-6 in the campaign").
+pub fn records_and_disagreements(jobs: &[Job], records: &[JobRecord]) -> (Vec<JobRecord>, Vec<String>) {
     let wanted: HashMap<&JobId, &Job> = jobs.iter().map(|j| (&j.id, j)).collect();
-    records
-        .iter()
-        .filter_map(|r| {
-            let why = disagreement(wanted.get(&r.job_id)?, r)?;
-            Some(format!("job {}: {why}", &r.job_id.0[..r.job_id.0.len().min(8)]))
-        })
-        .collect()
+    let (mut kept, mut disagreeing) = (Vec::new(), Vec::new());
+    for r in records {
+        let Some(job) = wanted.get(&r.job_id) else { continue };
+        match disagreement(job, r) {
+            None => kept.push(r.clone()),
+            Some(why) => disagreeing.push(format!("job {}: {why}", &r.job_id.0[..r.job_id.0.len().min(8)])),
+        }
+    }
+    (kept, disagreeing)
 }
 
 /// Why the record `r` is not the record of `job` although it carries its id: the first of its
