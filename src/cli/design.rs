@@ -457,6 +457,16 @@ pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
     s
 }
 
+/// The summary's note that ε‖K‖∞ sets the objective: active means within 0.1 % of γ or above
+/// (`design::controller_norm_active`), so "≥" is printed only where ε‖K‖∞ ≥ γ holds.
+fn controller_norm_note(eps_k: f64, gamma: f64, gamma_name: &str) -> String {
+    let relation = if eps_k >= gamma { "≥" } else { "is within 0.1 % of" };
+    format!(
+        "note:     ε‖K‖∞ = {} {relation} {gamma_name}: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets {gamma_name} go lower)\n",
+        fmt_num(eps_k, 6)
+    )
+}
+
 fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
     let mode = match opts.objective {
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
@@ -495,10 +505,7 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         s += "note:     ‖Tzw‖∞ not recomputed: interrupted (`campaign check` computes it from the controller file)\n";
     }
     if o.controller_norm_active {
-        s += &format!(
-            "note:     ε‖K‖∞ = {} ≥ {gamma_name}: the controller-norm penalty, not the closed loop, sets the objective (a smaller ε lets {gamma_name} go lower)\n",
-            fmt_num(opts.eps * o.k_hinf, 6)
-        );
+        s += &controller_norm_note(opts.eps * o.k_hinf, o.gamma, gamma_name);
     }
     // α, or in discrete time ρ (the outcome holds ρ − 1, `lti::stability_measure`)
     let (name, alpha_cl) = plant.domain.stability_quantity(o.alpha_cl);
@@ -566,6 +573,16 @@ mod tests {
         assert_eq!(jobs.len(), 1);
         assert_eq!(jobs[0].options, flags);
         assert_eq!(flags, DesignOptions { order: 2, ..DesignOptions::default() });
+    }
+
+    /// NN13 n_K = 2, ε = 1e-3: ε‖K‖∞ = 10.475971 against ‖Tzw‖∞ = 10.485645 is active (0.09 %
+    /// below) but not "≥".
+    #[test]
+    fn the_controller_norm_note_says_ge_only_where_it_holds() {
+        let below = controller_norm_note(10.475971, 10.485645, "‖Tzw‖∞");
+        assert!(below.contains("ε‖K‖∞ = 10.475971 is within 0.1 % of ‖Tzw‖∞"), "{below}");
+        let above = controller_norm_note(10.5, 10.485645, "‖Tzw‖∞");
+        assert!(above.contains("ε‖K‖∞ = 10.500000 ≥ ‖Tzw‖∞"), "{above}");
     }
 
     #[test]
