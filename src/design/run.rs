@@ -272,7 +272,7 @@ fn how_it_ended(
         DesignStatus::NotStabilised { best_alpha: res.stab.f }
     } else if res.truncated {
         DesignStatus::BudgetExhausted
-    } else if res.perf.as_ref().is_none_or(|b| b.x == b.from) {
+    } else if res.perf.as_ref().is_none_or(|b| !b.moved) {
         DesignStatus::StabilisedOnly
     } else if res.perf.as_ref().is_some_and(|b| b.dnorm <= opts.normtol) {
         DesignStatus::Converged

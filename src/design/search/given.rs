@@ -57,7 +57,7 @@ impl Search<'_, '_, '_> {
                 let x = given[i].clone();
                 let (dnorm, evaldist, coords) = (f64::INFINITY, f64::NAN, Coords::Raw);
                 let start = plan.position_of(i);
-                st.perf = Some(Best { from: x.clone(), x, f, dnorm, evaldist, start, coords, verified: true });
+                st.perf = Some(Best { x, f, dnorm, evaldist, start, moved: false, coords, verified: true });
                 st.stabilised = true;
             }
         }

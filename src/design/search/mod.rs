@@ -65,8 +65,12 @@ pub(crate) struct Best {
     pub evaldist: f64,
     /// The local search that produced it.
     pub start: usize,
-    /// The stable point its f_h local search started from (to tell whether it moved).
-    pub from: Vec<f64>,
+    /// Whether a local search reached it by moving: its f_h local search ended away from its
+    /// start, or it is the incumbent's point again (a resumed local search that could not move
+    /// it, replacing it on a tie) and the incumbent was so reached. False for the f_s points, the
+    /// given controllers, and f_h end points no local search moved: the run's status calls a
+    /// result that is such a point "stabilised only" (`design::run`).
+    pub moved: bool,
     /// The coordinates of the local search that produced it.
     pub coords: Coords,
     /// Whether it is stable with the verification margin (f_h points; [`verified`]).
@@ -178,7 +182,7 @@ impl<'s> State<'s> {
         if self.stab.is_none() || f < old {
             let verified = false; // not asked of f_s points
             self.stab =
-                Some(Best { from: x.clone(), x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, coords, verified });
+                Some(Best { x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, moved: false, coords, verified });
         }
         better
     }
@@ -197,8 +201,9 @@ impl<'s> State<'s> {
         // A tie with a better certificate replaces (a local search that could not move its
         // start, a given point offered uncertified: module `given`).
         if r.f.is_finite() && (upgrade || r.f < old || (r.f == old && r.dnorm < old_dnorm)) {
-            let (x, from) = (r.x.clone(), from.to_vec());
-            self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, from, coords, verified });
+            let moved = r.x != from || self.perf.as_ref().is_some_and(|b| b.moved && b.x == r.x);
+            let x = r.x.clone();
+            self.perf = Some(Best { x, f: r.f, dnorm: r.dnorm, evaldist: r.evaldist, start, moved, coords, verified });
             // Cut by `maxit`, or by the search's share of a budget (`return_gs_reserve` may give
             // the search more).
             self.perf_cut =
@@ -405,7 +410,7 @@ impl Search<'_, '_, '_> {
             dnorm: f64::NAN,
             evaldist: f64::NAN,
             start: 0,
-            from: first[0].clone(),
+            moved: false,
             coords: Coords::Raw,
             verified: false,
         });
@@ -439,6 +444,26 @@ mod tests {
     /// `offer_perf`: a verified point beats an unverified one whatever their f_h; among points of
     /// one kind the smaller f_h wins (module `verified`).
     #[test]
+    fn a_resumed_search_that_cannot_move_the_incumbent_keeps_it_moved() {
+        let opts = DesignOptions::default();
+        let mut st = State::new(&opts);
+        let at = |x: f64, f: f64, dnorm: f64| OptimResult { x: vec![x], ..end(f, dnorm, Termination::CpuBudget) };
+        // a local search from 0 ends at 1 (cut by its budget share): moved
+        assert!(st.offer_perf(&at(1.0, 2.0, 5.0), &[0.0], 0, Coords::Raw, true));
+        assert!(st.perf.as_ref().unwrap().moved);
+        // resumed from 1, it cannot move; the tie with a smaller dnorm replaces the incumbent,
+        // which is still a point a local search reached by moving (NN13 n_K = 2 was called
+        // "stabilised only" at γ = 10.4842, 0.6 below every start)
+        st.offer_perf(&at(1.0, 2.0, 1.0), &[1.0], 1, Coords::Raw, true);
+        let b = st.perf.as_ref().unwrap();
+        assert_eq!((b.start, b.dnorm), (1, 1.0));
+        assert!(b.moved);
+        // a local search that ends where it started, below the incumbent: a point nothing moved
+        st.offer_perf(&at(3.0, 1.5, 1.0), &[3.0], 2, Coords::Raw, true);
+        assert!(!st.perf.as_ref().unwrap().moved);
+    }
+
+    #[test]
     fn a_verified_point_beats_an_unverified_one() {
         let opts = DesignOptions::default();
         let mut st = State::new(&opts);
@@ -465,7 +490,7 @@ mod tests {
             dnorm: 0.0,
             evaldist: 0.0,
             start: 0,
-            from: vec![1.0],
+            moved: false,
             coords: Coords::Raw,
             verified: true,
         };
