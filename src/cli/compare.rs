@@ -18,7 +18,7 @@ pub struct CompareArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Relative tolerance of a tie (and of "best" in the tables).
-    #[arg(long, value_name = "RTOL", default_value_t = DEFAULT_RTOL)]
+    #[arg(long, value_name = "RTOL", default_value_t = DEFAULT_RTOL, allow_hyphen_values = true)]
     pub rtol: f64,
 }
 

@@ -38,7 +38,7 @@ pub struct ExportArgs {
     #[arg(long, requires_all = ["results", "order"], conflicts_with = "job")]
     pub plant: Option<String>,
     /// With --results and --plant: the controller order n_K.
-    #[arg(long, requires = "plant")]
+    #[arg(long, requires = "plant", allow_hyphen_values = true)]
     pub order: Option<usize>,
     /// With --plant: the objective of the row (default: the strong row when the campaign ran
     /// both).

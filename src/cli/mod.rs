@@ -167,6 +167,24 @@ mod tests {
         assert_eq!(super::error_text(&e), "reading the trace: x.mcap: No such file");
     }
 
+    /// A negative number given to a numeric flag is that flag's value, for its own check to
+    /// answer ("--rtol must be in [0, 1), found -1"), not clap's "unexpected argument '-1'".
+    #[test]
+    fn numeric_flags_take_negative_values() {
+        use clap::Parser;
+        for argv in [
+            &["campaign", "compare", "--out", "o", "--rtol", "-1", "a=x", "b=y"][..],
+            &["campaign", "export", "--results", "r", "--plant", "P", "--order", "-1"][..],
+            &["campaign", "design", "--plant", "P", "--order", "1", "--out", "K.json", "--eps", "-1"][..],
+        ] {
+            if let Err(e) = super::Cli::try_parse_from(argv) {
+                // export's --order is a usize: clap's own "invalid value '-1'" names the flag
+                let e = e.to_string();
+                assert!(!e.contains("unexpected argument") && e.contains("-1"), "{argv:?}: {e}");
+            }
+        }
+    }
+
     #[test]
     fn numbers_stay_short() {
         assert_eq!(fmt_num(0.123456789, 6), "0.123457");

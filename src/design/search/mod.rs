@@ -181,8 +181,7 @@ impl<'s> State<'s> {
         let better = improves(f, old, self.opts.stall_rtol, 1.0);
         if self.stab.is_none() || f < old {
             let verified = false; // not asked of f_s points
-            self.stab =
-                Some(Best { x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, moved: false, coords, verified });
+            self.stab = Some(Best { x, f, dnorm: f64::NAN, evaldist: f64::NAN, start, moved: false, coords, verified });
         }
         better
     }
