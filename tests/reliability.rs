@@ -664,3 +664,21 @@ fn closed_stdout_ends_printing_commands_quietly() {
         );
     }
 }
+
+/// `campaign design … | head -1`: a stdout closed before the summary is printed ends the
+/// command with its own exit code and the controller written, not with the panic of `print!`
+/// ("failed printing to stdout").
+#[test]
+fn a_closed_stdout_does_not_make_design_panic() {
+    let dir = scratch("closed-stdout");
+    let out = dir.join("K.json");
+    let mut c = design_cli("HE1", "1", &out, &["--maxevals", "200"]);
+    let mut child = c.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    drop(child.stdout.take()); // the reader goes away before anything is printed
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_no_panic(&stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

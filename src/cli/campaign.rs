@@ -11,7 +11,7 @@ use crate::campaign::{
 };
 use anyhow::Context;
 
-use super::{signals, EXIT_JOBS_FAILED};
+use super::{print_out, signals, EXIT_JOBS_FAILED};
 
 /// Where campaign results go unless `--results` says otherwise.
 const DEFAULT_RESULTS: &str = "results";
@@ -152,9 +152,9 @@ fn budget_note(c: &Campaign, compare: &[crate::campaign::CompareRow]) -> Option<
 /// prints the comparison, and how many jobs were journaled more than once.
 fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Result<crate::campaign::CampaignReport> {
     let report = crate::campaign::report(dir, c, records)?;
-    print!("{}", report.summary);
+    print_out(&report.summary.to_string()).context("writing to stdout")?;
     if let Some(note) = budget_note(c, &report.summary.compare) {
-        println!("{note}");
+        print_out(&format!("{note}\n")).context("writing to stdout")?;
     }
     let dups = &report.duplicates;
     if !dups.is_empty() {
@@ -394,7 +394,7 @@ pub fn plot(a: PlotArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<Exi
     let (plants, problems) = (plant_map(&l.campaign), crate::campaign::problem_map(&l.campaign));
     let s = crate::campaign::plot::write_plots(&l.dir, &records, &plants, &problems, &reference, &library)?;
     for f in &s.files {
-        println!("{}", f.display());
+        print_out(&format!("{}\n", f.display())).context("writing to stdout")?;
     }
     for why in &s.skipped {
         eprintln!("skipped: {why}");

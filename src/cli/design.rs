@@ -38,7 +38,7 @@ use crate::fs_atomic::write_atomic;
 use crate::lti::{resolve_plant, Controller, Plant};
 use anyhow::Context;
 
-use super::{fmt_num, signals, EXIT_BOUND_VIOLATED, EXIT_NOT_STABILISED};
+use super::{fmt_num, print_out, signals, EXIT_BOUND_VIOLATED, EXIT_NOT_STABILISED};
 use crate::campaign::for_terminal;
 
 /// The default of a flag: the option's default ([`DesignOptions::default`], the option table of
@@ -321,9 +321,9 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
         }
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&outcome)?);
+        print_out(&(serde_json::to_string_pretty(&outcome)? + "\n")).context("writing to stdout")?;
     } else {
-        print!("{}", summary(plant, &opts, &outcome));
+        print_out(&summary(plant, &opts, &outcome)).context("writing to stdout")?;
     }
     let what = match (&a.out, &written, good) {
         (None, _, _) => "no --out: no controller file written (the JSON above holds it, `controller`)".to_string(),
@@ -344,7 +344,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     if a.json {
         eprintln!("{what}");
     } else {
-        println!("{what}");
+        print_out(&format!("{what}\n")).context("writing to stdout")?;
     }
     Ok(match outcome.status {
         DesignStatus::Interrupted => ExitCode::from(signals::exit_code()),

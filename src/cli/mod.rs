@@ -140,6 +140,20 @@ fn run_command_line(fake: Option<Box<dyn JobRunner>>) -> ExitCode {
     }
 }
 
+/// Prints `text` on stdout for the commands that write files (`run`, `design`, `plot`, which keep
+/// the default SIGPIPE handling off, [`signals::end_quietly_on_closed_stdout`]): a closed stdout
+/// (`campaign design … | head -3`) drops the rest of the text, as the reader asked, where
+/// `print!` panicked with "failed printing to stdout" after the files were written. Any other
+/// write error is returned.
+pub(crate) fn print_out(text: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => r,
+    }
+}
+
 /// An error and its causes, each cause left out when the text before it already contains it
 /// (many errors print their source in their own message: `{e:#}` alone repeated it).
 fn error_text(e: &anyhow::Error) -> String {
