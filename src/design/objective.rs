@@ -401,12 +401,19 @@ impl DesignObjective<'_> {
 
     /// Whether the controller's term of the strong objective sets f at a point of components `c`:
     /// ε‖K‖∞ > ‖Tzw‖∞ in the performance phase, ε·α(Ak) > α(A_cl) when stabilising (false for
-    /// order 0, whose α(Ak) is NaN, and without `strong`).
+    /// order 0, whose α(Ak) is NaN, and without `strong`). For a problem of several plants
+    /// (`multi_objective`), `c.gamma` is the largest weighted value of the unbounded plants (NaN
+    /// if every plant has a bound: then the controller's term, where there is one, is the only
+    /// one), and the term is ε·α(Ak) where [`Problem::controller_term_is_abscissa`].
     fn controller_term_sets_f(&self, c: &Components) -> bool {
         self.strong
-            && match self.phase {
-                ObjectivePhase::Performance => self.eps * c.k_hinf > c.gamma,
-                ObjectivePhase::Stabilisation => self.eps * c.alpha_k > c.alpha_cl,
+            && match (self.phase, self.problem) {
+                (ObjectivePhase::Performance, None) => self.eps * c.k_hinf > c.gamma,
+                (ObjectivePhase::Performance, Some(p)) => {
+                    let term = if p.controller_term_is_abscissa() { c.alpha_k } else { c.k_hinf } * self.eps;
+                    term > c.gamma || (c.gamma.is_nan() && term.is_finite())
+                }
+                (ObjectivePhase::Stabilisation, _) => self.eps * c.alpha_k > c.alpha_cl,
             }
     }
 
@@ -512,9 +519,9 @@ impl Objective for DesignObjective<'_> {
 
     /// ε where the controller's term ε·‖K‖∞ (ε·α(Ak) when stabilising) sets f at `x`, else 1:
     /// the certificate then weighs that term's gradient as ∇‖K‖∞, not ε∇‖K‖∞
-    /// (docs/ALGORITHMS.md §7.3). A problem of several plants, or a point no longer cached: 1.
+    /// (docs/ALGORITHMS.md §7.3), for one plant or several. A point no longer cached: 1.
     fn gradient_unit(&self, x: &[f64]) -> f64 {
-        if !self.strong || self.problem.is_some() || !(self.eps > 0.0) {
+        if !self.strong || !(self.eps > 0.0) {
             return 1.0;
         }
         let Some(c) = self.cache.borrow().lookup(x) else { return 1.0 };
