@@ -303,3 +303,24 @@ fn per_plant_flags_are_given_once_or_once_per_plant() {
     assert!(!ok && err.contains("weight"), "{err}");
     assert!(!Path::new(&k).exists(), "nothing written on an error");
 }
+
+/// `controller_norm_active` of a problem compares ε‖K‖∞ with the minimised plants' max: true for
+/// HE1 with weight 1 + 1e-7 at order 0 (the optimum is on the ridge ‖Tzw‖∞ = ε‖K‖∞, as for HE1
+/// alone); false where every plant has a bound (γ is then the bounded plants' max, which the
+/// objective does not minimise: "a smaller ε lets γ go lower" was printed beside it) and where
+/// a violated bound's penalty is in the objective.
+#[test]
+fn the_controller_norm_is_active_only_against_minimised_plants() {
+    let he1 = || Plant::load(format!("{}/plants/HE1.json", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let first_starts = DesignOptions { order: 0, stall_starts: 0, ..Default::default() };
+    let weighted = Problem { terms: vec![term(he1(), PlantObjective::Hinf, 1.0 + 1e-7, None)] };
+    assert!(design(&weighted, &first_starts, None).unwrap().controller_norm_active);
+    let bounded = Problem { terms: vec![term(he1(), PlantObjective::Hinf, 1.0, Some(0.2))] };
+    let o = design(&bounded, &DesignOptions { order: 1, eps: 1.0, ..opts(1, 0, 4000) }, None).unwrap();
+    assert!(o.objective > o.gamma, "ε‖K‖∞ = {} is the objective, γ = {}", o.k_hinf, o.gamma);
+    assert!(!o.controller_norm_active);
+    // a bound no controller of order 0 meets (HE1's optimum is 0.1541): violated, penalised
+    let violated = Problem { terms: vec![term(he1(), PlantObjective::Hinf, 1.0, Some(0.1))] };
+    let o = design(&violated, &first_starts, None).unwrap();
+    assert!(!o.plants[0].bound_met() && !o.controller_norm_active, "{:?}", o.plants);
+}

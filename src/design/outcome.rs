@@ -261,7 +261,11 @@ pub struct DesignOutcome {
     /// Whether ε‖K‖∞ is the active term of the final objective max(‖Tzw‖∞, ε‖K‖∞) (at least
     /// ‖Tzw‖∞ within [`crate::lti::NORM_TIE_RTOL`], 0.1 %): the controller-norm penalty, not
     /// the closed loop, sets the objective (strong stabilisation only; a smaller ε would let γ go
-    /// lower). Never where the controller's term is ε·s(Ak) (an abscissa problem).
+    /// lower). For a problem of several plants, ε‖K‖∞ against the largest weighted value of the
+    /// plants without a bound. Never where the controller's term is ε·s(Ak) (an abscissa
+    /// problem), where every plant has a bound (ε‖K‖∞ is then the objective by design: the
+    /// smallest controller meeting the bounds), where a bound is violated (its penalty is in the
+    /// objective), or where no variable is free.
     #[serde(default)]
     pub controller_norm_active: bool,
     /// Optimality certificate of the final point, if the optimisation phase ran.

@@ -330,8 +330,20 @@ fn outcome(
         alpha_cl: fig.alpha_cl,
         alpha_k: fig.alpha_k,
         objective: fig.objective,
-        controller_norm_active: !problem.controller_term_is_abscissa()
-            && controller_norm_active(opts, fig.gamma, fig.k_hinf),
+        controller_norm_active: search.stop != SearchStop::NoFreeVariable
+            && match plants.as_slice() {
+                [] => controller_norm_active(opts, fig.gamma, fig.k_hinf),
+                values => {
+                    // against the minimised plants' max (not γ, which is the bounded plants' max
+                    // when every plant has a bound), and not where a violated bound's penalty
+                    // is in the objective
+                    let (free_max, violation) = plant_part(values);
+                    !problem.controller_term_is_abscissa()
+                        && free_max > f64::NEG_INFINITY
+                        && violation == 0.0
+                        && controller_norm_active(opts, free_max, fig.k_hinf)
+                }
+            },
         certificate,
         iterations: phases.iter().map(|p| p.iters).sum(),
         evaluations: phases.iter().map(|p| p.evals).sum(),
