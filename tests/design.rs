@@ -642,3 +642,23 @@ fn a_design_too_large_for_bfgs_is_refused_at_once() {
     let text = e.to_string();
     assert!(text.starts_with("invalid design option `order`: 142 gives") && text.contains("more than 20000"), "{text}");
 }
+
+/// A static gain of HE1 at the stability boundary (α(A_cl) = −5e-17, found by bisection: stable
+/// by its eigenvalues, not with the verification margin) is unstable for the evaluation that
+/// `check` and the reports use: its ‖Tzw‖∞ is +∞, as the design's would be, and so are ‖Tzw‖₂
+/// and 1/r_C (`check` printed ‖Tzw‖∞ = 1.1e14 beside "UNSTABLE").
+#[test]
+fn a_loop_inside_the_verification_margin_has_no_finite_norm() {
+    let p = plant("HE1");
+    let mut k = Controller::zeros(0, 2, 1);
+    (k.dk[(0, 0)], k.dk[(1, 0)]) = (0.018899645451758703, 0.3230194891325363);
+    let alpha = spectral_abscissa(closed_loop(&p, &k).unwrap().a.as_ref());
+    assert!(alpha < 0.0 && alpha > -1e-12, "α(A_cl) = {alpha:e}");
+    let e = hinfix::design::evaluate_plant(&p, &k);
+    let l = e.plants[0].closed_loop.as_ref().unwrap();
+    assert!(!l.stability.is_stable());
+    assert_eq!(l.hinf.value, f64::INFINITY);
+    let d = hinfix::design::loop_details(&p, &k, &l.hinf).unwrap();
+    assert_eq!((d.h2, d.inverse_radius), (f64::INFINITY, Some(f64::INFINITY)));
+    assert!(d.peak_freqs.is_empty());
+}

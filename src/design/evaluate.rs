@@ -219,7 +219,9 @@ pub fn evaluate_plant(plant: &Plant, k: &Controller) -> Evaluation {
 fn plant_evaluation(plant: &Plant, k: &Controller) -> PlantEvaluation {
     let closed_loop = closed_loop(plant, k).map(|cl| {
         let stability = verified_stability(plant.domain, cl.a.as_ref());
-        let h = hinf_norm_checked(plant.domain, &cl);
+        // a loop not stable with the margin is unstable here: its norm is +∞, as the design's
+        // (a finite ‖Tzw‖∞ = 1.1e14 was printed beside "UNSTABLE" for α(A_cl) = −4e-16)
+        let h = if stability.is_stable() { hinf_norm_checked(plant.domain, &cl) } else { HinfNorm::UNSTABLE };
         // in rad/s (a discrete norm's θ is in rad/sample)
         LoopEvaluation {
             stability,
@@ -307,6 +309,11 @@ pub struct LoopDetails {
 /// peak in rad/s).
 pub fn loop_details(plant: &Plant, k: &Controller, hinf: &HinfNorm) -> Result<LoopDetails, LtiError> {
     let cl = closed_loop(plant, k)?;
+    if !hinf.value.is_finite() {
+        // unstable (with the margin, `plant_evaluation`): every norm of it is +∞
+        let inverse_radius = (!plant.domain.is_discrete()).then_some(f64::INFINITY);
+        return Ok(LoopDetails { peak_freqs: Vec::new(), h2: f64::INFINITY, inverse_radius });
+    }
     let peak_freqs = near_peak_frequencies(plant.domain, &cl, hinf, NORM_TIE_RTOL);
     let params = HinfParams::default();
     let value = |o: PlantObjective| plant_value(plant, o, k, &params).map_or(f64::INFINITY, |(v, _)| v);
