@@ -52,12 +52,12 @@ pub use kernels::spectral::{
 pub use norms::discrete::{
     closed_loop_hinf_grad_discrete, controller_hinf_grad_discrete, hinf_norm_discrete, hinf_norm_grad_discrete,
 };
+pub(crate) use norms::domain::stability_measure_of;
 pub use norms::domain::{
     closed_loop_h2_grad_in, closed_loop_hinf_grad, closed_loop_stability_grad, controller_hinf_grad,
     controller_stability_grad, hinf_norm_in, stability_measure, verified_stability, verified_stability_measure,
     VerifiedStability,
 };
-pub(crate) use norms::domain::{hinf_norm_with_poles_in, stability_measure_of};
 pub use norms::gradient::{
     closed_loop_abscissa_grad, closed_loop_radius_grad, controller_abscissa_grad, controller_radius_grad,
     ControllerGradient,
@@ -71,8 +71,8 @@ pub use norms::hinf::{
     MAX_EXPLICIT_HAMILTONIAN_COND, MAX_LEVEL_SET_ITERS, MIN_HINF_TOL,
 };
 pub use norms::sigma::{
-    frequency_band, hinf_norm_checked, near_peak_frequencies, sigma_curve, NORM_TIE_RTOL, SIGMA_BASE_POINTS,
-    SIGMA_MAX_POINTS, SIGMA_STEP_RTOL,
+    frequency_band, hinf_norm_checked, hinf_norm_checked_with, near_peak_frequencies, sigma_curve, NORM_TIE_RTOL,
+    SIGMA_BASE_POINTS, SIGMA_MAX_POINTS, SIGMA_STEP_RTOL,
 };
 pub use norms::stability_radius::{closed_loop_inverse_stability_radius_grad, inverse_stability_radius};
 pub use synthesis::balanced_truncation::{

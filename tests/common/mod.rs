@@ -197,14 +197,22 @@ fn check_tabular(cols: usize, rows: &[String], longtable: bool) -> Result<(), St
 /// σmax(C (iωI − A)⁻¹ B + D) by a dense complex LU (independent of the library's Hessenberg
 /// path); σmax(D) at ω = ∞ or for a static system.
 pub fn sigma_direct(sys: &hinfix::lti::StateSpace, w: f64) -> f64 {
+    if !w.is_finite() || sys.order() == 0 {
+        return sys.d.singular_values().unwrap().into_iter().fold(0.0, f64::max);
+    }
+    sigma_at(sys, faer::c64::new(0.0, w))
+}
+
+/// σmax(D + C(sI − A)⁻¹B) at a complex point s (e^{iθ} for a discrete-time system), by a dense
+/// complex solve.
+#[allow(dead_code)]
+pub fn sigma_at(sys: &hinfix::lti::StateSpace, s: faer::c64) -> f64 {
     use faer::c64;
     use faer::linalg::solvers::Solve;
     use faer::Mat;
     let n = sys.order();
-    if !w.is_finite() || n == 0 {
-        return sys.d.singular_values().unwrap().into_iter().fold(0.0, f64::max);
-    }
-    let z = Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], if i == j { w } else { 0.0 }));
+    let z =
+        Mat::<c64>::from_fn(n, n, |i, j| c64::new(-sys.a[(i, j)], 0.0) + if i == j { s } else { c64::new(0.0, 0.0) });
     let b = Mat::<c64>::from_fn(n, sys.inputs(), |i, j| c64::new(sys.b[(i, j)], 0.0));
     let x = z.partial_piv_lu().solve(&b);
     let g = Mat::<c64>::from_fn(sys.outputs(), sys.inputs(), |i, j| {

@@ -20,7 +20,7 @@ use super::gradient::{
     controller_hinf_grad_continuous, controller_radius_grad, ControllerGradient,
 };
 use super::h2::{closed_loop_h2_grad, closed_loop_h2_grad_discrete};
-use super::hinf::{hinf_norm, hinf_norm_with_poles, HinfNorm, HinfParams};
+use super::hinf::{hinf_norm, HinfNorm, HinfParams};
 use crate::lti::error::LtiError;
 use crate::lti::interrupt::Interrupted;
 use crate::lti::kernels::balance::balanced_for_eigenvalues;
@@ -122,22 +122,6 @@ pub fn controller_stability_grad(k: &Controller) -> (f64, ControllerGradient) {
 pub fn hinf_norm_in(domain: TimeDomain, sys: &StateSpace, params: &HinfParams<'_>) -> Result<HinfNorm, Interrupted> {
     match domain {
         TimeDomain::Continuous => hinf_norm(sys, params),
-        TimeDomain::Discrete { .. } => hinf_norm_discrete(sys, params),
-    }
-}
-
-/// [`hinf_norm_in`] when the poles (eigenvalues of `sys.a`) are already known, shared with the
-/// stability test: in continuous time they serve the norm (`hinf_norm_with_poles`; the data must
-/// be finite, and `params.stop` is first polled after the stability test), the discrete-time norm
-/// computes its own.
-pub(crate) fn hinf_norm_with_poles_in(
-    domain: TimeDomain,
-    sys: &StateSpace,
-    poles: &[c64],
-    params: &HinfParams<'_>,
-) -> Result<HinfNorm, Interrupted> {
-    match domain {
-        TimeDomain::Continuous => hinf_norm_with_poles(sys, poles, params),
         TimeDomain::Discrete { .. } => hinf_norm_discrete(sys, params),
     }
 }

@@ -370,19 +370,6 @@ pub fn hinf_lower_bound_sharing(sys: &StateSpace, freqs: &[f64], wanted: f64, sl
     })
 }
 
-/// [`hinf_norm`] when the poles (eigenvalues of A) are already known (shared with the stability
-/// test). The data must be finite; `params.reuse` is not looked at, and unlike [`hinf_norm`]
-/// `params.stop` is first polled after the stability test.
-pub(crate) fn hinf_norm_with_poles(
-    sys: &StateSpace,
-    poles: &[c64],
-    params: &HinfParams<'_>,
-) -> Result<HinfNorm, Interrupted> {
-    let HinfParams { tol, hints, stop, enough, reuse: _ } = *params;
-    let working = Working::of(sys);
-    measured(sys, Step::Norm, || hinf_norm_from(&working.sys, poles, &mut None, tol, hints, stop, enough))
-}
-
 /// The norm when the poles (eigenvalues of A) are known, reusing the frequency-response
 /// evaluator of `sys` in `fr` if there is one (and leaving the one it makes there). The data
 /// must be finite.
