@@ -345,3 +345,20 @@ fn a_plant_from_its_matrices_is_the_plant_of_its_file() {
     let err = Plant::from_matrices("T", refs).unwrap_err();
     assert!(err.to_string().contains("D12"), "{err}");
 }
+
+/// A plant library folder that is not there (HINFIX_PLANTS pointing nowhere) is named in the
+/// error, not listed as a library of no plants ("known: ").
+#[test]
+fn a_library_folder_that_is_not_there_is_named() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_campaign"))
+        .args(["plant", "HE1"])
+        .env("HINFIX_PLANTS", "/nonexistent/hinfix-plants")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the library folder /nonexistent/hinfix-plants is not a folder (from HINFIX_PLANTS)"),
+        "{err}"
+    );
+}

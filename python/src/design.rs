@@ -70,12 +70,6 @@ pub fn design<'py>(
         (None, Some(path)) => Some(Structure::load(&path, shape).map_err(|e| bad_input("structure", e))?),
         (None, None) => None,
     };
-    if structure.as_ref().is_some_and(|s| s.nfree() == 0) {
-        return Err(bad_input(
-            "structure",
-            "no entry is free (null in JSON, NaN in arrays): there is nothing to design",
-        ));
-    }
     let used = serde_json::to_string(&opts).map_err(|e| failure("design options", e))?;
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);

@@ -84,8 +84,13 @@ def test_a_structure_fixes_entries_bit_for_bit(he1):
     dk[1, 0] = 0.25
     K, info = hinfix.design(P, nmeas, ncon, 1, structure={"DK": dk, "AK": [[-1.0]]}, **BUDGET)
     assert K.D[1, 0] == 0.25 and K.A[0, 0] == -1.0 and info.stabilised
-    with pytest.raises(ValueError, match="nothing to design"):
-        hinfix.design(P, nmeas, ncon, 0, structure={"DK": np.zeros((ncon, nmeas))})
+    # every entry fixed: evaluated once and answered at once, as by `campaign design` (HE1's
+    # optimal static gain at ε = 1e-3)
+    dk = [[8.99941740947262], [153.81173268664625]]
+    K, info = hinfix.design(P, nmeas, ncon, 0, structure={"DK": dk})
+    assert info.search["stop"] == "no_free_variable" and info.evaluations == 1
+    assert K.D[0, 0] == dk[0][0] and K.D[1, 0] == dk[1][0]
+    assert info.stabilised and abs(info.gamma - 0.154124) < 1e-6
 
 
 def test_k_is_named_after_the_plants_partition_and_closes_the_loop(he1):

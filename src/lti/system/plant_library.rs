@@ -125,7 +125,14 @@ pub fn resolve_plant(name_or_path: &str) -> Result<PathBuf, PlantError> {
         })
         .unwrap_or_default();
     // The whole list only while it is short: the library holds about 150 plants.
+    let dir = plants_dir();
     let known = match names.len() {
+        // a library folder that is not there (HINFIX_PLANTS pointing nowhere) is named as such
+        0 if !dir.is_dir() => format!(
+            "none: the library folder {} is not a folder{}",
+            dir.display(),
+            if std::env::var_os(PLANTS_ENV).is_some() { format!(" (from {PLANTS_ENV})") } else { String::new() }
+        ),
         0..=KNOWN_LISTED => names.join(", "),
         n => format!("{n} plants, listed by `campaign plants`"),
     };
