@@ -30,7 +30,51 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }
+    remove_dead_writers_tmp(path);
     sync_dir(path)
+}
+
+/// Removes the tmp files of `path` (step 1 of the module docs) that processes of this host left
+/// and that are no longer running: a second Ctrl-C ends a process at once, between its tmp write
+/// and its rename, and nothing else would ever remove its `.best.csv.<host>.<pid>.<seq>.tmp`.
+/// A process that still runs (or that this user may not signal) keeps its file, and so does
+/// another host's. Best effort.
+fn remove_dead_writers_tmp(path: &Path) {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name().and_then(|n| n.to_str())) else { return };
+    let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+    let prefix = format!(".{name}.{}.", host_name());
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)).and_then(|r| r.strip_suffix(".tmp"))
+        else {
+            continue;
+        };
+        let Some(pid) =
+            rest.split_once('.').and_then(|(pid, seq)| seq.parse::<usize>().ok().and(pid.parse::<i32>().ok()))
+        else {
+            continue;
+        };
+        if pid > 0 && pid != std::process::id() as i32 && !process_runs(pid) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Whether a process `pid` exists on this host (`kill(pid, 0)`: only ESRCH means it does not).
+fn process_runs(pid: i32) -> bool {
+    // SAFETY: signal 0 sends nothing; it only checks that the process exists.
+    let rc = unsafe { libc::kill(pid, 0) };
+    rc == 0 || io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+}
+
+/// [`std::fs::create_dir_all`], whose error for a path component that is a file — "File exists
+/// (os error 17)", "Not a directory (os error 20)" — names that file as no folder.
+pub fn create_dir_all(dir: &Path) -> io::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| match dir.ancestors().find(|a| a.exists() && !a.is_dir()) {
+        Some(file) => io::Error::new(e.kind(), format!("{} is a file, not a folder", file.display())),
+        None => e,
+    })
 }
 
 /// Whether `path` can be written by [`write_atomic`]: a tmp file of the same unique name scheme
@@ -98,6 +142,39 @@ mod tests {
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    /// The tmp file of a writer that died before its rename (a second Ctrl-C) goes with the
+    /// next write of the file; one of a process that still runs, or of another host, stays.
+    #[test]
+    fn a_dead_writers_tmp_file_goes_with_the_next_write() {
+        let d = scratch("dead");
+        let p = d.join("best.csv");
+        let host = host_name();
+        // a process id that is not running: a child that has exited and been reaped
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let dead_tmp = d.join(format!(".best.csv.{host}.{dead}.0.tmp"));
+        let live_tmp = d.join(format!(".best.csv.{host}.1.0.tmp")); // init: always runs
+        let other_host = d.join(format!(".best.csv.{host}-elsewhere.{dead}.0.tmp"));
+        for f in [&dead_tmp, &live_tmp, &other_host] {
+            std::fs::write(f, b"half").unwrap();
+        }
+        write_atomic(&p, b"new\n").unwrap();
+        assert!(!dead_tmp.exists());
+        assert!(live_tmp.exists() && other_host.exists());
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn a_file_in_the_way_of_a_folder_is_named() {
+        let d = scratch("in-the-way");
+        std::fs::write(d.join("claims"), b"").unwrap();
+        let e = create_dir_all(&d.join("claims").join("x")).unwrap_err();
+        assert_eq!(e.to_string(), format!("{} is a file, not a folder", d.join("claims").display()));
+        create_dir_all(&d.join("ok").join("x")).unwrap();
+        let _ = std::fs::remove_dir_all(&d);
     }
 
     #[test]

@@ -170,7 +170,7 @@ fn report_into(dir: &Path, c: &Campaign, records: &[JobRecord]) -> anyhow::Resul
 /// `campaign run FILE`.
 pub fn run(a: RunArgs, fake: Option<Box<dyn JobRunner>>) -> anyhow::Result<ExitCode> {
     let l = load(&a.campaign, fake)?;
-    std::fs::create_dir_all(&l.dir).with_context(|| format!("creating {}", l.dir.display()))?;
+    crate::fs_atomic::create_dir_all(&l.dir).with_context(|| format!("creating {}", l.dir.display()))?;
     let jobs = match a.shard {
         Some(s) => shard_jobs(&l.jobs, s),
         None => l.jobs.clone(),

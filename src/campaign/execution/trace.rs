@@ -218,7 +218,7 @@ impl TraceWriter {
         let host = crate::campaign::leaves::provenance::host_name();
         let tmp = dir.join(format!("{job_id}.mcap.{host}.{}.tmp", std::process::id()));
         let io = |source| TraceError::Io { path: tmp.clone(), source };
-        std::fs::create_dir_all(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?;
+        crate::fs_atomic::create_dir_all(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?;
         let stale = format!("{job_id}.mcap.");
         for e in std::fs::read_dir(dir).map_err(|source| TraceError::Io { path: dir.to_path_buf(), source })?.flatten()
         {

@@ -82,7 +82,7 @@ pub enum SpecProblem {
     #[error("campaign name is longer than {MAX_NAME_CHARS} characters")]
     NameTooLong,
     /// The campaign name (given) cannot name a folder.
-    #[error("campaign name {0:?} must be non-empty and use only letters, digits, '-', '_' and '.' (it names the results folder)")]
+    #[error("campaign name {0:?} must be non-empty, use only letters, digits, '-', '_' and '.', and not begin with '.' (it names the results folder)")]
     BadName(String),
     /// `threads` (given) outside 1..=[`MAX_THREADS`].
     #[error("threads must be in 1..={MAX_THREADS}, found {0}")]

@@ -148,7 +148,7 @@ impl ClaimDir {
     pub fn try_claim(&self, job: &JobId, cpumax: f64, owner: &ClaimOwner) -> Result<TryClaim, ClaimError> {
         let path = self.path(job);
         let err = |source| ClaimError { path: path.clone(), source };
-        std::fs::create_dir_all(&self.dir).map_err(|source| ClaimError { path: self.dir.clone(), source })?;
+        crate::fs_atomic::create_dir_all(&self.dir).map_err(|source| ClaimError { path: self.dir.clone(), source })?;
         let mut broke = false;
         // A few rounds at most: each retry means a finishing owner unlinked the file in between
         // (or we broke an overdue claim).

@@ -269,7 +269,7 @@ impl JournalWriter {
     /// locked file would drop the lock).
     fn try_open(path: &Path) -> Result<Option<(JournalWriter, JournalRead)>, JournalError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(io_err(path))?;
+            crate::fs_atomic::create_dir_all(dir).map_err(io_err(path))?;
         }
         let mut file = OpenOptions::new().create(true).read(true).append(true).open(path).map_err(io_err(path))?;
         match file.try_lock() {
@@ -339,7 +339,7 @@ impl JournalWriter {
         }
         bytes.extend_from_slice(line);
         let dir = self.path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir)?;
+        crate::fs_atomic::create_dir_all(dir)?;
         let to = dir.join(format!("runs.rescued-{}.jsonl", std::process::id()));
         crate::fs_atomic::write_atomic(&to, &bytes)?;
         let file = OpenOptions::new().read(true).append(true).open(&to)?;

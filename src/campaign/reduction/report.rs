@@ -114,7 +114,8 @@ pub fn write_exports(data: &ReportData, exporters: &[&(dyn Exporter + Sync)]) ->
             continue;
         };
         let folder = p.parent().unwrap_or(data.dir);
-        std::fs::create_dir_all(folder).map_err(|source| ReportError::Io { path: folder.to_path_buf(), source })?;
+        crate::fs_atomic::create_dir_all(folder)
+            .map_err(|source| ReportError::Io { path: folder.to_path_buf(), source })?;
         write_atomic(&p, &bytes)?;
         files.push(p);
     }
@@ -145,7 +146,8 @@ pub fn write_problem_reports(
     reference: &[ReferenceRow],
     library: &LibraryIndex,
 ) -> Result<ReportSummary, ReportError> {
-    std::fs::create_dir_all(out_dir).map_err(|source| ReportError::Io { path: out_dir.to_path_buf(), source })?;
+    crate::fs_atomic::create_dir_all(out_dir)
+        .map_err(|source| ReportError::Io { path: out_dir.to_path_buf(), source })?;
     let data = ReportData::reduce(out_dir, records, plants, problems, reference, library);
     let files = write_exports(&data, &TABLES)?;
     Ok(ReportSummary { files, best: data.best, compare: data.compare })

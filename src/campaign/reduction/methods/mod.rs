@@ -83,7 +83,7 @@ pub fn compare_methods(sources: &[Source], rtol: f64, out: &Path) -> Result<Meth
     if rows.is_empty() {
         return Err(MethodsError::Empty);
     }
-    std::fs::create_dir_all(out).map_err(|source| ReportError::Io { path: out.to_path_buf(), source })?;
+    crate::fs_atomic::create_dir_all(out).map_err(|source| ReportError::Io { path: out.to_path_buf(), source })?;
     let sm = summarise(&rows, sources.len(), rtol);
     let text = write::summary_text(sources, &rows, &sm);
     let mut files = Vec::new();

@@ -180,7 +180,7 @@ pub fn write_plots(
     library: &LibraryIndex,
 ) -> Result<PlotSummary, PlotError> {
     let dir = campaign_dir.join("plots");
-    std::fs::create_dir_all(&dir).map_err(|source| ReportError::Io { path: dir.clone(), source })?;
+    crate::fs_atomic::create_dir_all(&dir).map_err(|source| ReportError::Io { path: dir.clone(), source })?;
     let best = best_per_problem(records, plants, problems);
     let names: Vec<&str> = best.iter().map(|r| r.plant.as_str()).collect();
     let part = |name: &str| file_part_among(name, &names);
