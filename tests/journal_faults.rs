@@ -192,3 +192,18 @@ fn a_byte_order_mark_at_the_start_of_a_journal_is_read_past() {
     assert_eq!(read.records[0].job_id, plain.records[0].job_id);
     assert!(read.torn.is_none());
 }
+
+/// A journal's name on a folder (or anything but a regular file) is an error naming it: it was
+/// skipped without a word, and `run` re-ran the jobs it should have held.
+#[test]
+fn a_journal_name_on_a_folder_is_named() {
+    let dir = std::env::temp_dir().join(format!("hinfix-journal-folder-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("runs.2.jsonl")).unwrap();
+    std::fs::write(dir.join("runs.jsonl"), b"").unwrap();
+    let e = journals_in(&dir).unwrap_err().to_string();
+    assert!(e.contains("runs.2.jsonl") && e.contains("is not a regular file"), "{e}");
+    std::fs::remove_dir_all(dir.join("runs.2.jsonl")).unwrap();
+    assert_eq!(journals_in(&dir).unwrap(), vec![dir.join("runs.jsonl")]);
+    let _ = std::fs::remove_dir_all(&dir);
+}

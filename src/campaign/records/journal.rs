@@ -357,7 +357,9 @@ pub fn is_journal_name(name: &str) -> bool {
     name == JOURNAL_FILE || (name.starts_with("runs.") && name.ends_with(".jsonl") && name.len() > "runs..jsonl".len())
 }
 
-/// The journals in folder `dir` (sorted by name). A missing folder has none.
+/// The journals in folder `dir` (sorted by name). A missing folder has none. A journal's name
+/// on something that is not a regular file (a folder, a FIFO, a dangling symbolic link) is an
+/// error naming it: skipping it silently re-ran the jobs it was meant to hold.
 pub fn journals_in(dir: &Path) -> Result<Vec<PathBuf>, JournalError> {
     let rd = match std::fs::read_dir(dir) {
         Ok(rd) => rd,
@@ -367,7 +369,14 @@ pub fn journals_in(dir: &Path) -> Result<Vec<PathBuf>, JournalError> {
     let mut out = Vec::new();
     for e in rd {
         let e = e.map_err(io_err(dir))?;
-        if is_journal_name(&e.file_name().to_string_lossy()) && e.path().is_file() {
+        if is_journal_name(&e.file_name().to_string_lossy()) {
+            if !e.path().is_file() {
+                let not_a_file = io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    "is not a regular file, and every runs*.jsonl of a results folder is read as a journal (move it away)",
+                );
+                return Err(io_err(&e.path())(not_a_file));
+            }
             out.push(e.path());
         }
     }
