@@ -35,7 +35,7 @@ use crate::design::{
     PlantTerm, PlantValue, Problem, SearchStop, Structure, VariableScaling,
 };
 use crate::fs_atomic::write_atomic;
-use crate::lti::{resolve_plant, Controller, Plant};
+use crate::lti::{resolve_plant, Controller, Plant, TimeDomain};
 use anyhow::Context;
 
 use super::{fmt_num, print_out, signals, EXIT_BOUND_VIOLATED, EXIT_NOT_STABILISED};
@@ -323,7 +323,7 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     if a.json {
         print_out(&(serde_json::to_string_pretty(&outcome)? + "\n")).context("writing to stdout")?;
     } else {
-        print_out(&summary(plant, &opts, &outcome)).context("writing to stdout")?;
+        print_out(&summary(&problem, &opts, &outcome)).context("writing to stdout")?;
     }
     let what = match (&a.out, &written, good) {
         (None, _, _) => "no --out: no controller file written (the JSON above holds it, `controller`)".to_string(),
@@ -408,14 +408,19 @@ fn check_writable(path: &Path) -> anyhow::Result<()> {
 
 /// The status as printed; a budget that ran out is named by the search's stop reason (a run
 /// `--maxevals` ended was once said to have exhausted its CPU budget).
-fn status_text(s: &DesignStatus, stop: SearchStop) -> String {
+fn status_text(s: &DesignStatus, stop: SearchStop, domain: TimeDomain) -> String {
     match s {
         DesignStatus::Converged => "converged (optimality certificate met)".into(),
         DesignStatus::Stopped => "stopped by a limit before the optimality certificate was met".into(),
         DesignStatus::StabilisedOnly => "stabilised only (the optimisation made no progress)".into(),
+        // the margin of `lti::verified_stability`: ‖·‖_F, of the balanced A where that pays
+        DesignStatus::NotStabilised { best_alpha } if domain.is_discrete() => format!(
+            "NOT STABILISED with the verification margin (best max(ρ(A_cl) − 1, ε·(ρ(Ak) − 1)) = {best_alpha:+.6e}; \
+             stable means ρ < 1 − 1e-12·max(1, ‖A‖_F))"
+        ),
         DesignStatus::NotStabilised { best_alpha } => format!(
             "NOT STABILISED with the verification margin (best max(α(A_cl), ε·α(Ak)) = {best_alpha:+.6e}; stable means \
-             below −1e-12·max(1, ‖A‖₂))"
+             α < −1e-12·max(1, ‖A‖_F))"
         ),
         DesignStatus::BoundViolated => "BOUND VIOLATED: the controller stabilises, but a bound does not hold".into(),
         DesignStatus::BudgetExhausted => format!("{} exhausted (best controller so far)", budget_name(stop)),
@@ -434,8 +439,9 @@ fn budget_name(stop: SearchStop) -> &'static str {
 }
 
 /// One line per plant of a several-plant (or non-H∞) design: its objective's value, weighted,
-/// its bound and whether it holds, its closed-loop stability measure. Empty for none.
-pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
+/// its bound and whether it holds, its closed-loop stability measure. Empty for none. The
+/// abscissa objective of a discrete plant is ρ(A_cl) − 1 (`lti::stability_measure`).
+fn plant_lines(values: &[PlantValue], domain: TimeDomain) -> String {
     let mut s = String::new();
     for (i, v) in values.iter().enumerate() {
         let bound = match v.bound {
@@ -446,7 +452,10 @@ pub(crate) fn plant_lines(values: &[PlantValue]) -> String {
             "plant {} {}: {} = {}   weight {} → {}{}   s(A_cl) = {:+.4e}\n",
             i + 1,
             for_terminal(&v.plant),
-            v.objective.symbol(),
+            match v.objective {
+                PlantObjective::Abscissa if domain.is_discrete() => "ρ(A_cl) − 1",
+                o => o.symbol(),
+            },
             fmt_num(v.value, 6),
             fmt_num(v.weight, 6),
             fmt_num(v.weighted(), 6),
@@ -467,7 +476,8 @@ fn controller_norm_note(eps_k: f64, gamma: f64, gamma_name: &str) -> String {
     )
 }
 
-fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
+fn summary(problem: &Problem, opts: &DesignOptions, o: &DesignOutcome) -> String {
+    let plant = problem.first();
     let mode = match opts.objective {
         ObjectiveKind::Strong => format!("strong stabilisation, ε = {:e}", opts.eps),
         // "plain H∞" only for the single-plant H∞ problem: an H2, abscissa or radius design (or
@@ -475,14 +485,21 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         ObjectiveKind::Plain if o.plants.is_empty() => "plain H∞".to_string(),
         ObjectiveKind::Plain => "plain (the controller may be unstable)".to_string(),
     };
-    let names = match o.plants.len() {
-        0 | 1 => for_terminal(&plant.name),
-        k => format!("{k} plants ({})", o.plants.iter().map(|v| for_terminal(&v.plant)).collect::<Vec<_>>().join(", ")),
+    let names = match problem.terms.as_slice() {
+        [_] => format!("{} (n = {}", for_terminal(&plant.name), plant.dims.n),
+        terms => format!(
+            "{} plants ({}",
+            terms.len(),
+            terms
+                .iter()
+                .map(|t| format!("{} n = {}", for_terminal(&t.plant.name), t.plant.dims.n))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     };
     let mut s = format!(
-        "{} (n = {}{}), order {}, {}, seed {}\n",
+        "{}{}), order {}, {}, seed {}\n",
         names,
-        plant.dims.n,
         plant
             .domain
             .ts()
@@ -491,8 +508,8 @@ fn summary(plant: &Plant, opts: &DesignOptions, o: &DesignOutcome) -> String {
         mode,
         opts.seed
     );
-    s += &format!("status:   {}\n", status_text(&o.status, o.search.stop));
-    s += &plant_lines(&o.plants);
+    s += &format!("status:   {}\n", status_text(&o.status, o.search.stop, plant.domain));
+    s += &plant_lines(&o.plants, plant.domain);
     // A problem's γ is its plants' largest weighted value (`design::Design`).
     let gamma_name = if o.plants.is_empty() { "‖Tzw‖∞" } else { "max w·g" };
     s += &format!(
@@ -583,6 +600,17 @@ mod tests {
         assert!(below.contains("ε‖K‖∞ = 10.475971 is within 0.1 % of ‖Tzw‖∞"), "{below}");
         let above = controller_norm_note(10.5, 10.485645, "‖Tzw‖∞");
         assert!(above.contains("ε‖K‖∞ = 10.500000 ≥ ‖Tzw‖∞"), "{above}");
+    }
+
+    /// The not-stabilised status names the measure of the plant's time domain and the margin's
+    /// norm as `lti::verified_stability` computes it (‖A‖_F, not ‖A‖₂).
+    #[test]
+    fn the_not_stabilised_status_speaks_of_the_plants_time_domain() {
+        let s = DesignStatus::NotStabilised { best_alpha: 0.5 };
+        let c = status_text(&s, SearchStop::Budget, TimeDomain::Continuous);
+        assert!(c.contains("max(α(A_cl), ε·α(Ak)) = +5.000000e-1") && c.contains("α < −1e-12·max(1, ‖A‖_F)"), "{c}");
+        let d = status_text(&s, SearchStop::Budget, TimeDomain::Discrete { ts: 0.1 });
+        assert!(d.contains("max(ρ(A_cl) − 1, ε·(ρ(Ak) − 1))") && d.contains("ρ < 1 − 1e-12"), "{d}");
     }
 
     #[test]
