@@ -93,6 +93,8 @@ def read_results(folder: str | os.PathLike) -> Results:
         warnings.warn(w, UserWarning, stacklevel=2)
     best = []
     best_csv = os.path.join(folder, "best.csv")
+    if os.path.exists(best_csv) and not os.path.isfile(best_csv):
+        raise ValueError(f"{best_csv} is not a file (`campaign report` writes it from the journal)")
     if os.path.isfile(best_csv):
         with open(best_csv, newline="") as f:
             reader = csv.DictReader(f)
@@ -101,7 +103,13 @@ def read_results(folder: str | os.PathLike) -> Results:
                     raise ValueError(f"{best_csv}: line {reader.line_num} does not have the header's "
                                      f"{len(reader.fieldnames)} cells: the file is damaged (`campaign report` "
                                      "writes it again from the journal)")
-                best.append({k: _cell(v) for k, v in row.items()})
+                cells = {k: _cell(v) for k, v in row.items()}
+                for column, kinds in (("order", (int,)), ("gamma", (int, float))):
+                    if column in cells and (isinstance(cells[column], bool) or not isinstance(cells[column], kinds)):
+                        raise ValueError(f"{best_csv}: line {reader.line_num}, column {column}: "
+                                         f"{row[column]!r} is not a number: the file is damaged "
+                                         "(`campaign report` writes it again from the journal)")
+                best.append(cells)
     return Results(folder, read["records"], best)
 
 

@@ -128,7 +128,9 @@ def _check_option(name, value):
         if not _is_real(value):
             raise TypeError(f"{name} must be a number, got {value!r}")
     elif isinstance(default, list):
-        if isinstance(value, (str, bytes)) or not all(_is_real(x) for x in np.ravel(np.asarray(value, dtype=object))):
+        # a 0-d array is one number, not a list (iterating it fails later, without the name)
+        items = None if isinstance(value, (str, bytes)) else np.asarray(value, dtype=object)
+        if items is None or items.ndim == 0 or not all(_is_real(x) for x in np.ravel(items)):
             raise TypeError(f"{name} must be a list of numbers, got {value!r}")
     elif isinstance(default, str):
         if not isinstance(value, str):
@@ -251,6 +253,9 @@ def _structure(structure):
             if not _is_real(x):
                 raise TypeError(f"structure block {k} entry ({i + 1}, {j + 1}) must be a real number, "
                                 f"None or NaN (free), got {x!r}")
+            if not math.isfinite(x):
+                raise ValueError(f"structure block {k} entry ({i + 1}, {j + 1}) is fixed at {x}, which is not "
+                                 f"finite (None or NaN: free)")
             return _json_value(x)
         out[k] = [[cell(x, i, j) for j, x in enumerate(row)] for i, row in enumerate(rows)]
     return json.dumps(out), None

@@ -15,8 +15,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use hinfix::design::{
-    ControllerShape, Design, DesignIterRecord, DesignObserver, DesignOptions, PlantObjective, PlantTerm, Problem,
-    Structure,
+    ControllerShape, Design, DesignError, DesignIterRecord, DesignObserver, DesignOptions, PlantObjective, PlantTerm,
+    Problem, Structure,
 };
 use hinfix::lti::{Controller, TimeDomain};
 
@@ -109,7 +109,12 @@ pub fn design<'py>(
         },
         on_poll,
     )?
-    .map_err(|e| failure("design", e))?;
+    .map_err(|e| match e {
+        // a failure of the optimiser is the program's; every other refusal (options, the
+        // initial controller, the structure, the plants) is of the arguments
+        DesignError::Numerical(_) => failure("design", e),
+        _ => bad_input("design", e),
+    })?;
     let k = &outcome.controller;
     let mats = [k.ak.as_ref(), k.bk.as_ref(), k.ck.as_ref(), k.dk.as_ref()].map(|m| to_numpy(py, m)).into();
     let json = serde_json::to_string(&outcome).map_err(|e| failure("design outcome", e))?;

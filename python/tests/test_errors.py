@@ -124,6 +124,18 @@ def test_unclear_inputs_get_messages_that_name_them(he1, tmp_path):
         hinfix.design(P, nmeas, ncon, 1, structure={"AK": [[1 + 2j]]}, maxevals=10)
     with pytest.raises(ValueError, match=r"option `hop_scales`: expected a number"):
         hinfix.design(P, nmeas, ncon, 1, hop_scales=[[0.1]], maxevals=10)
+    # a 0-d array is no list (iterating it failed without the option's name)
+    with pytest.raises(TypeError, match=r"hop_scales must be a list of numbers"):
+        hinfix.design(P, nmeas, ncon, 1, hop_scales=np.array(0.1), maxevals=10)
+    # a ragged matrix is named (numpy's own message did not say which)
+    with pytest.raises(ValueError, match=r"A is not a real matrix"):
+        hinfix.design([[[1.0, 2.0], [3.0]]] + [np.zeros((2, 1))] * 8, None, None, 1)
+    # a structure that no stable controller fits is a bad argument (it was a HinfixError)
+    with pytest.raises(ValueError, match="design: "):
+        hinfix.design(P, nmeas, ncon, 1, structure={"AK": [[1.0]]}, maxevals=10)
+    # an infinite fixed entry is named as such, not as "not a number" of a "structure file"
+    with pytest.raises(ValueError, match=r"structure block DK entry \(1, 1\) is fixed at inf, which is not finite"):
+        hinfix.design(P, nmeas, ncon, 1, structure={"DK": [[np.inf], [0.5]]}, maxevals=10)
     with pytest.raises(ValueError, match="order 10+ is larger than any plant's order"):
         hinfix.design(P, nmeas, ncon, 10**30)
     # a damaged best.csv (the report writes it whole; someone cut it)
@@ -132,4 +144,11 @@ def test_unclear_inputs_get_messages_that_name_them(he1, tmp_path):
     (res / "runs.jsonl").write_text("")
     (res / "best.csv").write_text("plant,order,objective,gamma\nHE1,1\n")
     with pytest.raises(ValueError, match=r"best.csv: line 2 does not have the header's 4 cells"):
+        hinfix.read_results(res)
+    (res / "best.csv").write_text("plant,order,objective,gamma\nHE1,notanumber,strong,0.1\n")
+    with pytest.raises(ValueError, match=r"best.csv: line 2, column order: 'notanumber' is not a number"):
+        hinfix.read_results(res)
+    (res / "best.csv").unlink()
+    (res / "best.csv").mkdir()
+    with pytest.raises(ValueError, match=r"best.csv is not a file"):
         hinfix.read_results(res)
