@@ -9,7 +9,7 @@
 use crate::design::ObserverMode;
 
 /// How much of the optimiser's iterations a job's trace keeps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum TraceLevel {
     /// What the summary, `campaign trace` and the convergence figure need
@@ -43,6 +43,28 @@ impl TraceLevel {
     }
 }
 
+/// From its name; anything else — another word, or another type (`trace = true`, which TOML's
+/// enum reading called "wanted string or table" without the key's values) — is an error that
+/// lists the three names.
+impl<'de> serde::Deserialize<'de> for TraceLevel {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Names;
+        impl serde::de::Visitor<'_> for Names {
+            type Value = TraceLevel;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("one of \"sparse\", \"full\", \"off\"")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<TraceLevel, E> {
+                [TraceLevel::Sparse, TraceLevel::Full, TraceLevel::Off]
+                    .into_iter()
+                    .find(|l| l.name() == v)
+                    .ok_or_else(|| E::invalid_value(serde::de::Unexpected::Str(v), &self))
+            }
+        }
+        d.deserialize_any(Names)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -54,5 +76,9 @@ mod tests {
             assert_eq!(v, level);
         }
         assert_eq!(TraceLevel::default(), TraceLevel::Sparse);
+        for bad in [serde_json::json!(true), serde_json::json!("verbose"), serde_json::json!(1)] {
+            let e = serde_json::from_value::<TraceLevel>(bad.clone()).unwrap_err().to_string();
+            assert!(e.contains(r#"one of "sparse", "full", "off""#), "{bad}: {e}");
+        }
     }
 }

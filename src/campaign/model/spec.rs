@@ -1145,6 +1145,7 @@ objective = "plain"
         assert!(e.message.to_string().contains("verbose") && e.message.to_string().contains("sparse"), "{e}");
         let e = err(&text("trace = true", ""));
         assert_eq!((e.location.line, e.location.column), (3, 9), "{e}");
+        assert!(e.message.to_string().contains(r#"one of "sparse", "full", "off""#), "{e}");
         assert!(e.to_string().starts_with("test.toml:3:9: "), "{e}");
     }
 
