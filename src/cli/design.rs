@@ -268,7 +268,9 @@ pub fn run(a: DesignArgs) -> anyhow::Result<ExitCode> {
     // Bad options and an unusable --out are errors before any work (and before any file is made).
     for t in &problem.terms {
         crate::design::validate(&t.plant, &opts, init.as_ref()).with_context(|| {
-            format!("designing an order-{} controller for {}", a.order, for_terminal(&t.plant.name))
+            // the initial controller's file, where it is the one that does not fit
+            let init_file = a.init.as_ref().map_or(String::new(), |p| format!(" from --init {}", p.display()));
+            format!("designing an order-{} controller for {}{init_file}", a.order, for_terminal(&t.plant.name))
         })?;
     }
     for t in &problem.terms {
