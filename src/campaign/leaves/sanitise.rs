@@ -1,7 +1,8 @@
 //! Names (of plants, campaigns) come from files a user may not have written. Before they reach
 //! an output they are made harmless for it:
 //! * [`for_terminal`]: control characters (escape sequences, NUL, newlines, DEL, C1 controls)
-//!   become visible `\u{…}` escapes, so they can neither move the cursor nor forge lines;
+//!   and bidirectional-text controls become visible `\u{…}` escapes, so they can neither move
+//!   the cursor, forge lines nor reorder them;
 //! * [`for_csv`]: control characters are escaped the same way, and a field that a spreadsheet
 //!   would take for a formula (it starts with `=`, `+`, `-`, `@`, tab or carriage return) gets a
 //!   leading `'` (OWASP's advice against CSV injection); quoting is left to the CSV writer;
@@ -26,9 +27,13 @@ pub fn as_key(name: &str, keep: impl Fn(char) -> bool, replacement: char, max_le
     format!("{}-{hash}", &clean[..clean.len().min(max_len.saturating_sub(9))])
 }
 
-/// Whether `c` must not reach an output raw.
+/// Whether `c` must not reach an output raw: a control character, or a bidirectional-text
+/// control (U+061C, U+200E/F, U+202A–U+202E, U+2066–U+2069), which reorders what follows it on
+/// the line (a name with U+202E displayed the rest of a `run` line reversed: CVE-2021-42574's
+/// "Trojan Source").
 fn is_control(c: char) -> bool {
     c.is_control()
+        || matches!(c, '\u{061c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
 }
 
 fn escape_controls(s: &str) -> String {
@@ -88,6 +93,7 @@ mod tests {
         assert!(!s.chars().any(char::is_control), "{s:?}");
         assert_eq!(s, "HE1\\u{1b}[2J\\u{0}\\u{a}x\\u{9b}y\\u{7f}");
         assert_eq!(for_terminal("AC10 ε"), "AC10 ε");
+        assert_eq!(for_terminal("AC\u{202e}01\u{2066}x"), "AC\\u{202e}01\\u{2066}x");
     }
 
     #[test]
