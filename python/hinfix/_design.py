@@ -189,6 +189,8 @@ def _init_matrices(init, dt):
 def _per_plant(value, n, name, check):
     """One value per plant: a single value (every plant) or a list of one per plant, as the
     command's repeated flags."""
+    if isinstance(value, np.ndarray) and value.ndim == 1:
+        value = value.tolist()  # a 1-D array is a list of one value per plant, as a list is
     if isinstance(value, (list, tuple)):
         if len(value) != n:
             raise ValueError(f"{name} has {len(value)} values for {n} plant(s): give one (for every plant) "

@@ -56,6 +56,7 @@ def test_two_plants_weights_and_bounds_agree_with_python_control(he1):
     P, nmeas, ncon = he1
     P2 = control.ss(P.A * 1.05, P.B, P.C, P.D)
     K, info = hinfix.design([P, P2], nmeas, ncon, 1, weight=[1.0, 2.0], **BUDGET)
+    K_weighted = K
     assert info.stabilised and len(info.plants) == 2 and len(info.closed_loops) == 2
     g = [linfnorm(P.lft(K)), linfnorm(P2.lft(K))]
     for v, gi, w in zip(info.plants, g, (1.0, 2.0)):
@@ -67,6 +68,9 @@ def test_two_plants_weights_and_bounds_agree_with_python_control(he1):
     assert relerr(info.gamma, linfnorm(P.lft(K))) <= 1e-8
     with pytest.raises(ValueError, match="weight has 3 values for 2 plant"):
         hinfix.design([P, P2], nmeas, ncon, 1, weight=[1.0, 2.0, 3.0])
+    # a 1-D array is one value per plant, as a list is
+    K2, info2 = hinfix.design([P, P2], nmeas, ncon, 1, weight=np.array([1.0, 2.0]), **BUDGET)
+    assert np.array_equal(K2.D, K_weighted.D) and [v["weight"] for v in info2.plants] == [1.0, 2.0]
 
 
 def test_the_h2_objective_agrees_with_python_control(he1):
