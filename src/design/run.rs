@@ -331,19 +331,7 @@ fn outcome(
         alpha_k: fig.alpha_k,
         objective: fig.objective,
         controller_norm_active: search.stop != SearchStop::NoFreeVariable
-            && match plants.as_slice() {
-                [] => controller_norm_active(opts, fig.gamma, fig.k_hinf),
-                values => {
-                    // against the minimised plants' max (not γ, which is the bounded plants' max
-                    // when every plant has a bound), and not where a violated bound's penalty
-                    // is in the objective
-                    let (free_max, violation) = plant_part(values);
-                    !problem.controller_term_is_abscissa()
-                        && free_max > f64::NEG_INFINITY
-                        && violation == 0.0
-                        && controller_norm_active(opts, free_max, fig.k_hinf)
-                }
-            },
+            && problem_norm_active(problem, opts, &fig, &plants),
         certificate,
         iterations: phases.iter().map(|p| p.iters).sum(),
         evaluations: phases.iter().map(|p| p.evals).sum(),
@@ -352,6 +340,21 @@ fn outcome(
         search,
         plants,
     }
+}
+
+/// [`controller_norm_active`] for the outcome of `problem`: for several plants (`plants` not
+/// empty) against the minimised plants' max — not γ, which is the bounded plants' max when every
+/// plant has a bound — and never where a violated bound's penalty is in the objective or the
+/// controller's term is ε·s(Ak).
+fn problem_norm_active(problem: &Problem, opts: &DesignOptions, fig: &Figures, plants: &[PlantValue]) -> bool {
+    if plants.is_empty() {
+        return controller_norm_active(opts, fig.gamma, fig.k_hinf);
+    }
+    let (free_max, violation) = plant_part(plants);
+    !problem.controller_term_is_abscissa()
+        && free_max > f64::NEG_INFINITY
+        && violation == 0.0
+        && controller_norm_active(opts, free_max, fig.k_hinf)
 }
 
 /// The most free controller variables a design takes: BFGS (`optim::bfgs`) keeps a dense
@@ -620,8 +623,9 @@ struct Figures {
 
 /// The figures of `k`, γ by the norm `check` and the reports use (`lti::hinf_norm_checked`: the
 /// level-set norm checked on a frequency grid). On large plants these figures are what a run
-/// spends after its budget (the evaluation in flight is abandoned, these are not). `stop` fires only for a cancelled run (Ctrl-C) of a large plant:
-/// then α(Acl) and γ may be left NaN ("not computed") rather than keep the user waiting.
+/// spends after its budget (the evaluation in flight is abandoned, these are not). `stop` fires
+/// only for a cancelled run (Ctrl-C) of a large plant: then α(Acl) and γ may be left NaN ("not
+/// computed") rather than keep the user waiting.
 fn figures(plant: &Plant, opts: &DesignOptions, k: &Controller, stop: Interrupt<'_>) -> Figures {
     let (alpha_cl, gamma) = match closed_loop(plant, k) {
         Ok(_) if stop.poll().is_err() => (f64::NAN, f64::NAN),
