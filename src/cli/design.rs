@@ -415,15 +415,19 @@ fn status_text(s: &DesignStatus, stop: SearchStop, domain: TimeDomain) -> String
         DesignStatus::Converged => "converged (optimality certificate met)".into(),
         DesignStatus::Stopped => "stopped by a limit before the optimality certificate was met".into(),
         DesignStatus::StabilisedOnly => "stabilised only (the optimisation made no progress)".into(),
-        // the margin of `lti::verified_stability`: ‖·‖_F, of the balanced A where that pays
-        DesignStatus::NotStabilised { best_alpha } if domain.is_discrete() => format!(
-            "NOT STABILISED with the verification margin (best max(ρ(A_cl) − 1, ε·(ρ(Ak) − 1)) = {best_alpha:+.6e}; \
-             stable means ρ < 1 − 1e-12·max(1, ‖A‖_F))"
-        ),
-        DesignStatus::NotStabilised { best_alpha } => format!(
-            "NOT STABILISED with the verification margin (best max(α(A_cl), ε·α(Ak)) = {best_alpha:+.6e}; stable means \
-             α < −1e-12·max(1, ‖A‖_F))"
-        ),
+        DesignStatus::NotStabilised { best_alpha } => {
+            // the measure of the time domain; the margin of `lti::verified_stability` (‖·‖_F, of
+            // the balanced A where that pays)
+            let (measure, stable) = if domain.is_discrete() {
+                ("max(ρ(A_cl) − 1, ε·(ρ(Ak) − 1))", "ρ < 1 − ")
+            } else {
+                ("max(α(A_cl), ε·α(Ak))", "α < −")
+            };
+            format!(
+                "NOT STABILISED with the verification margin (best {measure} = {best_alpha:+.6e}; stable means \
+                 {stable}1e-12·max(1, ‖A‖_F))"
+            )
+        }
         DesignStatus::BoundViolated => "BOUND VIOLATED: the controller stabilises, but a bound does not hold".into(),
         DesignStatus::BudgetExhausted => format!("{} exhausted (best controller so far)", budget_name(stop)),
         DesignStatus::Interrupted => "interrupted (best controller so far)".into(),
@@ -441,8 +445,7 @@ fn budget_name(stop: SearchStop) -> &'static str {
 }
 
 /// One line per plant of a several-plant (or non-H∞) design: its objective's value, weighted,
-/// its bound and whether it holds, its closed-loop stability measure. Empty for none. The
-/// abscissa objective of a discrete plant is ρ(A_cl) − 1 (`lti::stability_measure`).
+/// its bound and whether it holds, its closed-loop stability measure. Empty for none.
 fn plant_lines(values: &[PlantValue], domain: TimeDomain) -> String {
     let mut s = String::new();
     for (i, v) in values.iter().enumerate() {
@@ -454,10 +457,7 @@ fn plant_lines(values: &[PlantValue], domain: TimeDomain) -> String {
             "plant {} {}: {} = {}   weight {} → {}{}   s(A_cl) = {:+.4e}\n",
             i + 1,
             for_terminal(&v.plant),
-            match v.objective {
-                PlantObjective::Abscissa if domain.is_discrete() => "ρ(A_cl) − 1",
-                o => o.symbol(),
-            },
+            v.objective.symbol(domain),
             fmt_num(v.value, 6),
             fmt_num(v.weight, 6),
             fmt_num(v.weighted(), 6),

@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use crate::lti::{
     closed_loop, closed_loop_h2_grad_in, closed_loop_hinf_grad, closed_loop_inverse_stability_radius_grad,
     closed_loop_stability_grad, h2_feedthrough_parameterisation, stability_measure, Controller, ControllerGradient,
-    DkAffine, FeedthroughError, HinfParams, LtiError, Plant,
+    DkAffine, FeedthroughError, HinfParams, LtiError, Plant, TimeDomain,
 };
 
 /// Weight μ of the exact ℓ1 penalty on violated bounds (module docs). It is exact once μ exceeds
@@ -93,11 +93,13 @@ impl PlantObjective {
         self == PlantObjective::Abscissa && !(g < 0.0)
     }
 
-    /// The quantity as a reader sees it (‖Tzw‖∞, …).
-    pub fn symbol(self) -> &'static str {
+    /// The quantity as a reader sees it (‖Tzw‖∞, …) for a plant in `domain`: the abscissa
+    /// objective of a discrete plant is ρ(A_cl) − 1 (`lti::stability_measure`).
+    pub fn symbol(self, domain: TimeDomain) -> &'static str {
         match self {
             PlantObjective::Hinf => "‖Tzw‖∞",
             PlantObjective::H2 => "‖Tzw‖₂",
+            PlantObjective::Abscissa if domain.is_discrete() => "ρ(A_cl) − 1",
             PlantObjective::Abscissa => "α(A_cl)",
             PlantObjective::Radius => "1/r_C(A_cl)",
         }

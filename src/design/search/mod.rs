@@ -440,8 +440,8 @@ mod tests {
         OptimResult { x: vec![0.0], f, g: vec![0.0], dnorm, evaldist: 0.0, termination, iters: 1, evals: 1, cpu_s: 0.0 }
     }
 
-    /// `offer_perf`: a verified point beats an unverified one whatever their f_h; among points of
-    /// one kind the smaller f_h wins (module `verified`).
+    /// `offer_perf`'s `moved`: kept through a tie with the incumbent's own point (a resumed local
+    /// search that could not move it), false for an end point no local search moved.
     #[test]
     fn a_resumed_search_that_cannot_move_the_incumbent_keeps_it_moved() {
         let opts = DesignOptions::default();
@@ -462,6 +462,8 @@ mod tests {
         assert!(!st.perf.as_ref().unwrap().moved);
     }
 
+    /// `offer_perf`: a verified point beats an unverified one whatever their f_h; among points of
+    /// one kind the smaller f_h wins (module `verified`).
     #[test]
     fn a_verified_point_beats_an_unverified_one() {
         let opts = DesignOptions::default();
