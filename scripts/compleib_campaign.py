@@ -68,6 +68,10 @@ name = "compleib"
 description = "COMPleib v1.1: every library plant, orders 0-3 (0-1 for n > 60), plain and strong (eps = 1e-3)"
 
 [defaults]
+# The search its committed results (results/compleib/) were made with: no BFGS restarts. The default
+# (bfgs_restart = 300, campaigns/FORMAT.md) would make new job ids, and `campaign run` would start
+# this campaign over instead of resuming its journal.
+bfgs_restart = 0
 eps = 1e-3
 seeds = 2
 cpumax = 10.0

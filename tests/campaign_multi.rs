@@ -137,10 +137,13 @@ fn a_structure_loads_for_every_order_and_enters_the_ids() {
 }
 
 /// The committed strong-stab journal's ids (results/strong-stab) are jobs of the campaign, and
-/// the smoke campaign's first job keeps the id it had before problems of several plants.
+/// the smoke campaign's first job keeps the id it had before problems of several plants (with
+/// `bfgs_restart = 0`, the search of that build: a new default makes new ids, campaigns/FORMAT.md).
 #[test]
 fn single_plant_ids_are_unchanged() {
-    let c = Campaign::load(&Path::new(ROOT).join("campaigns/smoke.toml")).unwrap();
+    let smoke = Path::new(ROOT).join("campaigns/smoke.toml");
+    let text = std::fs::read_to_string(&smoke).unwrap().replacen("[defaults]\n", "[defaults]\nbfgs_restart = 0\n", 1);
+    let c = Campaign::from_toml_str(&text, &smoke).unwrap();
     let jobs = expand(&c, RunnerTag::Design);
     assert_eq!(jobs[0].id.0, "5a2a5e20881c547a3dd986b6c3fe174905f396e5be9718e4d6c9a72c6d245468", "{}", jobs[0].label());
     let c = Campaign::load(&Path::new(ROOT).join("campaigns/strong-stab.toml")).unwrap();

@@ -128,6 +128,11 @@ pub struct DesignArgs {
     /// variables reach it.
     #[arg(long, value_name = "N", default_value_t = default().continued_maxit, allow_hyphen_values = true)]
     pub continued_maxit: usize,
+    /// Restart every BFGS run's inverse-Hessian approximation at the identity after every this
+    /// many iterations (the run goes on from its point; docs/ALGORITHMS.md §7.1). 0: never, as
+    /// HIFOO.
+    #[arg(long, value_name = "N", default_value_t = default().bfgs_restart, allow_hyphen_values = true)]
+    pub bfgs_restart: usize,
     /// Keep the whole gradient-sampling reserve (10 % of the budget) to the end. By default
     /// gradient sampling runs on the best controller right after the --nrand first starts (as
     /// HIFOO's search does) and the search keeps only twice what that took; gradient sampling
@@ -374,6 +379,7 @@ fn options(a: &DesignArgs) -> anyhow::Result<DesignOptions> {
         spend_budget: if a.stop_on_stall { false } else { d.spend_budget },
         continue_at_maxit: if a.no_continue_at_maxit { false } else { d.continue_at_maxit },
         continued_maxit: a.continued_maxit,
+        bfgs_restart: a.bfgs_restart,
         return_gs_reserve: if a.keep_gs_reserve { false } else { d.return_gs_reserve },
         refine_rtol: a.refine_rtol,
         max_starts: a.max_starts.map(|n| n as usize),

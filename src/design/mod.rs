@@ -58,8 +58,8 @@ pub use observe::{
 pub(crate) use options::design_option_table;
 pub use options::{
     options_markdown, DesignOptions, ObjectiveKind, OptionRow, OptionValue, UnknownVariableScaling, VariableScaling,
-    DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES, DEFAULT_REFINE_RTOL,
-    DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
+    DEFAULT_BFGS_RESTART, DEFAULT_CENTRAL_GAMMAS, DEFAULT_CONTINUED_MAXIT, DEFAULT_HOP_SCALES, DEFAULT_RANDOM_SCALES,
+    DEFAULT_REFINE_RTOL, DEFAULT_STALL_STARTS, MAX_ITERATIONS, MAX_NRAND,
 };
 pub use outcome::{
     Certificate, DesignError, DesignOutcome, DesignStatus, InitError, Phase, PhaseStats, SearchStop, SearchSummary,

@@ -8,9 +8,17 @@ use crate::optim::{BfgsOptions, GradSampOptions, OptimError};
 use super::options::DesignOptions;
 use super::outcome::DesignError;
 
-/// BFGS options of both phases from the design options (fvalquit is set per phase).
+/// BFGS options of both phases from the design options (fvalquit is set per phase; the restart
+/// period `bfgs_restart` serves both).
 pub(crate) fn bfgs_options(opts: &DesignOptions, fvalquit: f64) -> BfgsOptions {
-    BfgsOptions { normtol: opts.normtol, evaldist: opts.evaldist, maxit: opts.maxit, fvalquit, ..Default::default() }
+    BfgsOptions {
+        normtol: opts.normtol,
+        evaldist: opts.evaldist,
+        maxit: opts.maxit,
+        fvalquit,
+        restart_every: opts.bfgs_restart,
+        ..Default::default()
+    }
 }
 
 /// BFGS options of an f_h local search (fvalquit = −∞): `maxit`, or `continued_maxit` (0: `maxit`)

@@ -14,6 +14,11 @@
 //!    Optional GRANSO-style damping (Curtis, Mitchell & Overton 2017), off by default; optional relative
 //!    eigenvalue floor H ← H + δ·maxᵢHᵢᵢ·I (`h_floor`), off by default.
 //!
+//! With `restart_every` = R > 0 (not in HANSO), H is set back to I, unscaled, before iterations
+//! R + 1, 2R + 1, …; the run keeps its point and its gradient bundle. (Scaling the reset H by
+//! sᵀy/yᵀy, as the first update does, undid the gain: near a kink y is a jump of the gradient,
+//! the scale is tiny and the steps crawl again; docs/ALGORITHMS.md §7.1.)
+//!
 //! Termination tests, in HANSO's order: f < fvalquit, ‖x‖ > xnormquit, line search bracketed but
 //! failed (the usual end at a nonsmooth minimiser, where H becomes very ill conditioned), line
 //! search never bracketed (unbounded), dnorm ≤ normtol, CPU budget, maxit; then the observer
@@ -70,6 +75,13 @@ fn symv(h: &[f64], v: &[f64]) -> Vec<f64> {
 }
 
 impl BfgsState {
+    /// H ← I (a restart, `BfgsOptions::restart_every`).
+    fn restart(&mut self) {
+        let n = self.x.len();
+        self.h.iter_mut().for_each(|v| *v = 0.0);
+        (0..n).for_each(|i| self.h[i * n + i] = 1.0);
+    }
+
     /// The BFGS update with s, y (and Bs for damping); returns false if skipped.
     fn update(&mut self, s: &[f64], y: &mut [f64], bs: &[f64], opts: &BfgsOptions) -> bool {
         let n = s.len();
@@ -153,6 +165,10 @@ impl Solver for Bfgs<'_> {
 
     fn step(&mut self, ev: &mut Evaluator<'_>, s: &mut BfgsState) -> Result<f64, Termination> {
         let n = s.x.len();
+        let r = self.opts.restart_every;
+        if r > 0 && s.iter > 0 && s.iter.is_multiple_of(r) {
+            s.restart();
+        }
         s.iter += 1;
         let p: Vec<f64> = symv(&s.h, &s.g).into_iter().map(|v| -v).collect();
         let gtp = dot(&s.g, &p);

@@ -51,6 +51,12 @@ pub struct BfgsOptions {
     /// the minimiser. The floor sets an accuracy floor of its own (f ≈ 3e-10 at 3e-15, 3e-9 at
     /// 3e-14 on that problem). `None` (HANSO). Default `None`.
     pub h_floor: Option<f64>,
+    /// Restart period: after every `restart_every` iterations H is set back to I (unscaled) and
+    /// the run goes on from its current point, with its gradient bundle. On long nonsmooth runs
+    /// H keeps the curvature of kinks the iterates have left, and its steps shrink: a run that
+    /// crawls for thousands of iterations reaches lower minimisers with a periodic restart
+    /// (docs/ALGORITHMS.md §7.1 has the measurements). 0: never (HANSO). Default 0.
+    pub restart_every: usize,
 }
 
 impl Default for BfgsOptions {
@@ -68,6 +74,7 @@ impl Default for BfgsOptions {
             scale: true,
             damping: None,
             h_floor: None,
+            restart_every: 0,
         }
     }
 }

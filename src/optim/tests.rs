@@ -363,3 +363,50 @@ fn a_small_weight_does_not_certify_a_point_when_gradients_are_taken_in_their_uni
     assert!(in_units.f <= 1e-3 * f0, "f = {:e} from {f0:e}", in_units.f);
     assert!(in_units.dnorm <= 1e-3, "the certificate is in the term's unit: dnorm {:e}", in_units.dnorm);
 }
+
+/// `restart_every`: a run no longer than the period is the run without restarts, bit for bit; a
+/// restart sets H back to I, so with a period of 1 every step is along −∇f (steepest descent),
+/// which plain BFGS's steps are not; and a restarted run still reaches the nonsmooth minimiser of
+/// a max of quadratics.
+#[test]
+fn restarts_set_the_inverse_hessian_back_to_the_identity() {
+    let ctl = RunControl::new(f64::INFINITY);
+    let path = |restart_every: usize, maxit: usize| {
+        let mut obj = Rosenbrock { n: 2 };
+        let opts = BfgsOptions { normtol: 1e-13, evaldist: 0.0, maxit, restart_every, ..Default::default() };
+        let mut xs: Vec<Vec<f64>> = vec![];
+        let mut ob = FnObserver(|r: &IterRecord<'_>| {
+            xs.push(r.x.to_vec());
+            ControlFlow::Continue(())
+        });
+        let r = bfgs(&mut obj, &[-1.2, 1.0], 0, &opts, &ctl, &mut ob).unwrap();
+        (xs, r.f.to_bits())
+    };
+    assert_eq!(path(0, 20), path(20, 20), "no restart within the period");
+    assert_ne!(path(0, 21).0, path(20, 21).0, "a restart before iteration 21");
+    // cos ∠(x_{k+1} − x_k, −∇f(x_k)) for every step of a run
+    let cosines = |xs: &[Vec<f64>]| -> Vec<f64> {
+        let mut obj = Rosenbrock { n: 2 };
+        let mut g = vec![0.0; 2];
+        xs.windows(2)
+            .filter(|w| w[1] != w[0])
+            .map(|w| {
+                obj.eval(&w[0], &mut g);
+                let s: Vec<f64> = (0..2).map(|i| w[1][i] - w[0][i]).collect();
+                -crate::numeric::dot(&s, &g) / (norm(&s) * norm(&g))
+            })
+            .collect()
+    };
+    let steepest = cosines(&path(1, 50).0);
+    assert!(steepest.len() >= 40 && steepest.iter().all(|c| *c > 1.0 - 1e-12), "{steepest:?}");
+    let plain = cosines(&path(0, 50).0);
+    assert!(plain.iter().any(|c| *c < 0.99), "{plain:?}");
+
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let mut mq = MaxQuad::random(10, &mut rng);
+    let mut opts = hanso_opts(1e-8, 1e-10, 3000, false);
+    opts.bfgs.restart_every = 100;
+    let r = run_hanso(&mut mq, 3, &opts, 4);
+    show("max-quad n=10, restart every 100", &r.best);
+    assert!(r.best.f <= 1e-6 && r.best.f >= -1e-12, "f = {:e}", r.best.f);
+}
