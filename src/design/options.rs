@@ -165,12 +165,21 @@ fn any_value<T>(_: &T) -> Result<(), String> {
     Ok(())
 }
 
-/// `Ok` when `ok`, else the message.
 /// The check of an optional count limit (`maxevals`, `max_starts`): absent, or at least 1.
 fn optional_limit(v: &Option<usize>) -> Result<(), String> {
     require(*v != Some(0), || "must be at least 1 (omit it for no limit)".into())
 }
 
+/// The check of an iteration count (`continued_maxit`, `bfgs_restart`, `gradsamp_maxit`): at most
+/// [`MAX_ITERATIONS`]; `zero` says what 0 means, where it means something else than 0 iterations.
+fn iterations_at_most_max(v: usize, zero: Option<&str>) -> Result<(), String> {
+    require(v <= MAX_ITERATIONS, || {
+        let zero = zero.map_or(String::new(), |z| format!(" (0: {z})"));
+        format!("must be at most {MAX_ITERATIONS}{zero}, got {v}")
+    })
+}
+
+/// `Ok` when `ok`, else the message.
 fn require(ok: bool, problem: impl FnOnce() -> String) -> Result<(), String> {
     if ok {
         Ok(())
@@ -397,9 +406,7 @@ macro_rules! design_option_table {
             continued_maxit: usize = $crate::design::DEFAULT_CONTINUED_MAXIT,
                 key layered, flag "--continued-maxit",
                 accepts format!("0..={} (0: maxit)", $crate::design::MAX_ITERATIONS),
-                check |v: &usize| require(*v <= $crate::design::MAX_ITERATIONS, || {
-                    format!("must be at most {} (0: maxit), got {v}", $crate::design::MAX_ITERATIONS)
-                }),
+                check |v: &usize| iterations_at_most_max(*v, Some("maxit")),
                 doc "BFGS iterations per local search of the continued search (HIFOO's first starts keep maxit)";
             /// Restart period of every BFGS run (`optim::BfgsOptions::restart_every`): after every
             /// `bfgs_restart` iterations the inverse-Hessian approximation is set back to the
@@ -410,9 +417,7 @@ macro_rules! design_option_table {
             bfgs_restart: usize = $crate::design::DEFAULT_BFGS_RESTART,
                 key layered, flag "--bfgs-restart",
                 accepts format!("0..={} (0: never)", $crate::design::MAX_ITERATIONS),
-                check |v: &usize| require(*v <= $crate::design::MAX_ITERATIONS, || {
-                    format!("must be at most {} (0: never), got {v}", $crate::design::MAX_ITERATIONS)
-                }),
+                check |v: &usize| iterations_at_most_max(*v, Some("never")),
                 doc "BFGS restarts its inverse Hessian at the identity every this many iterations (0: never)";
             /// Give the unused part of the gradient-sampling reserve back to the search: gradient
             /// sampling runs on the incumbent where HIFOO's search runs it (after the `nrand` first
@@ -583,9 +588,7 @@ macro_rules! design_option_table {
             gradsamp_maxit: usize = 300,
                 key "", flag "",
                 accepts format!("0..={}", $crate::design::MAX_ITERATIONS),
-                check |v: &usize| require(*v <= $crate::design::MAX_ITERATIONS, || {
-                    format!("must be at most {}, got {v}", $crate::design::MAX_ITERATIONS)
-                }),
+                check |v: &usize| iterations_at_most_max(*v, None),
                 doc "iterations of each gradient-sampling run (HIFOO's 3 radii × 100)";
         }
     };

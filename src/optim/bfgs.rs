@@ -69,6 +69,13 @@ pub(crate) struct Bfgs<'o> {
     pub(crate) opts: &'o BfgsOptions,
 }
 
+/// The n × n identity, row-major: H₀, and H after a restart.
+fn identity(n: usize) -> Vec<f64> {
+    let mut h = vec![0.0; n * n];
+    (0..n).for_each(|i| h[i * n + i] = 1.0);
+    h
+}
+
 fn symv(h: &[f64], v: &[f64]) -> Vec<f64> {
     let n = v.len();
     (0..n).map(|i| dot(&h[i * n..(i + 1) * n], v)).collect()
@@ -77,9 +84,7 @@ fn symv(h: &[f64], v: &[f64]) -> Vec<f64> {
 impl BfgsState {
     /// H ← I (a restart, `BfgsOptions::restart_every`).
     fn restart(&mut self) {
-        let n = self.x.len();
-        self.h.iter_mut().for_each(|v| *v = 0.0);
-        (0..n).for_each(|i| self.h[i * n + i] = 1.0);
+        self.h = identity(self.x.len());
     }
 
     /// The BFGS update with s, y (and Bs for damping); returns false if skipped.
@@ -143,10 +148,7 @@ impl Solver for Bfgs<'_> {
         if !usable(f, &g) || x0.iter().any(|v| !v.is_finite()) {
             return Err(OptimError::NonFiniteStart { f });
         }
-        let mut h = vec![0.0; n * n];
-        for i in 0..n {
-            h[i * n + i] = 1.0;
-        }
+        let h = identity(n);
         let bundle = GradBundle::new(self.opts.ngrad_for(n), x0, &g, ev.gradient_unit(x0));
         let dnorm = bundle.dnorm();
         Ok(BfgsState {
