@@ -19,13 +19,12 @@ NAMES = ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22")
 def as_matrix(x, name):
     """``x`` as a 2-D float64 array (no copy when it already is one)."""
     try:
-        if np.iscomplexobj(x):  # may itself fail on ragged rows
-            raise ValueError(f"{name} must be real, got a complex array")
-        a = np.asarray(x, dtype=np.float64)
+        complex_ = np.iscomplexobj(x)  # may itself fail on ragged rows
+        a = None if complex_ else np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as e:
-        if str(e).startswith(f"{name} must be real"):
-            raise
         raise ValueError(f"{name} is not a real matrix: {e}") from None
+    if complex_:
+        raise ValueError(f"{name} must be real, got a complex array")
     if a.ndim != 2:
         raise ValueError(f"{name} must be 2-D, got an array of shape {a.shape}")
     return a
